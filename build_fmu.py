@@ -1,0 +1,176 @@
+"""Build the bushing FMU: ``python build_fmu.py [--params FILE] [--out DIR]``.
+
+Writes ``DIR/BoucWenBushing.fmu`` (FMI 2.0 co-simulation, pythonfmu) whose parameter start
+values are the set in FILE (default: the paper's Table 5, ``data/params_table5_combined.json``).
+
+What the build adds to pythonfmu's output, and why:
+- Unique module names. The slave module is packed as ``boucwen_bushing_<hash>.py`` with its
+  library in ``boucwen_bushing_<hash>_lib/``, the hash taken over the packed sources and the
+  default parameters: pythonfmu imports packed modules into the host's shared
+  ``sys.modules``, so two FMUs with equal module names would silently run the first one's code.
+- modelDescription.xml: units on every variable and their UnitDefinitions, the
+  InitialUnknowns and the output's direct dependencies (pythonfmu writes none of these), and
+  a check with ``fmpy.validation.validate_fmu`` that must find no problem.
+- ``needsExecutionTool="true"`` is kept on purpose: the FMU runs Python code and needs a
+  Python 3 runtime (libpython) in the host process.
+"""
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+import shutil
+import sys
+import tempfile
+import zipfile
+from pathlib import Path
+from xml.dom.minidom import parseString
+from xml.etree import ElementTree as ET
+
+REPO = Path(__file__).resolve().parent
+SOURCE_DIR = REPO / "fmu_src"
+DEFAULT_PARAMS = REPO / "data" / "params_table5_combined.json"
+LIBRARY_MODULES = ("bushing_core.py", "bushing_params.py")
+SLAVE_MODULE = "bushing_slave.py"
+
+sys.path.insert(0, str(REPO))
+from fmu_src import bushing_params  # noqa: E402
+
+# Unit name -> SI base-unit exponents and factor (value_SI = factor * value); None: no SI form.
+UNIT_DEFINITIONS = {
+    "m": {"m": "1"},
+    "m/s": {"m": "1", "s": "-1"},
+    "N": {"kg": "1", "m": "1", "s": "-2"},
+    "N/mm": {"kg": "1", "s": "-2", "factor": "1000"},
+    "N.s/mm": {"kg": "1", "s": "-1", "factor": "1000"},
+    "1": {},
+    # beta*|z|^n must be in N/mm, so beta and gamma carry N^(1-n)/mm: a non-integer power
+    # that FMI's BaseUnit cannot express. Declared by name only.
+    "N^(1-n1)/mm": None,
+    "N^(1-n2)/mm": None,
+}
+PORT_UNITS = {"x": "m", "v": "m/s", "F": "N", "z1": "N", "z2": "N", "y": "m", "w": "m"}
+
+
+class BuildError(RuntimeError):
+    pass
+
+
+def build_fmu(params_file: str | Path = DEFAULT_PARAMS, out_dir: str | Path = REPO / "dist") -> Path:
+    """Build the FMU with the parameter set in ``params_file`` as start values; return its path."""
+    from pythonfmu.builder import FmuBuilder
+
+    params_file = Path(params_file)
+    parameters = bushing_params.load_parameter_file(params_file)
+    defaults_json = bushing_params.parameter_document(
+        parameters, {"source": f"build_fmu.py --params {params_file.name}"})
+    defaults_text = json.dumps(defaults_json, indent=2) + "\n"
+
+    digest = hashlib.sha256()
+    for name in (SLAVE_MODULE, *LIBRARY_MODULES):
+        digest.update((SOURCE_DIR / name).read_bytes())
+    digest.update(defaults_text.encode())
+    module_name = f"boucwen_bushing_{digest.hexdigest()[:12]}"
+
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(prefix="bushing_build_") as stage:
+        stage = Path(stage)
+        script = stage / f"{module_name}.py"
+        shutil.copy2(SOURCE_DIR / SLAVE_MODULE, script)
+        library = stage / f"{module_name}_lib"
+        library.mkdir()
+        (library / "__init__.py").write_text('"""Packed library of the bushing FMU."""\n')
+        for name in LIBRARY_MODULES:
+            shutil.copy2(SOURCE_DIR / name, library / name)
+        (library / "default_parameters.json").write_text(defaults_text)
+
+        sys.path.insert(0, str(stage))
+        try:
+            fmu_path = Path(FmuBuilder.build_FMU(
+                script, dest=out_dir, project_files=[library],
+                canGetAndSetFMUstate=True, canSerializeFMUstate=True))
+        finally:
+            sys.path.remove(str(stage))
+            for loaded in [m for m in sys.modules if m.startswith(module_name)]:
+                del sys.modules[loaded]
+
+    _rewrite_model_description(fmu_path, parameters)
+    from fmpy.validation import validate_fmu
+    problems = validate_fmu(str(fmu_path))
+    if problems:
+        raise BuildError(f"{fmu_path} fails validation:\n  " + "\n  ".join(problems))
+    return fmu_path
+
+
+def _rewrite_model_description(fmu_path: Path, parameters: dict[str, float]) -> None:
+    with zipfile.ZipFile(fmu_path) as archive:
+        entries = {info.filename: archive.read(info.filename) for info in archive.infolist()}
+    root = ET.fromstring(entries["modelDescription.xml"])
+    _add_units(root)
+    _set_parameter_starts(root, parameters)
+    _add_model_structure(root)
+    text = parseString(ET.tostring(root, encoding="UTF-8")).toprettyxml(indent="  ", encoding="UTF-8")
+    entries["modelDescription.xml"] = b"\n".join(line for line in text.splitlines() if line.strip())
+    with zipfile.ZipFile(fmu_path, "w", zipfile.ZIP_DEFLATED) as archive:
+        for name, data in entries.items():
+            archive.writestr(name, data)
+
+
+def _add_units(root: ET.Element) -> None:
+    units_used = set()
+    for variable in root.iter("ScalarVariable"):
+        name = variable.get("name")
+        unit = PORT_UNITS.get(name) or bushing_params.PARAMETER_UNITS.get(name)
+        if unit is None:
+            raise BuildError(f"no unit declared for variable {name!r}")
+        variable.find("Real").set("unit", unit)
+        units_used.add(unit)
+    definitions = ET.Element("UnitDefinitions")
+    for unit in sorted(units_used):
+        element = ET.SubElement(definitions, "Unit", name=unit)
+        base = UNIT_DEFINITIONS[unit]
+        if base is not None:
+            ET.SubElement(element, "BaseUnit", base)
+    # FMI 2.0 schema order: CoSimulation, UnitDefinitions, TypeDefinitions, LogCategories, ...
+    position = list(root).index(root.find("CoSimulation")) + 1
+    root.insert(position, definitions)
+
+
+def _set_parameter_starts(root: ET.Element, parameters: dict[str, float]) -> None:
+    """pythonfmu writes starts with %.16g, which need not round-trip; repr() does."""
+    for variable in root.iter("ScalarVariable"):
+        if variable.get("name") in parameters:
+            variable.find("Real").set("start", repr(parameters[variable.get("name")]))
+
+
+def _add_model_structure(root: ET.Element) -> None:
+    index = {v.get("name"): str(i + 1) for i, v in enumerate(root.iter("ScalarVariable"))}
+    structure = root.find("ModelStructure")
+    for child in list(structure):
+        structure.remove(child)
+    # F = k0*y + c0*(c2*v + k2*(x - w) + alpha2*z2)/(c0 + c2): direct feedthrough of x and v.
+    outputs = ET.SubElement(structure, "Outputs")
+    ET.SubElement(outputs, "Unknown", index=index["F"], dependencies=f"{index['x']} {index['v']}",
+                  dependenciesKind="dependent dependent")
+    initial = ET.SubElement(structure, "InitialUnknowns")
+    ET.SubElement(initial, "Unknown", index=index["F"])
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--params", default=str(DEFAULT_PARAMS),
+                        help="parameter set (project JSON, paper N-mm-s units); default: the paper's Table 5")
+    parser.add_argument("--out", default=str(REPO / "dist"), help="output directory (default: dist/)")
+    args = parser.parse_args(argv)
+    try:
+        path = build_fmu(args.params, args.out)
+    except (bushing_params.ParameterError, BuildError) as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    print(f"wrote {path}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,158 @@
+"""The 16 parameters of the proposed bushing model: names, units, validation, files.
+
+Units are the paper's N-mm-s units so that its tables can be typed in verbatim:
+stiffnesses k and the Bouc-Wen gains A in N/mm, dampings c in N*s/mm, beta and gamma
+in N^(1-n)/mm (so that beta*|z|^n is in N/mm with z in N), alpha and n dimensionless.
+
+Validation never raises: it returns human-readable problems, each naming the parameter,
+its value, its unit and what is allowed, so that the FMU can log them with an FMI status
+and the identification can raise them.
+"""
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Mapping
+
+MODEL_NAME = "BoucWenBushing"
+UNIT_SYSTEM = "N-mm-s"
+
+
+@dataclass(frozen=True)
+class ParameterSpec:
+    name: str
+    unit: str
+    description: str
+
+
+PARAMETER_SPECS: tuple[ParameterSpec, ...] = (
+    ParameterSpec("c0", "N.s/mm", "dashpot in series with the right block; roll-off at low velocity"),
+    ParameterSpec("k0", "N/mm", "spring from the left plate y to ground; main static stiffness"),
+    ParameterSpec("c1", "N.s/mm", "dashpot between x and y; relaxation of the impact force"),
+    ParameterSpec("k1", "N/mm", "spring between x and y (standard solid)"),
+    ParameterSpec("c2", "N.s/mm", "dashpot between x and w; viscous damping at large velocity"),
+    ParameterSpec("k2", "N/mm", "spring between x and w; stiffness at large velocity"),
+    ParameterSpec("alpha1", "1", "weight of the hysteretic force z1 on the left plate"),
+    ParameterSpec("alpha2", "1", "weight of the hysteretic force z2 on the right plate"),
+    ParameterSpec("beta1", "N^(1-n1)/mm", "Bouc-Wen shape parameter of z1 (eq. 1)"),
+    ParameterSpec("beta2", "N^(1-n2)/mm", "Bouc-Wen shape parameter of z2 (eq. 2)"),
+    ParameterSpec("gamma1", "N^(1-n1)/mm", "Bouc-Wen shape parameter of z1 (eq. 1)"),
+    ParameterSpec("gamma2", "N^(1-n2)/mm", "Bouc-Wen shape parameter of z2 (eq. 2)"),
+    ParameterSpec("n1", "1", "Bouc-Wen exponent of z1 (smoothness of the transition)"),
+    ParameterSpec("n2", "1", "Bouc-Wen exponent of z2"),
+    ParameterSpec("A1", "N/mm", "Bouc-Wen initial stiffness of z1"),
+    ParameterSpec("A2", "N/mm", "Bouc-Wen initial stiffness of z2"),
+)
+PARAMETER_NAMES: tuple[str, ...] = tuple(spec.name for spec in PARAMETER_SPECS)
+PARAMETER_UNITS: dict[str, str] = {spec.name: spec.unit for spec in PARAMETER_SPECS}
+
+
+class ParameterError(ValueError):
+    """A parameter set that the model cannot simulate; the message lists every problem."""
+
+
+def validate_parameters(params: Mapping[str, float]) -> tuple[list[str], list[str]]:
+    """Check a parameter set (paper units).
+
+    Returns ``(errors, warnings)``. Errors make the model unusable (NaN/Inf, c1 <= 0,
+    c0 + c2 <= 0, n <= 0, negative stiffness); warnings are the paper's identification
+    constraints (A >= 1, beta >= 0, beta1 + gamma1 > 0, beta2 - gamma2 > 0), which the
+    equations do not need but a fitted bushing should satisfy.
+    """
+    errors: list[str] = []
+    warnings: list[str] = []
+    missing = [name for name in PARAMETER_NAMES if name not in params]
+    if missing:
+        errors.append(f"missing parameters: {', '.join(missing)}")
+        return errors, warnings
+    p = {name: params[name] for name in PARAMETER_NAMES}
+    for name, value in p.items():
+        if not isinstance(value, (int, float)) or isinstance(value, bool):
+            errors.append(f"{name} = {value!r} is not a number (unit {PARAMETER_UNITS[name]})")
+        elif not math.isfinite(value):
+            errors.append(f"{name} = {value} [{PARAMETER_UNITS[name]}] must be a finite number")
+    if errors:
+        return errors, warnings
+
+    if not p["c1"] > 0:
+        errors.append(f"c1 = {p['c1']} N.s/mm must be > 0 (it divides eq. 3)")
+    if not p["c0"] + p["c2"] > 0:
+        errors.append(f"c0 + c2 = {p['c0'] + p['c2']} N.s/mm must be > 0 (it divides eq. 4)")
+    for name in ("n1", "n2"):
+        if not p[name] > 0:
+            errors.append(f"{name} = {p[name]} must be > 0 (exponent of |z| in eqs. 1-2)")
+    for name in ("k0", "k1", "k2"):
+        if p[name] < 0:
+            errors.append(f"{name} = {p[name]} N/mm must be >= 0 (a negative spring is unstable)")
+
+    for name in ("A1", "A2"):
+        if p[name] < 1:
+            warnings.append(f"{name} = {p[name]} N/mm violates the paper's constraint {name} >= 1")
+    for name in ("beta1", "beta2"):
+        if p[name] < 0:
+            warnings.append(f"{name} = {p[name]} violates the paper's constraint {name} >= 0")
+    if not p["beta1"] + p["gamma1"] > 0:
+        warnings.append(f"beta1 + gamma1 = {p['beta1'] + p['gamma1']} violates the paper's constraint "
+                        "beta1 + gamma1 > 0")
+    if not p["beta2"] - p["gamma2"] > 0:
+        warnings.append(f"beta2 - gamma2 = {p['beta2'] - p['gamma2']} violates the paper's constraint "
+                        "beta2 - gamma2 > 0")
+    for name in ("c0", "c2"):
+        if p[name] < 0:
+            warnings.append(f"{name} = {p[name]} N.s/mm is a negative damping (unphysical)")
+    return errors, warnings
+
+
+def check_parameters(params: Mapping[str, float]) -> dict[str, float]:
+    """Return the 16 parameters as floats, or raise ParameterError listing every error."""
+    errors, _ = validate_parameters(params)
+    if errors:
+        raise ParameterError("invalid bushing parameters: " + "; ".join(errors))
+    unknown = sorted(set(params) - set(PARAMETER_NAMES))
+    if unknown:
+        raise ParameterError(f"unknown parameter names {unknown}; allowed: {', '.join(PARAMETER_NAMES)}")
+    return {name: float(params[name]) for name in PARAMETER_NAMES}
+
+
+def load_parameter_file(path: str | Path) -> dict[str, float]:
+    """Read a parameter set from the project's JSON format (paper units).
+
+    Format: ``{"model": "BoucWenBushing", "units": "N-mm-s", "parameters": {16 names: values},
+    "fit": {...provenance...}}``.
+    """
+    path = Path(path)
+    try:
+        document = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise ParameterError(f"parameter file {path} does not exist") from None
+    except json.JSONDecodeError as exc:
+        raise ParameterError(f"parameter file {path} is not valid JSON: {exc}") from None
+    if not isinstance(document, dict) or "parameters" not in document:
+        raise ParameterError(f"parameter file {path} has no 'parameters' object")
+    units = document.get("units", UNIT_SYSTEM)
+    if units != UNIT_SYSTEM:
+        raise ParameterError(f"parameter file {path} declares units {units!r}; only {UNIT_SYSTEM!r} is supported")
+    model = document.get("model", MODEL_NAME)
+    if model != MODEL_NAME:
+        raise ParameterError(f"parameter file {path} is for model {model!r}, not {MODEL_NAME!r}")
+    try:
+        return check_parameters(document["parameters"])
+    except ParameterError as exc:
+        raise ParameterError(f"{path}: {exc}") from None
+
+
+def parameter_document(params: Mapping[str, float], provenance: Mapping | None = None) -> dict:
+    """The JSON document written by :func:`save_parameter_file`."""
+    return {
+        "model": MODEL_NAME,
+        "units": UNIT_SYSTEM,
+        "parameters": {name: float(params[name]) for name in PARAMETER_NAMES},
+        "fit": dict(provenance or {}),
+    }
+
+
+def save_parameter_file(path: str | Path, params: Mapping[str, float], provenance: Mapping | None = None) -> None:
+    check_parameters(params)
+    Path(path).write_text(json.dumps(parameter_document(params, provenance), indent=2) + "\n", encoding="utf-8")

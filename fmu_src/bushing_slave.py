@@ -1,0 +1,208 @@
+"""pythonfmu adapter: the FMI 2.0 co-simulation face of the bushing model.
+
+A thin layer: it declares the variables, converts SI ports to the paper's N-mm-s units,
+validates every value it is given and calls ``bushing_core``. Nothing here changes the
+equations.
+
+Error policy. pythonfmu turns a Python exception into fmi2Fatal (the instance is lost), so
+nothing here raises. A setter stores the value and logs a problem at once; a doStep that
+cannot succeed (invalid parameter or input, overflow, too many substeps) logs the reason
+with category ``logStatusError`` and returns False, which pythonfmu reports as fmi2Discard;
+the committed state stays untouched, so the master can fix the value and step again.
+The output F is never NaN or Inf: it falls back to the last finite force.
+
+Packaging. Inside an FMU this module is renamed to a name unique to the build, and its
+siblings live in the package ``<that name>_lib``, so several FMUs of this project (even
+with different code or defaults) can share one Python interpreter without running each
+other's modules.
+"""
+import importlib
+import math
+from pathlib import Path
+
+from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Real
+from pythonfmu.default_experiment import DefaultExperiment
+from pythonfmu.enums import Fmi2Status
+
+if __package__:
+    from . import bushing_core as core
+    from . import bushing_params as params
+else:
+    core = importlib.import_module(__name__ + "_lib.bushing_core")
+    params = importlib.import_module(__name__ + "_lib.bushing_params")
+
+DEFAULT_PARAMETERS_FILE = Path(core.__file__).with_name("default_parameters.json")
+"""Written by build_fmu.py into the packed library: the parameter start values."""
+
+MM_PER_M = 1000.0
+FMU_VERSION = "0.1.0"
+
+
+class BoucWenBushing(Fmi2Slave):
+    author = "Bouc-Wen bushing project"
+    description = ("Nonlinear rubber bushing, one axis: the modified Spencer/Bouc-Wen model of "
+                   "'New nonlinear bushing model for general excitations using Bouc-Wen hysteretic "
+                   "model' (eqs. 1-5). Ports in SI, parameters in the paper's N-mm-s units.")
+    version = FMU_VERSION
+    license = "MIT"
+    default_experiment = DefaultExperiment(start_time=0.0, stop_time=1.0, step_size=1e-3)
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        defaults = params.load_parameter_file(DEFAULT_PARAMETERS_FILE)
+        for name in params.PARAMETER_NAMES:
+            setattr(self, name, defaults[name])
+        self.x = 0.0  # m
+        self.v = 0.0  # m/s
+        self._compiled = None          # core.CompiledModel of the parameters in force
+        self._parameters = None        # dict of the parameters in force (paper units)
+        self._parameters_changed = True
+        self._state = core.BushingState(0.0, 0.0, 0.0, 0.0)  # committed state, mm and N
+        self._x_output_mm = 0.0        # displacement at which F is reported
+        self._last_force = 0.0         # N, last finite force
+        self._initialized = False
+
+        for spec in params.PARAMETER_SPECS:
+            self.register_variable(Real(
+                spec.name, causality=Fmi2Causality.parameter, variability=Fmi2Variability.tunable,
+                description=f"{spec.description} [{spec.unit}]",
+                setter=self._parameter_setter(spec.name)))
+        self.register_variable(Real(
+            "x", causality=Fmi2Causality.input, variability=Fmi2Variability.continuous,
+            description="relative displacement of the bushing (upper plate minus base) [m]",
+            setter=self._set_displacement))
+        self.register_variable(Real(
+            "v", causality=Fmi2Causality.input, variability=Fmi2Variability.continuous,
+            description="relative velocity dx/dt [m/s]", setter=self._set_velocity))
+        self.register_variable(Real(
+            "F", causality=Fmi2Causality.output, variability=Fmi2Variability.continuous,
+            description="bushing force, positive for positive x (force on the base) [N]",
+            getter=self._force))
+        for name, scale, unit, meaning in (
+                ("z1", 1.0, "N", "hysteretic force of the left block (eq. 1)"),
+                ("z2", 1.0, "N", "hysteretic force of the right block (eq. 2)"),
+                ("y", 1.0 / MM_PER_M, "m", "displacement of the left plate (eq. 3)"),
+                ("w", 1.0 / MM_PER_M, "m", "displacement of the right plate (eq. 4)")):
+            self.register_variable(Real(
+                name, causality=Fmi2Causality.local, variability=Fmi2Variability.continuous,
+                description=f"internal state: {meaning} [{unit}]",
+                getter=self._state_getter(name, scale)))
+
+    # ---------------------------------------------------------------- variable access
+    def _parameter_setter(self, name):
+        def set_parameter(value):
+            setattr(self, name, value)
+            self._parameters_changed = True
+            if not math.isfinite(value):
+                self._error(f"parameter {name} = {value} [{params.PARAMETER_UNITS[name]}] is not "
+                            "a finite number; the next doStep will be refused until it is")
+        return set_parameter
+
+    def _set_displacement(self, value):
+        self.x = value
+        self._x_output_mm = value * MM_PER_M
+        if not math.isfinite(value):
+            self._error(f"input x = {value} m is not a finite number; the next doStep will be refused")
+
+    def _set_velocity(self, value):
+        self.v = value
+        if not math.isfinite(value):
+            self._error(f"input v = {value} m/s is not a finite number; the next doStep will be refused")
+
+    def _state_getter(self, name, scale):
+        index = core.BushingState._fields.index(name)
+        return lambda: self._state[index] * scale
+
+    def _force(self):
+        """F at the current time: committed state, current displacement and velocity."""
+        if self._refresh_parameters():
+            try:
+                force = core.force(self._state, self._x_output_mm, self.v * MM_PER_M, self._parameters)
+            except (ArithmeticError, ValueError):
+                force = math.nan
+            if math.isfinite(force):
+                self._last_force = force
+        return self._last_force
+
+    # ---------------------------------------------------------------- FMI life cycle
+    def exit_initialization_mode(self):
+        if self._refresh_parameters():
+            x_mm = self.x * MM_PER_M if math.isfinite(self.x) else 0.0
+            self._state = core.initial_state(self._parameters, x_mm)
+            self._x_output_mm = x_mm
+        self._initialized = True
+
+    def do_step(self, current_time, step_size):
+        if not (math.isfinite(step_size) and step_size > 0.0):
+            return self._refuse(f"communication step size {step_size} s must be a finite number > 0")
+        if not self._refresh_parameters():
+            return self._refuse("doStep refused: the parameters are invalid (see the errors above)")
+        for name, value, unit in (("x", self.x, "m"), ("v", self.v, "m/s")):
+            if not math.isfinite(value):
+                return self._refuse(f"doStep refused: input {name} = {value} {unit} is not a finite number")
+        x_mm = self.x * MM_PER_M
+        v_mm = self.v * MM_PER_M
+        try:
+            state, _ = core.advance(self._compiled, self._state, x_mm, v_mm, step_size)
+        except core.StepError as exc:
+            return self._refuse(f"doStep at t = {current_time} s refused: {exc}")
+        x_end = x_mm + v_mm * step_size
+        force = core.force(state, x_end, v_mm, self._parameters)
+        if not math.isfinite(force):
+            return self._refuse(f"doStep at t = {current_time} s refused: the force would be {force} N "
+                                f"(x = {self.x} m, v = {self.v} m/s); check the units of the inputs")
+        self._state = state
+        self._x_output_mm = x_end
+        self._last_force = force
+        return True
+
+    def _refresh_parameters(self) -> bool:
+        """Validate and compile the parameters once after they change, logging errors and
+        warnings; True if the parameters in force are usable."""
+        if self._parameters_changed:
+            self._parameters_changed = False
+            values = {name: getattr(self, name) for name in params.PARAMETER_NAMES}
+            errors, warnings = params.validate_parameters(values)
+            for message in errors:
+                self._error(message)
+            if errors:
+                self._compiled = None
+                self._parameters = None
+            else:
+                for message in warnings:
+                    self.log(f"accepted, but {message}", Fmi2Status.warning, "logStatusWarning")
+                self._parameters = values
+                self._compiled = core.compile_model(values)
+        return self._compiled is not None
+
+    def _error(self, message):
+        self.log(message, Fmi2Status.error, "logStatusError")
+
+    def _refuse(self, message) -> bool:
+        self._error(message)
+        return False
+
+    # ---------------------------------------------------------------- FMU state
+    # pythonfmu's default state holds the registered variables only; the committed ODE
+    # state, the reported displacement and the last force must travel with it too.
+    def _get_fmu_state(self):
+        return {
+            "parameters": {name: getattr(self, name) for name in params.PARAMETER_NAMES},
+            "x": self.x, "v": self.v,
+            "state": list(self._state),
+            "x_output_mm": self._x_output_mm,
+            "last_force": self._last_force,
+            "initialized": self._initialized,
+        }
+
+    def _set_fmu_state(self, state):
+        for name, value in state["parameters"].items():
+            setattr(self, name, value)
+        self.x = state["x"]
+        self.v = state["v"]
+        self._state = core.BushingState(*state["state"])
+        self._x_output_mm = state["x_output_mm"]
+        self._last_force = state["last_force"]
+        self._initialized = state["initialized"]
+        self._parameters_changed = True
+        self._refresh_parameters()
