@@ -49,6 +49,13 @@ UNIT_DEFINITIONS = {
     "N^(1-n1)/mm": None,
     "N^(1-n2)/mm": None,
 }
+PACKED_LIBRARY_INIT = '''"""Packed library of the bushing FMU (written by build_fmu.py)."""
+from pathlib import Path
+
+from . import bushing_core, bushing_params
+
+DEFAULT_PARAMETERS = bushing_params.load_parameter_file(Path(__file__).with_name("default_parameters.json"))
+'''
 PORT_UNITS = {"x": "m", "v": "m/s", "F": "N", "z1": "N", "z2": "N", "y": "m", "w": "m"}
 
 
@@ -80,7 +87,7 @@ def build_fmu(params_file: str | Path = DEFAULT_PARAMS, out_dir: str | Path = RE
         shutil.copy2(SOURCE_DIR / SLAVE_MODULE, script)
         library = stage / f"{module_name}_lib"
         library.mkdir()
-        (library / "__init__.py").write_text('"""Packed library of the bushing FMU."""\n')
+        (library / "__init__.py").write_text(PACKED_LIBRARY_INIT)
         for name in LIBRARY_MODULES:
             shutil.copy2(SOURCE_DIR / name, library / name)
         (library / "default_parameters.json").write_text(defaults_text)

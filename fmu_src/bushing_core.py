@@ -240,15 +240,60 @@ def _substeps_needed(u0, z0, T, a, blk):
     return int(math.ceil(worst / THETA))
 
 
-def advance(model: CompiledModel, state, x: float, v: float, h: float,
-            max_substeps: int = DEFAULT_MAX_SUBSTEPS) -> tuple[BushingState, int]:
-    """Integrate from the start of a step to its end.
+def apply_displacement_jump(model: CompiledModel, state, jump_mm: float) -> BushingState:
+    """Exact response of eqs. 1-4 to an instantaneous displacement jump [mm] (an impulse in
+    dx/dt): the dashpot c1 carries y along (y += jump, z1 unchanged); the dashpots c0, c2
+    split it (w += c2/(c0 + c2)*jump) and block 2 sees the relative displacement
+    xi = c0/(c0 + c2)*jump, along which z2 follows dz2/dxi = g2(z2, sgn xi).
 
-    x [mm] is the displacement at the start, v [mm/s] the constant velocity, h [s] > 0 the
-    step. Returns the new state and the number of substeps used. Raises StepError if the
-    result would overflow or is not finite, or if more than ``max_substeps`` are needed;
-    the state passed in is never modified (it is an immutable tuple).
+    A master that sets x_{k+1} different from x_k + v_k*h (e.g. the instantaneous velocity
+    instead of the mean over the step) makes such a jump at every step; treating it as a
+    displacement of the whole model, not of the springs alone, keeps ẋ = v consistent.
     """
+    y, z1, w, z2 = state
+    if jump_mm == 0.0:
+        return BushingState(y, z1, w, z2)
+    K, alpha, c, A, beta, gamma, n = model.block2
+    xi_total = model.c0 / model.C * jump_mm
+    sigma = 1.0 if xi_total > 0.0 else -1.0
+    cpos = gamma + beta * sigma
+    cneg = gamma - beta * sigma
+    remaining = xi_total
+    for _ in range(DEFAULT_MAX_SUBSTEPS):
+        # Same a-priori rule as the time steps: bound the change of g2 per piece.
+        g0 = A - (cpos * z2 ** n if z2 > 0.0 else cneg * (-z2) ** n)
+        z_pred = z2 + g0 * remaining
+        g_pred = A - (cpos * z_pred ** n if z_pred > 0.0 else cneg * (-z_pred) ** n)
+        dg = abs(g0 - A) + abs(g_pred - A) if (z_pred > 0.0) != (z2 > 0.0) else abs(g_pred - g0)
+        pieces = 1 if dg <= THETA * abs(g0) else min(int(math.ceil(dg / (THETA * abs(g0) + 1e-300))), 1000)
+        piece = remaining / pieces
+        z2 = _rk4_in_xi(z2, piece, A, cpos, cneg, n)
+        remaining -= piece
+        if pieces == 1:
+            break
+    else:
+        raise StepError(f"a displacement jump of {jump_mm:g} mm needs too many substeps; "
+                        "check the units of the inputs (the FMU takes metres)")
+    return BushingState(y + jump_mm, z1, w + (model.C - model.c0) / model.C * jump_mm, z2)
+
+
+def advance(model: CompiledModel, state, state_x: float, x: float, v: float, h: float,
+            max_substeps: int = DEFAULT_MAX_SUBSTEPS) -> tuple[BushingState, int]:
+    """Integrate one step: displacement x + v*t [mm] for 0 <= t <= h [s], h > 0.
+
+    ``state`` is valid at displacement ``state_x`` [mm] (the end of the previous step, or the
+    initial displacement). If the step starts elsewhere (x != state_x) the difference is
+    applied first as a displacement jump (:func:`apply_displacement_jump`). The new state is
+    valid at x + v*h. Returns the new state and the number of substeps used. Raises
+    StepError if the result would overflow or is not finite, or if more than
+    ``max_substeps`` are needed; the state passed in is never modified (immutable tuple).
+    """
+    try:
+        if x != state_x:
+            state = apply_displacement_jump(model, state, x - state_x)
+    except (OverflowError, ZeroDivisionError, ValueError) as exc:
+        raise StepError(f"a displacement jump from {state_x:g} mm to {x:g} mm overflowed ({exc}); "
+                        "check the units of the inputs (the FMU takes metres)") from None
     y, z1, w, z2 = state
     k0, k1, k2, c0, c1, C, K1, alpha1, alpha2, blk1, blk2 = model
     a1 = k0 * v / c1

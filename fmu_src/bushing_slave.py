@@ -18,23 +18,29 @@ other's modules.
 """
 import importlib
 import math
-from pathlib import Path
 
 from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Real
 from pythonfmu.default_experiment import DefaultExperiment
 from pythonfmu.enums import Fmi2Status
 
+# pythonfmu 0.7 re-executes this module's source at every instantiation (in the cached
+# module's namespace), possibly after the host deleted the first extracted copy of the FMU
+# (fmpy's simulate_fmu does). So module-level code here must touch no files: the packed
+# library, imported once and then cached, reads the default parameters.
 if __package__:
     from . import bushing_core as core
     from . import bushing_params as params
+    DEFAULT_PARAMETERS = None  # only an FMU built by build_fmu.py has defaults
 else:
-    core = importlib.import_module(__name__ + "_lib.bushing_core")
-    params = importlib.import_module(__name__ + "_lib.bushing_params")
-
-DEFAULT_PARAMETERS_FILE = Path(core.__file__).with_name("default_parameters.json")
-"""Written by build_fmu.py into the packed library: the parameter start values."""
+    _library = importlib.import_module(__name__ + "_lib")
+    core = _library.bushing_core
+    params = _library.bushing_params
+    DEFAULT_PARAMETERS = _library.DEFAULT_PARAMETERS
 
 MM_PER_M = 1000.0
+PLAUSIBLE_TRAVEL_M = 0.1
+"""|x| beyond this is far outside any rubber bushing's travel: most likely millimetres
+entered where metres are expected. It is warned about, not refused."""
 FMU_VERSION = "0.1.0"
 
 
@@ -49,18 +55,21 @@ class BoucWenBushing(Fmi2Slave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        defaults = params.load_parameter_file(DEFAULT_PARAMETERS_FILE)
+        if DEFAULT_PARAMETERS is None:
+            raise RuntimeError("BoucWenBushing runs inside an FMU built by build_fmu.py")
         for name in params.PARAMETER_NAMES:
-            setattr(self, name, defaults[name])
+            setattr(self, name, DEFAULT_PARAMETERS[name])
         self.x = 0.0  # m
         self.v = 0.0  # m/s
         self._compiled = None          # core.CompiledModel of the parameters in force
         self._parameters = None        # dict of the parameters in force (paper units)
         self._parameters_changed = True
         self._state = core.BushingState(0.0, 0.0, 0.0, 0.0)  # committed state, mm and N
-        self._x_output_mm = 0.0        # displacement at which F is reported
+        self._state_x_mm = 0.0         # displacement the committed state belongs to
+        self._x_now_mm = 0.0           # current displacement: x as last set, else x_k + v_k*h
         self._last_force = 0.0         # N, last finite force
         self._initialized = False
+        self._travel_warned = False    # the implausible-travel warning is given once
 
         for spec in params.PARAMETER_SPECS:
             self.register_variable(Real(
@@ -100,9 +109,13 @@ class BoucWenBushing(Fmi2Slave):
 
     def _set_displacement(self, value):
         self.x = value
-        self._x_output_mm = value * MM_PER_M
+        self._x_now_mm = value * MM_PER_M
         if not math.isfinite(value):
             self._error(f"input x = {value} m is not a finite number; the next doStep will be refused")
+        elif abs(value) > PLAUSIBLE_TRAVEL_M and not self._travel_warned:
+            self._travel_warned = True
+            self.log(f"input x = {value} m exceeds {PLAUSIBLE_TRAVEL_M} m, far beyond a bushing's travel; "
+                     "the FMU takes metres (2 mm is x = 0.002)", Fmi2Status.warning, "logStatusWarning")
 
     def _set_velocity(self, value):
         self.v = value
@@ -114,10 +127,14 @@ class BoucWenBushing(Fmi2Slave):
         return lambda: self._state[index] * scale
 
     def _force(self):
-        """F at the current time: committed state, current displacement and velocity."""
+        """F at the current time and displacement. If x was set away from the displacement of
+        the committed state, F includes the model's instantaneous response to that jump."""
         if self._refresh_parameters():
             try:
-                force = core.force(self._state, self._x_output_mm, self.v * MM_PER_M, self._parameters)
+                state = self._state
+                if self._x_now_mm != self._state_x_mm:
+                    state = core.apply_displacement_jump(self._compiled, state, self._x_now_mm - self._state_x_mm)
+                force = core.force(state, self._x_now_mm, self.v * MM_PER_M, self._parameters)
             except (ArithmeticError, ValueError):
                 force = math.nan
             if math.isfinite(force):
@@ -129,7 +146,7 @@ class BoucWenBushing(Fmi2Slave):
         if self._refresh_parameters():
             x_mm = self.x * MM_PER_M if math.isfinite(self.x) else 0.0
             self._state = core.initial_state(self._parameters, x_mm)
-            self._x_output_mm = x_mm
+            self._state_x_mm = self._x_now_mm = x_mm
         self._initialized = True
 
     def do_step(self, current_time, step_size):
@@ -140,10 +157,10 @@ class BoucWenBushing(Fmi2Slave):
         for name, value, unit in (("x", self.x, "m"), ("v", self.v, "m/s")):
             if not math.isfinite(value):
                 return self._refuse(f"doStep refused: input {name} = {value} {unit} is not a finite number")
-        x_mm = self.x * MM_PER_M
+        x_mm = self._x_now_mm
         v_mm = self.v * MM_PER_M
         try:
-            state, _ = core.advance(self._compiled, self._state, x_mm, v_mm, step_size)
+            state, _ = core.advance(self._compiled, self._state, self._state_x_mm, x_mm, v_mm, step_size)
         except core.StepError as exc:
             return self._refuse(f"doStep at t = {current_time} s refused: {exc}")
         x_end = x_mm + v_mm * step_size
@@ -152,7 +169,7 @@ class BoucWenBushing(Fmi2Slave):
             return self._refuse(f"doStep at t = {current_time} s refused: the force would be {force} N "
                                 f"(x = {self.x} m, v = {self.v} m/s); check the units of the inputs")
         self._state = state
-        self._x_output_mm = x_end
+        self._state_x_mm = self._x_now_mm = x_end
         self._last_force = force
         return True
 
@@ -190,7 +207,8 @@ class BoucWenBushing(Fmi2Slave):
             "parameters": {name: getattr(self, name) for name in params.PARAMETER_NAMES},
             "x": self.x, "v": self.v,
             "state": list(self._state),
-            "x_output_mm": self._x_output_mm,
+            "state_x_mm": self._state_x_mm,
+            "x_now_mm": self._x_now_mm,
             "last_force": self._last_force,
             "initialized": self._initialized,
         }
@@ -201,7 +219,8 @@ class BoucWenBushing(Fmi2Slave):
         self.x = state["x"]
         self.v = state["v"]
         self._state = core.BushingState(*state["state"])
-        self._x_output_mm = state["x_output_mm"]
+        self._state_x_mm = state["state_x_mm"]
+        self._x_now_mm = state["x_now_mm"]
         self._last_force = state["last_force"]
         self._initialized = state["initialized"]
         self._parameters_changed = True

@@ -1,0 +1,76 @@
+"""Drive one instance of a built bushing FMU through fmpy's low-level FMI 2.0 API.
+
+Used by the tests to see statuses, log messages and FMU states that fmpy's
+``simulate_fmu`` hides. Units at this interface are the FMU's: m, m/s, N.
+"""
+from __future__ import annotations
+
+import re
+
+from fmpy import extract, read_model_description
+from fmpy.fmi1 import FMICallException
+from fmpy.fmi2 import (FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
+                       fmi2CallbackFunctions, fmi2CallbackLoggerTYPE)
+from fmpy.fmi2 import calloc, free
+
+STATUS_NAMES = ["ok", "warning", "discard", "error", "fatal", "pending"]
+
+
+class BushingFmu:
+    """One FMU instance, initialised and ready to step."""
+
+    def __init__(self, fmu_path, instance_name="bushing", start_values=None, x0_m=0.0, v0_m_s=0.0):
+        self.description = read_model_description(fmu_path)
+        self.refs = {v.name: v.valueReference for v in self.description.modelVariables}
+        self.messages: list[tuple[str, str, str]] = []  # (status, category, message)
+        self._callbacks = fmi2CallbackFunctions()
+        self._callbacks.logger = fmi2CallbackLoggerTYPE(self._log)
+        self._callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+        self._callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+        self.unzip_dir = extract(fmu_path)
+        self.fmu = FMU2Slave(guid=self.description.guid, unzipDirectory=self.unzip_dir,
+                             modelIdentifier=self.description.coSimulation.modelIdentifier,
+                             instanceName=instance_name)
+        self.fmu.instantiate(callbacks=self._callbacks, loggingOn=True)
+        self.fmu.setupExperiment(startTime=0.0)
+        self.fmu.enterInitializationMode()
+        for name, value in (start_values or {}).items():
+            self.set(name, value)
+        self.set("x", x0_m)
+        self.set("v", v0_m_s)
+        self.fmu.exitInitializationMode()
+        self.time = 0.0
+
+    def _log(self, component, instance_name, status, category, message):
+        self.messages.append((STATUS_NAMES[status], category.decode(), message.decode()))
+
+    def set(self, name: str, value: float) -> None:
+        self.fmu.setReal([self.refs[name]], [value])
+
+    def get(self, name: str) -> float:
+        return self.fmu.getReal([self.refs[name]])[0]
+
+    def step(self, x_m: float, v_m_s: float, h: float) -> str:
+        """Set the inputs, do one step; return the status name ('ok' or 'discard'...)."""
+        self.set("x", x_m)
+        self.set("v", v_m_s)
+        return self.do_step(h)
+
+    def do_step(self, h: float) -> str:
+        try:
+            self.fmu.doStep(currentCommunicationPoint=self.time, communicationStepSize=h)
+        except FMICallException as exc:
+            return re.search(r"\((\w+)\)", str(exc)).group(1)
+        self.time += h
+        return "ok"
+
+    def states(self) -> tuple[float, float, float, float]:
+        """(y [m], z1 [N], w [m], z2 [N])"""
+        return tuple(self.fmu.getReal([self.refs[n] for n in ("y", "z1", "w", "z2")]))
+
+    def messages_with(self, status: str) -> list[str]:
+        return [message for s, _, message in self.messages if s == status]
+
+    def free(self) -> None:
+        self.fmu.terminate()
+        self.fmu.freeInstance()

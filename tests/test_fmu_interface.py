@@ -1,0 +1,64 @@
+"""modelDescription.xml: validity, units, start values, structure."""
+import zipfile
+
+from fmpy import read_model_description
+from fmpy.validation import validate_fmu
+
+from conftest import paper_parameters
+from fmu_src.bushing_params import PARAMETER_NAMES, PARAMETER_UNITS
+
+
+def test_fmpy_validation_finds_no_problem(fmu_path):
+    assert validate_fmu(str(fmu_path)) == []
+
+
+def test_ports_are_si_and_parameters_in_paper_units(fmu_path):
+    description = read_model_description(fmu_path)
+    variables = {v.name: v for v in description.modelVariables}
+    assert (variables["x"].causality, variables["x"].unit) == ("input", "m")
+    assert (variables["v"].causality, variables["v"].unit) == ("input", "m/s")
+    assert (variables["F"].causality, variables["F"].unit) == ("output", "N")
+    for name in ("z1", "z2"):
+        assert variables[name].unit == "N"
+    for name in ("y", "w"):
+        assert variables[name].unit == "m"
+    for name in PARAMETER_NAMES:
+        assert variables[name].causality == "parameter"
+        assert variables[name].variability == "tunable"
+        assert variables[name].unit == PARAMETER_UNITS[name]
+    defined = {unit.name: unit for unit in description.unitDefinitions}
+    assert defined["N/mm"].baseUnit.kg == 1 and defined["N/mm"].baseUnit.s == -2
+    assert defined["N/mm"].baseUnit.factor == 1000.0
+
+
+def test_parameter_start_values_are_table5_exactly(fmu_path):
+    variables = {v.name: v for v in read_model_description(fmu_path).modelVariables}
+    table5 = paper_parameters("table5")
+    for name in PARAMETER_NAMES:
+        assert float(variables[name].start) == table5[name]
+
+
+def test_force_depends_directly_on_x_and_v_and_is_an_initial_unknown(fmu_path):
+    description = read_model_description(fmu_path)
+    (output,) = description.outputs
+    assert output.variable.name == "F"
+    assert sorted(v.name for v in output.dependencies) == ["v", "x"]
+    assert [u.variable.name for u in description.initialUnknowns] == ["F"]
+
+
+def test_state_handling_declared_and_default_experiment_present(fmu_path):
+    description = read_model_description(fmu_path)
+    assert description.coSimulation.canGetAndSetFMUstate
+    assert description.coSimulation.canSerializeFMUstate
+    assert description.coSimulation.modelIdentifier == "BoucWenBushing"
+    assert description.defaultExperiment.stepSize == "0.001"
+    assert description.version and description.description
+
+
+def test_packed_modules_have_build_specific_names(fmu_path, fmu_path_table2):
+    def slave_module(path):
+        with zipfile.ZipFile(path) as archive:
+            return archive.read("resources/slavemodule.txt").decode().strip()
+    first, second = slave_module(fmu_path), slave_module(fmu_path_table2)
+    assert first.startswith("boucwen_bushing_") and second.startswith("boucwen_bushing_")
+    assert first != second

@@ -1,0 +1,171 @@
+"""The model core against independent references: scipy's Radau, analytic cases."""
+import math
+
+import numpy as np
+import pytest
+
+from conftest import paper_parameters, reference_force
+from fmu_src import bushing_core as core
+from fmu_src.bushing_params import ParameterError, check_parameters, validate_parameters
+from identification.protocols import Random, Sine, Step, sample_times
+from identification.simulate import simulate
+
+
+def relative_max_error(force, reference):
+    return np.max(np.abs(force - reference)) / np.max(np.abs(reference))
+
+
+@pytest.mark.parametrize("table", ["table2", "table4", "table5"])
+def test_sine_10Hz_2mm_matches_radau_for_every_paper_table(table):
+    params = paper_parameters(table)
+    t = sample_times(0.12, 1000.0)
+    x, v = Sine(2.0, 10.0).signals(t)
+    error = relative_max_error(simulate(params, t, x, v), reference_force(params, t, x, v))
+    assert error < 1e-3
+
+
+def test_step_2mm_rise_0p4s_matches_radau():
+    params = paper_parameters("table5")
+    t = sample_times(1.0, 100.0)  # 10 ms communication steps
+    x, v = Step(2.0, 0.4).signals(t)
+    error = relative_max_error(simulate(params, t, x, v), reference_force(params, t, x, v))
+    assert error < 1e-4
+
+
+def test_stiff_parameter_set_c1_0p01_matches_radau_at_10ms_steps():
+    # c1 = 0.01 makes the y-z1 mode ~5e5 1/s: 5000 time constants per 10 ms step.
+    params = dict(paper_parameters("table5"), c1=0.01)
+    t = sample_times(0.1, 100.0)
+    x, v = Sine(2.0, 10.0).signals(t)
+    error = relative_max_error(simulate(params, t, x, v), reference_force(params, t, x, v))
+    assert error < 2e-3
+
+
+def test_large_amplitude_30Hz_3mm_matches_radau():
+    # z2 grows almost exponentially with displacement here (peak force ~15 kN).
+    params = paper_parameters("table5")
+    t = sample_times(0.05, 1000.0)
+    x, v = Sine(3.0, 30.0).signals(t)
+    error = relative_max_error(simulate(params, t, x, v), reference_force(params, t, x, v))
+    assert error < 1e-3
+
+
+def test_without_hysteresis_steady_sine_converges_to_analytic_complex_stiffness():
+    # alpha1 = alpha2 = 0 leaves a linear network: F = K(i*omega) X with
+    # K = k0 (k1 + i w c1)/(k0 + k1 + i w c1) + c0 i w (k2 + i w c2)/(k2 + i w (c0 + c2)).
+    # The input holds v at its sampled value over each interval, a first-order error in the
+    # sample interval: the error must shrink ~4x when the sampling is 4x finer.
+    params = dict(paper_parameters("table5"), alpha1=0.0, alpha2=0.0, k2=1000.0)
+    frequency, amplitude = 10.0, 1.0
+    w = 2 * np.pi * frequency
+    p = params
+    stiffness = (p["k0"] * (p["k1"] + 1j * w * p["c1"]) / (p["k0"] + p["k1"] + 1j * w * p["c1"])
+                 + p["c0"] * 1j * w * (p["k2"] + 1j * w * p["c2"]) / (p["k2"] + 1j * w * (p["c0"] + p["c2"])))
+    errors = []
+    for rate in (4000.0, 16000.0):
+        t = sample_times(3.0, rate)
+        x, v = Sine(amplitude, frequency).signals(t)
+        force = simulate(params, t, x, v)
+        analytic = np.imag(stiffness * amplitude * np.exp(1j * w * t))
+        last_period = t >= 3.0 - 1.0 / frequency  # transients (slowest: 0.26 s) have died out
+        errors.append(np.max(np.abs(force[last_period] - analytic[last_period])) / np.max(np.abs(analytic)))
+    assert errors[1] < 3e-4
+    assert 3.0 < errors[0] / errors[1] < 5.0
+
+
+def test_initial_state_is_relaxed_equilibrium_with_static_stiffness():
+    params = paper_parameters("table5")
+    x0 = 1.5
+    state = core.initial_state(params, x0)
+    static_stiffness = params["k0"] * params["k1"] / (params["k0"] + params["k1"])
+    assert core.force(state, x0, 0.0, params) == pytest.approx(static_stiffness * x0, rel=1e-12)
+    assert core.rhs(0.0, state, x0, 0.0, params) == pytest.approx([0, 0, 0, 0], abs=1e-9)
+    held, _ = core.advance(core.compile_model(params), state, x0, x0, 0.0, 5.0)
+    assert core.force(held, x0, 0.0, params) == pytest.approx(static_stiffness * x0, rel=1e-12)
+
+
+def test_random_input_matches_radau():
+    params = paper_parameters("table5")
+    t = sample_times(0.3, 1000.0)
+    x, v = Random(peak_mm=2.0, duration_s=0.3, seed=3).signals(t)
+    error = relative_max_error(simulate(params, t, x, v), reference_force(params, t, x, v))
+    assert error < 1e-3
+
+
+def test_advance_reports_unbounded_growth_and_leaves_input_state():
+    # Without the alpha2 feedback and with n2 = 1, dz2/dx = A2 + 3.4/mm * z2 grows like
+    # exp(3.4/mm * x): a ramp to 2 m (metres entered where millimetres were meant) overflows.
+    params = dict(paper_parameters("table5"), alpha2=0.0, n2=1.0)
+    model = core.compile_model(params)
+    state = core.initial_state(params, 0.0)
+    with pytest.raises(core.StepError, match="units"):
+        core.advance(model, state, 0.0, 0.0, 2000.0 / 0.4, 0.4)
+    assert state == core.initial_state(params, 0.0)
+
+
+def test_paper_tables_saturate_instead_of_overflowing_for_a_2m_stroke():
+    # With alpha2 > 0 the growing gain of z2 also raises lam2, so u2 decays and z2 stays
+    # finite: the model gives a (physically absurd) finite force, which the FMU flags.
+    params = paper_parameters("table5")
+    state, _ = core.advance(core.compile_model(params), core.initial_state(params), 0.0, 0.0, 2000.0 / 0.4, 0.4)
+    assert all(math.isfinite(value) for value in state)
+
+
+def test_advance_refuses_instead_of_hanging_when_substeps_run_out():
+    params = paper_parameters("table5")
+    model = core.compile_model(params)
+    with pytest.raises(core.StepError, match="substeps"):
+        core.advance(model, core.initial_state(params), 0.0, 0.0, 500.0, 0.01, max_substeps=3)
+
+
+def test_table5_satisfies_the_paper_constraints_and_validates_cleanly():
+    errors, warnings = validate_parameters(paper_parameters("table5"))
+    assert errors == [] and warnings == []
+
+
+@pytest.mark.parametrize("name, value, fragment", [
+    ("c1", 0.0, "c1 = 0.0 N.s/mm must be > 0"),
+    ("c0", -300.0, "c0 + c2"),
+    ("n2", -1.0, "n2 = -1.0 must be > 0"),
+    ("k1", -5.0, "k1 = -5.0 N/mm must be >= 0"),
+    ("A1", math.nan, "A1 = nan [N/mm] must be a finite number"),
+])
+def test_invalid_parameters_are_errors_naming_value_unit_and_range(name, value, fragment):
+    params = dict(paper_parameters("table5"), **{name: value})
+    errors, _ = validate_parameters(params)
+    assert any(fragment in message for message in errors), errors
+    with pytest.raises(ParameterError, match=name):
+        check_parameters(params)
+
+
+@pytest.mark.parametrize("change, fragment", [
+    ({"A2": 0.5}, "A2 >= 1"),
+    ({"beta1": -1.0}, "beta1 >= 0"),
+    ({"gamma1": -13.0}, "beta1 + gamma1 > 0"),
+    ({"gamma2": 1.0}, "beta2 - gamma2 > 0"),
+])
+def test_paper_constraint_violations_are_warnings_not_errors(change, fragment):
+    errors, warnings = validate_parameters(dict(paper_parameters("table5"), **change))
+    assert errors == []
+    assert any(fragment in message for message in warnings), warnings
+
+
+@pytest.mark.parametrize("jump_mm", [0.3, -0.8, 2.5])
+def test_displacement_jump_matches_reference_and_a_steep_ramp(jump_mm):
+    # A jump is the limit of a ramp of vanishing duration: compare with a 1 us ramp too.
+    params = paper_parameters("table5")
+    model = core.compile_model(params)
+    start, _ = core.advance(model, core.initial_state(params), 0.0, 0.0, 50.0, 0.02)  # some history
+    jumped = core.apply_displacement_jump(model, start, jump_mm)
+    from conftest import reference_jump
+    reference = reference_jump(params, start, jump_mm)
+    np.testing.assert_allclose(jumped[:3], reference[:3], rtol=1e-12, atol=1e-12)
+    z2_scale = max(abs(start[3]), abs(reference[3]))  # z2 may pass through zero on the way
+    assert abs(jumped[3] - reference[3]) < 3e-4 * z2_scale
+    jump_force = core.force(jumped, 1.0 + jump_mm, 0.0, params)
+    gaps = []
+    for ramp_s in (1e-6, 1e-8):
+        ramped, _ = core.advance(model, start, 1.0, 1.0, jump_mm / ramp_s, ramp_s)
+        gaps.append(abs(core.force(ramped, 1.0 + jump_mm, 0.0, params) - jump_force))
+    assert gaps[1] < 0.02 * gaps[0]  # the gap closes linearly with the ramp time
+    assert gaps[1] < 1e-4 * params["k0"] * abs(jump_mm)
