@@ -68,6 +68,7 @@ class BoucWenBushing(Fmi2Slave):
         self._state_x_mm = 0.0         # displacement the committed state belongs to
         self._x_now_mm = 0.0           # current displacement: x as last set, else x_k + v_k*h
         self._last_force = 0.0         # N, last finite force
+        self._force_is_current = False  # _last_force belongs to the current inputs and state
         self._initialized = False
         self._travel_warned = False    # the implausible-travel warning is given once
 
@@ -102,6 +103,7 @@ class BoucWenBushing(Fmi2Slave):
         def set_parameter(value):
             setattr(self, name, value)
             self._parameters_changed = True
+            self._force_is_current = False
             if not math.isfinite(value):
                 self._error(f"parameter {name} = {value} [{params.PARAMETER_UNITS[name]}] is not "
                             "a finite number; the next doStep will be refused until it is")
@@ -110,6 +112,7 @@ class BoucWenBushing(Fmi2Slave):
     def _set_displacement(self, value):
         self.x = value
         self._x_now_mm = value * MM_PER_M
+        self._force_is_current = False
         if not math.isfinite(value):
             self._error(f"input x = {value} m is not a finite number; the next doStep will be refused")
         elif abs(value) > PLAUSIBLE_TRAVEL_M and not self._travel_warned:
@@ -119,6 +122,7 @@ class BoucWenBushing(Fmi2Slave):
 
     def _set_velocity(self, value):
         self.v = value
+        self._force_is_current = False
         if not math.isfinite(value):
             self._error(f"input v = {value} m/s is not a finite number; the next doStep will be refused")
 
@@ -129,6 +133,8 @@ class BoucWenBushing(Fmi2Slave):
     def _force(self):
         """F at the current time and displacement. If x was set away from the displacement of
         the committed state, F includes the model's instantaneous response to that jump."""
+        if self._force_is_current:
+            return self._last_force
         if self._refresh_parameters():
             try:
                 state = self._state
@@ -139,6 +145,7 @@ class BoucWenBushing(Fmi2Slave):
                 force = math.nan
             if math.isfinite(force):
                 self._last_force = force
+                self._force_is_current = True
         return self._last_force
 
     # ---------------------------------------------------------------- FMI life cycle
@@ -147,16 +154,17 @@ class BoucWenBushing(Fmi2Slave):
             x_mm = self.x * MM_PER_M if math.isfinite(self.x) else 0.0
             self._state = core.initial_state(self._parameters, x_mm)
             self._state_x_mm = self._x_now_mm = x_mm
+        self._force_is_current = False
         self._initialized = True
 
     def do_step(self, current_time, step_size):
-        if not (math.isfinite(step_size) and step_size > 0.0):
+        if not 0.0 < step_size < math.inf:
             return self._refuse(f"communication step size {step_size} s must be a finite number > 0")
         if not self._refresh_parameters():
             return self._refuse("doStep refused: the parameters are invalid (see the errors above)")
-        for name, value, unit in (("x", self.x, "m"), ("v", self.v, "m/s")):
-            if not math.isfinite(value):
-                return self._refuse(f"doStep refused: input {name} = {value} {unit} is not a finite number")
+        if not (math.isfinite(self.x) and math.isfinite(self.v)):
+            name, value, unit = ("x", self.x, "m") if not math.isfinite(self.x) else ("v", self.v, "m/s")
+            return self._refuse(f"doStep refused: input {name} = {value} {unit} is not a finite number")
         x_mm = self._x_now_mm
         v_mm = self.v * MM_PER_M
         try:
@@ -171,6 +179,7 @@ class BoucWenBushing(Fmi2Slave):
         self._state = state
         self._state_x_mm = self._x_now_mm = x_end
         self._last_force = force
+        self._force_is_current = True
         return True
 
     def _refresh_parameters(self) -> bool:
@@ -222,6 +231,7 @@ class BoucWenBushing(Fmi2Slave):
         self._state_x_mm = state["state_x_mm"]
         self._x_now_mm = state["x_now_mm"]
         self._last_force = state["last_force"]
+        self._force_is_current = False
         self._initialized = state["initialized"]
         self._parameters_changed = True
         self._refresh_parameters()

@@ -116,8 +116,10 @@ def test_force_is_independent_of_the_communication_step_at_fixed_input(fmu_path)
         fmu.free()
         results[step] = np.array(forces)
     finest = results[1e-4]
+    # The integration accuracy spec (README): below 1e-3 of the peak force. Measured with
+    # THETA = 0.35: 7.8e-4 at 10 ms steps (velocities up to 400 mm/s), less at shorter ones.
     for step in (1e-2, 5e-3, 1e-3):
-        assert np.max(np.abs(results[step] - finest)) < 5e-4 * np.max(np.abs(finest))
+        assert np.max(np.abs(results[step] - finest)) < 1e-3 * np.max(np.abs(finest))
 
 
 def test_nonzero_initial_displacement_starts_and_stays_in_static_equilibrium(fmu_path):
