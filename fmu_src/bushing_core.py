@@ -5,8 +5,9 @@ z1, z2 and the bushing force F in N, time in s; parameters as in ``bushing_param
 The state is the tuple ``(y, z1, w, z2)``.
 
 Input convention: within a step of length h starting at displacement x0 the displacement is
-``x0 + v*t`` and the velocity is ``v`` (constant). ``x`` and ``v`` are used as given:
-the springs see ``x``, the dashpots and hysteresis see ``v``.
+``x0 + v*t`` and the velocity is ``v`` (constant). Where a step starts at a displacement other
+than the one the state belongs to (the end of the previous step), the difference is applied
+first as a displacement jump, the model's exact response to an impulse in dx/dt.
 
 Integrator
 ----------
@@ -24,8 +25,8 @@ hysteretic force z (g is the bracket of eqs. 1-2, which depends on u only throug
 u, which is propagated exactly for a frozen lam (exponential integrator: stable for any
 lam*h). Because z depends on time only through xi = integral of u, z follows the scalar
 autonomous ODE dz/dxi = g(z, sgn u), which is advanced with classical RK4 in xi. lam is then
-re-evaluated with the mean gain over the substep and the substep repeated once
-(second order in the coupling). A substep is split where u crosses zero, so each part
+re-evaluated with the mean gain over the substep and the substep repeated once (second order
+in the coupling), or, where that changes xi by under 1 %, z extended by one Taylor step. A substep is split where u crosses zero, so each part
 stays on one branch of sgn(). Substeps are chosen a priori so that g and lam change by at
 most a fraction ``THETA`` over each; there is no fixed time limit, since the linear part is
 exact. y is recovered from the invariant c1*u1 = -(k1*(x - y) - k0*y + alpha1*z1), w by
@@ -217,6 +218,18 @@ def _block_step(u0, z0, h, a, blk):
     return _segment(u0, z0, h, a, blk, sigma)
 
 
+def _gain_variation(z0, g0, z_pred, A, cpos, cneg, n):
+    """Gain at z_pred and how much g varies on the way from z0; returns (g_pred, dg, crosses).
+
+    g has a cusp at z = 0 (g = A there): where z changes sign, the variation is measured
+    through it, which the secant from g0 to g_pred can miss entirely.
+    """
+    g_pred = A - (cpos * z_pred ** n if z_pred > 0.0 else cneg * (-z_pred) ** n)
+    crosses_zero = (z_pred > 0.0) != (z0 > 0.0)
+    dg = abs(g0 - A) + abs(g_pred - A) if crosses_zero else abs(g_pred - g0)
+    return g_pred, dg, crosses_zero
+
+
 def _substeps_needed(u0, z0, T, a, blk):
     """Substeps so that g and lam change by at most THETA (relative) over each, predicted
     from the start of the remaining interval T."""
@@ -235,14 +248,7 @@ def _substeps_needed(u0, z0, T, a, blk):
         target = a * c / lam_c
         if abs(target) > abs(rate):
             rate = target
-    z_pred = z0 + g0 * rate * T
-    g_pred = A - (cpos * z_pred ** n if z_pred > 0.0 else cneg * (-z_pred) ** n)
-    if (z_pred > 0.0) != (z0 > 0.0):
-        # g has a cusp at z = 0 (g = A there): measure the variation through it, which the
-        # secant from g0 to g_pred can miss entirely.
-        dg = abs(g0 - A) + abs(g_pred - A)
-    else:
-        dg = abs(g_pred - g0)
+    _, dg, _ = _gain_variation(z0, g0, z0 + g0 * rate * T, A, cpos, cneg, n)
     if dg == 0.0:
         return 1
     rel = dg / abs(g0) if g0 != 0.0 else math.inf
@@ -277,16 +283,14 @@ def apply_displacement_jump(model: CompiledModel, state, jump_mm: float) -> Bush
     for _ in range(DEFAULT_MAX_SUBSTEPS):
         # The a-priori rule of the time steps: bound the change of g2 per piece.
         g0 = A - (cpos * z2 ** n if z2 > 0.0 else cneg * (-z2) ** n)
-        z_pred = z2 + g0 * remaining
-        g_pred = A - (cpos * z_pred ** n if z_pred > 0.0 else cneg * (-z_pred) ** n)
-        crosses_zero = (z_pred > 0.0) != (z2 > 0.0)
-        dg = abs(g0 - A) + abs(g_pred - A) if crosses_zero else abs(g_pred - g0)
+        g_pred, dg, crosses_zero = _gain_variation(z2, g0, z2 + g0 * remaining, A, cpos, cneg, n)
         if not crosses_zero and dg <= 0.01 * abs(g0):
             # The usual case, a jump of O(h^2) from a master that passes the instantaneous
             # velocity: Heun's step from the two gains just computed, error ~1e-5 of dz.
             z2 = z2 + 0.5 * remaining * (g0 + g_pred)
             break
-        pieces = 1 if dg <= THETA_JUMP * abs(g0) else min(int(math.ceil(dg / (THETA_JUMP * abs(g0) + 1e-300))), 1000)
+        allowed = THETA_JUMP * abs(g0)
+        pieces = 1 if dg <= allowed else min(int(math.ceil(dg / (allowed + 1e-300))), 1000)
         piece = remaining / pieces
         z2 = _rk4_in_xi(z2, piece, A, cpos, cneg, n)
         remaining -= piece

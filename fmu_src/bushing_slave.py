@@ -69,7 +69,7 @@ class BoucWenBushing(Fmi2Slave):
         self._x_now_mm = 0.0           # current displacement: x as last set, else x_k + v_k*h
         self._last_force = 0.0         # N, last finite force
         self._force_is_current = False  # _last_force belongs to the current inputs and state
-        self._initialized = False
+        self._initial_state_pending = True  # set at exit of initialization, or first valid step
         self._travel_warned = False    # the implausible-travel warning is given once
 
         for spec in params.PARAMETER_SPECS:
@@ -150,12 +150,15 @@ class BoucWenBushing(Fmi2Slave):
 
     # ---------------------------------------------------------------- FMI life cycle
     def exit_initialization_mode(self):
-        if self._refresh_parameters():
-            x_mm = self.x * MM_PER_M if math.isfinite(self.x) else 0.0
-            self._state = core.initial_state(self._parameters, x_mm)
-            self._state_x_mm = self._x_now_mm = x_mm
+        if self._refresh_parameters() and math.isfinite(self._x_now_mm):
+            self._set_initial_state()
+
+    def _set_initial_state(self):
+        """Relaxed equilibrium at the current displacement (see bushing_core.initial_state)."""
+        self._state = core.initial_state(self._parameters, self._x_now_mm)
+        self._state_x_mm = self._x_now_mm
         self._force_is_current = False
-        self._initialized = True
+        self._initial_state_pending = False
 
     def do_step(self, current_time, step_size):
         if not 0.0 < step_size < math.inf:
@@ -165,6 +168,8 @@ class BoucWenBushing(Fmi2Slave):
         if not (math.isfinite(self.x) and math.isfinite(self.v)):
             name, value, unit = ("x", self.x, "m") if not math.isfinite(self.x) else ("v", self.v, "m/s")
             return self._refuse(f"doStep refused: input {name} = {value} {unit} is not a finite number")
+        if self._initial_state_pending:  # the values at initialization could not be used
+            self._set_initial_state()
         x_mm = self._x_now_mm
         v_mm = self.v * MM_PER_M
         try:
@@ -219,7 +224,7 @@ class BoucWenBushing(Fmi2Slave):
             "state_x_mm": self._state_x_mm,
             "x_now_mm": self._x_now_mm,
             "last_force": self._last_force,
-            "initialized": self._initialized,
+            "initial_state_pending": self._initial_state_pending,
         }
 
     def _set_fmu_state(self, state):
@@ -232,6 +237,6 @@ class BoucWenBushing(Fmi2Slave):
         self._x_now_mm = state["x_now_mm"]
         self._last_force = state["last_force"]
         self._force_is_current = False
-        self._initialized = state["initialized"]
+        self._initial_state_pending = state["initial_state_pending"]
         self._parameters_changed = True
         self._refresh_parameters()

@@ -126,3 +126,17 @@ def test_messages_carry_a_category_the_model_description_declares(fmu_path):
     declared = {category.name for category in fmu.description.logCategories}
     assert fmu.messages and all(category in declared for _, category, _ in fmu.messages)
     fmu.free()
+
+
+def test_parameters_fixed_after_initialization_start_from_the_equilibrium(fmu_path):
+    # Invalid at exitInitializationMode: no initial state can be computed then. Once fixed,
+    # the first step starts from the relaxed equilibrium at x0, as if they had been valid.
+    fmu = BushingFmu(fmu_path, start_values={"c1": -1.0}, x0_m=1.0 * MM)
+    assert fmu.do_step(STEP) == "discard"
+    fmu.set("c1", 1.485)
+    assert fmu.do_step(STEP) == "ok"
+    reference = BushingFmu(fmu_path, x0_m=1.0 * MM)
+    assert reference.do_step(STEP) == "ok"
+    assert fmu.states() == reference.states() and fmu.get("F") == reference.get("F")
+    for instance in (fmu, reference):
+        instance.free()

@@ -11,43 +11,32 @@ from identification.protocols import Random, Sine, Step, sample_times
 from identification.simulate import simulate
 
 
-def relative_max_error(force, reference):
-    return np.max(np.abs(force - reference)) / np.max(np.abs(reference))
+def radau_error(params, protocol, duration_s, rate_hz):
+    """Largest force difference between the core and the Radau reference, over the peak force,
+    for ``protocol`` sampled (one communication step per sample) at ``rate_hz``."""
+    t = sample_times(duration_s, rate_hz)
+    x, v = protocol.signals(t)
+    reference = reference_force(params, t, x, v)
+    return np.max(np.abs(simulate(params, t, x, v) - reference)) / np.max(np.abs(reference))
 
 
 @pytest.mark.parametrize("table", ["table2", "table4", "table5"])
 def test_sine_10Hz_2mm_matches_radau_for_every_paper_table(table):
-    params = paper_parameters(table)
-    t = sample_times(0.12, 1000.0)
-    x, v = Sine(2.0, 10.0).signals(t)
-    error = relative_max_error(simulate(params, t, x, v), reference_force(params, t, x, v))
-    assert error < 1e-3
+    assert radau_error(paper_parameters(table), Sine(2.0, 10.0), 0.12, 1000.0) < 1e-3
 
 
 def test_step_2mm_rise_0p4s_matches_radau():
-    params = paper_parameters("table5")
-    t = sample_times(1.0, 100.0)  # 10 ms communication steps
-    x, v = Step(2.0, 0.4).signals(t)
-    error = relative_max_error(simulate(params, t, x, v), reference_force(params, t, x, v))
-    assert error < 1e-4
+    assert radau_error(paper_parameters("table5"), Step(2.0, 0.4), 1.0, 100.0) < 1e-4  # 10 ms steps
 
 
 def test_stiff_parameter_set_c1_0p01_matches_radau_at_10ms_steps():
     # c1 = 0.01 makes the y-z1 mode ~5e5 1/s: 5000 time constants per 10 ms step.
-    params = dict(paper_parameters("table5"), c1=0.01)
-    t = sample_times(0.1, 100.0)
-    x, v = Sine(2.0, 10.0).signals(t)
-    error = relative_max_error(simulate(params, t, x, v), reference_force(params, t, x, v))
-    assert error < 2e-3
+    assert radau_error(dict(paper_parameters("table5"), c1=0.01), Sine(2.0, 10.0), 0.1, 100.0) < 2e-3
 
 
 def test_large_amplitude_30Hz_3mm_matches_radau():
     # z2 grows almost exponentially with displacement here (peak force ~15 kN).
-    params = paper_parameters("table5")
-    t = sample_times(0.05, 1000.0)
-    x, v = Sine(3.0, 30.0).signals(t)
-    error = relative_max_error(simulate(params, t, x, v), reference_force(params, t, x, v))
-    assert error < 1e-3
+    assert radau_error(paper_parameters("table5"), Sine(3.0, 30.0), 0.05, 1000.0) < 1e-3
 
 
 def test_without_hysteresis_steady_sine_converges_to_analytic_complex_stiffness():
@@ -85,11 +74,7 @@ def test_initial_state_is_relaxed_equilibrium_with_static_stiffness():
 
 
 def test_random_input_matches_radau():
-    params = paper_parameters("table5")
-    t = sample_times(0.3, 1000.0)
-    x, v = Random(peak_mm=2.0, duration_s=0.3, seed=3).signals(t)
-    error = relative_max_error(simulate(params, t, x, v), reference_force(params, t, x, v))
-    assert error < 1e-3
+    assert radau_error(paper_parameters("table5"), Random(peak_mm=2.0, duration_s=0.3, seed=3), 0.3, 1000.0) < 1e-3
 
 
 def test_advance_reports_unbounded_growth_and_leaves_input_state():
