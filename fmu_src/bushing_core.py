@@ -46,6 +46,10 @@ THETA_JUMP = 0.1
 """The same bound for the RK4 pieces of a large displacement jump: jumps are rare (small ones
 take a Heun step), so they can afford the tighter bound; a 2.5 mm jump is then exact to 1e-5."""
 
+HEUN_JUMP_LIMIT = 0.05
+"""A displacement jump over which g2 changes by less than this fraction takes one Heun step
+(local error ~HEUN_JUMP_LIMIT^2/12 = 2e-4 of the jump's own, O(h^2) small, increment of z2)."""
+
 DEFAULT_MAX_SUBSTEPS = 20000
 """Substeps allowed per call of :func:`advance` before it gives up (guards against hangs)."""
 
@@ -284,9 +288,9 @@ def apply_displacement_jump(model: CompiledModel, state, jump_mm: float) -> Bush
         # The a-priori rule of the time steps: bound the change of g2 per piece.
         g0 = A - (cpos * z2 ** n if z2 > 0.0 else cneg * (-z2) ** n)
         g_pred, dg, crosses_zero = _gain_variation(z2, g0, z2 + g0 * remaining, A, cpos, cneg, n)
-        if not crosses_zero and dg <= 0.01 * abs(g0):
+        if not crosses_zero and dg <= HEUN_JUMP_LIMIT * abs(g0):
             # The usual case, a jump of O(h^2) from a master that passes the instantaneous
-            # velocity: Heun's step from the two gains just computed, error ~1e-5 of dz.
+            # velocity: Heun's step from the two gains just computed.
             z2 = z2 + 0.5 * remaining * (g0 + g_pred)
             break
         allowed = THETA_JUMP * abs(g0)

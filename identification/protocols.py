@@ -43,7 +43,7 @@ class Random:
     The paper's "index n = 2.5" is read as the exponent of the displacement power spectral
     density, PSD ~ f^-2.5 between f_low and f_high (as road-profile spectra are specified);
     the phases are uniform random from ``seed``. A cosine taper over the first and last
-    0.25 s starts and ends the signal at rest.
+    0.25 s (at most a quarter of the duration each) starts and ends the signal at rest.
     """
     peak_mm: float = 2.0
     duration_s: float = 5.0
@@ -69,19 +69,18 @@ class Random:
 
 
 def _taper(time_s, duration_s, ramp_s):
-    """Cosine fade-in/fade-out window and its time derivative."""
-    window = np.ones_like(time_s)
-    rate = np.zeros_like(time_s)
-    for start, sign in ((0.0, 1.0), (duration_s - ramp_s, -1.0)):
-        inside = (time_s >= start) & (time_s <= start + ramp_s)
-        phase = np.pi * (time_s[inside] - start) / ramp_s
-        if sign > 0:
-            window[inside] = 0.5 * (1.0 - np.cos(phase))
-            rate[inside] = 0.5 * np.pi / ramp_s * np.sin(phase)
-        else:
-            window[inside] = 0.5 * (1.0 + np.cos(phase))
-            rate[inside] = -0.5 * np.pi / ramp_s * np.sin(phase)
-    return window, rate
+    """Cosine fade-in times cosine fade-out, and its time derivative. The ramps are at most
+    a quarter of the duration each, so they never overlap."""
+    ramp_s = min(ramp_s, duration_s / 4.0)
+    rising = time_s < ramp_s
+    falling = time_s > duration_s - ramp_s
+    phase_in = np.pi * np.clip(time_s / ramp_s, 0.0, 1.0)
+    phase_out = np.pi * np.clip((time_s - (duration_s - ramp_s)) / ramp_s, 0.0, 1.0)
+    fade_in = np.where(rising, 0.5 * (1.0 - np.cos(phase_in)), 1.0)
+    fade_out = np.where(falling, 0.5 * (1.0 + np.cos(phase_out)), 1.0)
+    fade_in_rate = np.where(rising, 0.5 * np.pi / ramp_s * np.sin(phase_in), 0.0)
+    fade_out_rate = np.where(falling, -0.5 * np.pi / ramp_s * np.sin(phase_out), 0.0)
+    return fade_in * fade_out, fade_in_rate * fade_out + fade_in * fade_out_rate
 
 
 def sample_times(duration_s: float, rate_hz: float) -> np.ndarray:
