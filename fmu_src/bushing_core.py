@@ -278,8 +278,57 @@ def apply_displacement_jump(model: CompiledModel, state, jump_mm: float) -> Bush
     y, z1, w, z2 = state
     if jump_mm == 0.0:
         return BushingState(y, z1, w, z2)
-    K, alpha, c, A, beta, gamma, n = model.block2
-    xi_total = model.c0 / model.C * jump_mm
+    y, z1, w, z2, status = _jump_kernel(model, y, z1, w, z2, jump_mm)
+    if status != OK:
+        raise StepError(f"a displacement jump of {jump_mm:g} mm needs too many substeps; "
+                        "check the units of the inputs (the FMU takes metres)")
+    return BushingState(y, z1, w, z2)
+
+
+def advance(model: CompiledModel, state, state_x: float, x: float, v: float, h: float,
+            max_substeps: int = DEFAULT_MAX_SUBSTEPS) -> tuple[BushingState, int]:
+    """Integrate one step: displacement x + v*t [mm] for 0 <= t <= h [s], h > 0.
+
+    ``state`` is valid at displacement ``state_x`` [mm] (the end of the previous step, or the
+    initial displacement). If the step starts elsewhere (x != state_x) the difference is
+    applied first as a displacement jump (:func:`apply_displacement_jump`). The new state is
+    valid at x + v*h. Returns the new state and the number of substeps used. Raises
+    StepError if the result would overflow or is not finite, or if more than
+    ``max_substeps`` are needed; the state passed in is never modified (immutable tuple).
+    """
+    y, z1, w, z2 = state
+    try:
+        status = OK
+        if x != state_x:
+            y, z1, w, z2, status = _jump_kernel(model, y, z1, w, z2, x - state_x)
+        if status == OK:
+            y, z1, w, z2, used, status = _integrate(model, y, z1, w, z2, x, v, h, max_substeps)
+    except (OverflowError, ZeroDivisionError, ValueError) as exc:
+        raise StepError(f"the step overflowed ({exc}) at x = {x:g} mm, v = {v:g} mm/s, "
+                        f"state = {tuple(state)}; check the units of the inputs "
+                        "(the FMU takes metres and m/s) and the parameters") from None
+    if status == TOO_MANY_SUBSTEPS:
+        raise StepError(f"the step of {h:g} s would need more than {max_substeps} substeps "
+                        f"(x = {x:g} mm, v = {v:g} mm/s); check the units of the inputs "
+                        "(the FMU takes metres and m/s) or shorten the communication step")
+    if status == NOT_FINITE:
+        raise StepError(f"the step gave a non-finite state {(y, z1, w, z2)} at x = {x:g} mm, "
+                        f"v = {v:g} mm/s; check the units of the inputs (the FMU takes metres "
+                        "and m/s) and the parameters")
+    return BushingState(y, z1, w, z2), used
+
+
+# ---------------------------------------------------------------------------- kernels
+# Plain float arithmetic, no exceptions raised, errors as status codes: the identification
+# compiles these same functions with numba (identification/compiled_core.py).
+OK, TOO_MANY_SUBSTEPS, NOT_FINITE = 0, 1, 2
+
+
+def _jump_kernel(model, y, z1, w, z2, jump_mm):
+    """apply_displacement_jump for a non-zero jump; returns (y, z1, w, z2, status)."""
+    k0, k1, k2, c0, c1, C, K1, alpha1, alpha2, blk1, blk2 = model
+    K, alpha, c, A, beta, gamma, n = blk2
+    xi_total = c0 / C * jump_mm
     sigma = 1.0 if xi_total > 0.0 else -1.0
     cpos = gamma + beta * sigma
     cneg = gamma - beta * sigma
@@ -301,66 +350,37 @@ def apply_displacement_jump(model: CompiledModel, state, jump_mm: float) -> Bush
         if pieces == 1:
             break
     else:
-        raise StepError(f"a displacement jump of {jump_mm:g} mm needs too many substeps; "
-                        "check the units of the inputs (the FMU takes metres)")
-    return BushingState(y + jump_mm, z1, w + (model.C - model.c0) / model.C * jump_mm, z2)
+        return y, z1, w, z2, TOO_MANY_SUBSTEPS
+    return y + jump_mm, z1, w + (C - c0) / C * jump_mm, z2, OK
 
 
-def advance(model: CompiledModel, state, state_x: float, x: float, v: float, h: float,
-            max_substeps: int = DEFAULT_MAX_SUBSTEPS) -> tuple[BushingState, int]:
-    """Integrate one step: displacement x + v*t [mm] for 0 <= t <= h [s], h > 0.
-
-    ``state`` is valid at displacement ``state_x`` [mm] (the end of the previous step, or the
-    initial displacement). If the step starts elsewhere (x != state_x) the difference is
-    applied first as a displacement jump (:func:`apply_displacement_jump`). The new state is
-    valid at x + v*h. Returns the new state and the number of substeps used. Raises
-    StepError if the result would overflow or is not finite, or if more than
-    ``max_substeps`` are needed; the state passed in is never modified (immutable tuple).
-    """
-    try:
-        if x != state_x:
-            state = apply_displacement_jump(model, state, x - state_x)
-    except (OverflowError, ZeroDivisionError, ValueError) as exc:
-        raise StepError(f"a displacement jump from {state_x:g} mm to {x:g} mm overflowed ({exc}); "
-                        "check the units of the inputs (the FMU takes metres)") from None
-    y, z1, w, z2 = state
+def _integrate(model, y, z1, w, z2, x, v, h, max_substeps):
+    """advance without the jump; returns (y, z1, w, z2, substeps used, status)."""
     k0, k1, k2, c0, c1, C, K1, alpha1, alpha2, blk1, blk2 = model
     a1 = k0 * v / c1
     elapsed = 0.0
     used = 0
-    try:
-        while True:
-            remaining = h - elapsed
-            x_now = x + v * elapsed
-            u1 = -(k1 * (x_now - y) - k0 * y + alpha1 * z1) / c1
-            u2 = (c0 * v - k2 * (x_now - w) - alpha2 * z2) / C
-            count = max(_substeps_needed(u1, z1, remaining, a1, blk1),
-                        _substeps_needed(u2, z2, remaining, 0.0, blk2))
-            if used + 1 > max_substeps or count > max_substeps:
-                raise StepError(
-                    f"the step of {h:g} s would need more than {max_substeps} substeps "
-                    f"(x = {x:g} mm, v = {v:g} mm/s); check the units of the inputs "
-                    "(the FMU takes metres and m/s) or shorten the communication step")
-            sub = remaining if count == 1 else remaining / count
-            u1, z1, xi1 = _block_step(u1, z1, sub, a1, blk1)
-            u2, z2, xi2 = _block_step(u2, z2, sub, 0.0, blk2)
-            elapsed = h if count == 1 else elapsed + sub
-            x_now = x + v * elapsed
-            # The invariant keeps y consistent with u1; the stiff k/c1 coupling would amplify
-            # any quadrature error of y into u1.
-            y = (k1 * x_now + alpha1 * z1 + c1 * u1) / K1 if K1 > 0.0 else y + v * sub - xi1
-            w = w + v * sub - xi2
-            used += 1
-            if count == 1:
-                break
-    except (OverflowError, ZeroDivisionError, ValueError) as exc:
-        raise StepError(f"the step overflowed ({exc}) at x = {x:g} mm, v = {v:g} mm/s, "
-                        f"state = {tuple(state)}; check the units of the inputs "
-                        "(the FMU takes metres and m/s) and the parameters") from None
-    new_state = BushingState(y, z1, w, z2)
-    isfinite = math.isfinite
-    if not (isfinite(y) and isfinite(z1) and isfinite(w) and isfinite(z2)):
-        raise StepError(f"the step gave a non-finite state {tuple(new_state)} at x = {x:g} mm, "
-                        f"v = {v:g} mm/s; check the units of the inputs (the FMU takes metres "
-                        "and m/s) and the parameters")
-    return new_state, used
+    while True:
+        remaining = h - elapsed
+        x_now = x + v * elapsed
+        u1 = -(k1 * (x_now - y) - k0 * y + alpha1 * z1) / c1
+        u2 = (c0 * v - k2 * (x_now - w) - alpha2 * z2) / C
+        count = max(_substeps_needed(u1, z1, remaining, a1, blk1),
+                    _substeps_needed(u2, z2, remaining, 0.0, blk2))
+        if used + 1 > max_substeps or count > max_substeps:
+            return y, z1, w, z2, used, TOO_MANY_SUBSTEPS
+        sub = remaining if count == 1 else remaining / count
+        u1, z1, xi1 = _block_step(u1, z1, sub, a1, blk1)
+        u2, z2, xi2 = _block_step(u2, z2, sub, 0.0, blk2)
+        elapsed = h if count == 1 else elapsed + sub
+        x_now = x + v * elapsed
+        # The invariant keeps y consistent with u1; the stiff k/c1 coupling would amplify
+        # any quadrature error of y into u1.
+        y = (k1 * x_now + alpha1 * z1 + c1 * u1) / K1 if K1 > 0.0 else y + v * sub - xi1
+        w = w + v * sub - xi2
+        used += 1
+        if count == 1:
+            break
+    if not (math.isfinite(y) and math.isfinite(z1) and math.isfinite(w) and math.isfinite(z2)):
+        return y, z1, w, z2, used, NOT_FINITE
+    return y, z1, w, z2, used, OK
