@@ -1,7 +1,8 @@
 """Build the bushing FMU: ``python build_fmu.py [--params FILE] [--out DIR]``.
 
 Writes ``DIR/BoucWenBushing.fmu`` (FMI 2.0 co-simulation, pythonfmu) whose parameter start
-values are the set in FILE (default: the paper's Table 5, ``data/params_table5_combined.json``).
+values are the set in FILE, project JSON or SSP 1.0 ``.ssv`` (default: the paper's Table 5,
+``data/params_table5_combined.json``).
 
 What the build adds to pythonfmu's output, and why:
 - Unique module names. The slave module is packed as ``boucwen_bushing_<hash>.py`` with its
@@ -36,19 +37,6 @@ SLAVE_MODULE = "bushing_slave.py"
 sys.path.insert(0, str(REPO))
 from fmu_src import bushing_params  # noqa: E402
 
-# Unit name -> SI base-unit exponents and factor (value_SI = factor * value); None: no SI form.
-UNIT_DEFINITIONS = {
-    "m": {"m": "1"},
-    "m/s": {"m": "1", "s": "-1"},
-    "N": {"kg": "1", "m": "1", "s": "-2"},
-    "N/mm": {"kg": "1", "s": "-2", "factor": "1000"},
-    "N.s/mm": {"kg": "1", "s": "-1", "factor": "1000"},
-    "1": {},
-    # beta*|z|^n must be in N/mm, so beta and gamma carry N^(1-n)/mm: a non-integer power
-    # that FMI's BaseUnit cannot express. Declared by name only.
-    "N^(1-n1)/mm": None,
-    "N^(1-n2)/mm": None,
-}
 PACKED_LIBRARY_INIT = '''"""Packed library of the bushing FMU (written by build_fmu.py)."""
 from pathlib import Path
 
@@ -136,7 +124,7 @@ def _add_units(root: ET.Element) -> None:
     definitions = ET.Element("UnitDefinitions")
     for unit in sorted(units_used):
         element = ET.SubElement(definitions, "Unit", name=unit)
-        base = UNIT_DEFINITIONS[unit]
+        base = bushing_params.UNIT_DEFINITIONS[unit]
         if base is not None:
             ET.SubElement(element, "BaseUnit", base)
     # FMI 2.0 schema order: CoSimulation, UnitDefinitions, TypeDefinitions, LogCategories, ...
@@ -167,7 +155,8 @@ def _add_model_structure(root: ET.Element) -> None:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--params", default=str(DEFAULT_PARAMS),
-                        help="parameter set (project JSON, paper N-mm-s units); default: the paper's Table 5")
+                        help="parameter set, project JSON or SSP 1.0 .ssv (paper N-mm-s units); "
+                             "default: the paper's Table 5")
     parser.add_argument("--out", default=str(REPO / "dist"), help="output directory (default: dist/)")
     args = parser.parse_args(argv)
     try:

@@ -1,0 +1,75 @@
+"""Command line: ``python -m identification fit ...`` (see ``--help``)."""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from fmu_src.bushing_params import ParameterError, save_parameter_file, save_ssv
+from identification.measurements import MeasurementError, load_measurement
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m identification",
+                                     description="Identify the bushing model's parameters from measured tests.")
+    commands = parser.add_subparsers(dest="command", required=True)
+    fit_parser = commands.add_parser("fit", help="fit the 16 parameters to sine (and step, random) tests")
+    fit_parser.add_argument("--sine", action="append", type=Path, required=True, metavar="FILE",
+                            help="sine test CSV (time_s,displacement_mm,force_N[,velocity_mm_s]); repeatable")
+    fit_parser.add_argument("--step", type=Path, metavar="FILE", help="step test CSV")
+    fit_parser.add_argument("--rise-time", type=float, metavar="S", help="rise time of the step test [s]")
+    fit_parser.add_argument("--random", action="append", type=Path, default=[], metavar="FILE",
+                            help="random-input test CSV; repeatable")
+    fit_parser.add_argument("--preset", default="default", choices=["default"],
+                            help="search settings (the paper's GA preset is not implemented yet)")
+    fit_parser.add_argument("--seed", type=int, default=0)
+    fit_parser.add_argument("--popsize", type=int, help="override the preset's population multiplier")
+    fit_parser.add_argument("--maxiter", type=int, help="override the preset's number of generations")
+    fit_parser.add_argument("--out", type=Path, required=True, help="parameter file to write (JSON)")
+    fit_parser.add_argument("--ssv", type=Path, help="also write an SSP 1.0 ParameterValues file")
+    args = parser.parse_args(argv)
+    try:
+        return _fit(args)
+    except (MeasurementError, ParameterError, ValueError) as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+
+
+def _fit(args) -> int:
+    from identification.fit import fit
+    from identification.objectives import Objective, StepTest, nrmse, rms_error
+    from identification.compiled_core import simulate_population
+
+    if (args.step is None) != (args.rise_time is None):
+        raise ValueError("--step and --rise-time go together")
+    sines = [load_measurement(path) for path in args.sine]
+    step = StepTest(load_measurement(args.step), args.rise_time) if args.step else None
+    randoms = [load_measurement(path) for path in args.random]
+    objective = Objective(sines, step, randoms)
+    print(f"fitting to {len(sines)} sine, {int(step is not None)} step and {len(randoms)} random test(s) "
+          f"(numba compiles the model on first use)", file=sys.stderr)
+    result = fit(objective, preset=args.preset, seed=args.seed, popsize=args.popsize, maxiter=args.maxiter)
+
+    provenance = result.provenance()
+    provenance["data"] = [str(path) for path in [*args.sine, *([args.step] if args.step else []), *args.random]]
+    save_parameter_file(args.out, result.parameters, provenance)
+    if args.ssv:
+        save_ssv(args.ssv, result.parameters)
+
+    matrix = np.array([[result.parameters[name] for name in result.parameters]])
+    print(f"objective E3 = {result.objective:.4e}   ({', '.join(f'{k} {v:.3e}' for k, v in result.terms.items())})")
+    print(f"{'test':50s} {'NRMSE':>8s} {'eq. 10':>8s}")
+    for measurement in [*sines, *randoms, *([step.measurement] if step else [])]:
+        predicted = simulate_population(matrix, measurement.time_s, measurement.displacement_mm,
+                                        measurement.velocity_mm_s)[0]
+        print(f"{Path(measurement.source).name:50s} {nrmse(predicted, measurement.force_N):8.2%} "
+              f"{rms_error(predicted, measurement.force_N):8.2%}")
+    print(f"{result.evaluations} evaluations in {result.seconds:.1f} s; wrote {args.out}"
+          + (f" and {args.ssv}" if args.ssv else ""))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

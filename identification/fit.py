@@ -1,0 +1,141 @@
+"""Fit the 16 parameters: global search in the normalised space, then a local polish.
+
+``fit(objective) -> FitResult``. The default preset runs scipy's differential evolution
+with the whole population evaluated in one compiled call (``vectorized=True``), then
+polishes the best candidate with scipy's bounded ``least_squares`` on the residuals whose
+sum of squares is E3. The paper's constraints beta1 + gamma1 > 0 and beta2 - gamma2 > 0 are
+a penalty (an infeasible candidate scores 1e3 + its violation, worse than any feasible one);
+A >= 1 and beta >= 0 are bounds (``search_space``).
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import differential_evolution, least_squares
+
+from fmu_src.bushing_params import PARAMETER_NAMES
+from identification.objectives import Objective
+from identification.search_space import SearchSpace
+
+PRESETS = {
+    # popsize is scipy's multiplier: 15 x 14 coordinates = 210 candidates per generation.
+    # rand1bin with dithered mutation explores more than scipy's best1bin: on the synthetic
+    # Table 5 tests it reached the noise floor for 3 of 3 seeds, best1bin for 1 of 3.
+    "default": {"popsize": 15, "maxiter": 100, "strategy": "rand1bin", "mutation": (0.5, 1.0),
+                "recombination": 0.9},
+}
+INFEASIBLE = 1e3
+POLISH_STARTS = 4
+
+
+@dataclass
+class FitResult:
+    parameters: dict[str, float]          # paper units, alpha1 = alpha2 = 1 representative
+    objective: float                      # E3 (dimensionless, see objectives)
+    terms: dict[str, float]
+    evaluations: int
+    seconds: float
+    preset: str
+    seed: int
+    space: SearchSpace
+    history: list[float] = field(default_factory=list)  # best E3 after each generation
+
+    def provenance(self) -> dict:
+        return {"method": f"differential evolution (rand1bin) + least_squares polish from the best "
+                          f"{POLISH_STARTS} (preset {self.preset!r})",
+                "seed": self.seed, "objective_E3": self.objective, "terms": self.terms,
+                "evaluations": self.evaluations, "seconds": round(self.seconds, 2),
+                "search_space": {"k_ref_N_per_mm": self.space.k_ref, "c_ref_Ns_per_mm": self.space.c_ref,
+                                 "F_ref_N": self.space.F_ref},
+                "note": "alpha1 = alpha2 = 1: only 14 of the 16 parameters are identifiable "
+                        "(search_space.rescale_hysteresis gives the equivalent sets)"}
+
+
+def fit(objective: Objective, preset: str = "default", seed: int = 0, progress: bool = True,
+        space: SearchSpace | None = None, popsize: int | None = None, maxiter: int | None = None) -> FitResult:
+    """Identify the parameters minimising ``objective``; ``popsize``/``maxiter`` override the preset."""
+    if preset not in PRESETS:
+        raise ValueError(f"unknown preset {preset!r}; choose one of {', '.join(PRESETS)}")
+    settings = dict(PRESETS[preset])
+    settings.update({k: v for k, v in (("popsize", popsize), ("maxiter", maxiter)) if v is not None})
+    space = space or SearchSpace.from_measurements(objective.sines)
+    bounds = space.bounds()
+    evaluations = 0
+    history: list[float] = []
+
+    def penalised(theta: np.ndarray) -> np.ndarray:
+        nonlocal evaluations
+        theta = np.atleast_2d(theta)
+        evaluations += theta.shape[0]
+        violation = space.constraint_violation(theta)
+        values = np.full(theta.shape[0], np.inf)
+        feasible = violation == 0.0
+        if feasible.any():
+            values[feasible] = objective(space.to_parameters(theta[feasible]))
+        values[~feasible] = INFEASIBLE + violation[~feasible]
+        return values
+
+    bar = _progress_bar(settings["maxiter"], progress)
+    started = time.perf_counter()
+
+    def on_generation(intermediate_result):
+        history.append(float(intermediate_result.fun))
+        bar.set_postfix_str(f"E3 {intermediate_result.fun:.3e}, {evaluations} evaluations")
+        bar.update(1)
+
+    search = differential_evolution(
+        lambda columns: penalised(columns.T), bounds, vectorized=True, updating="deferred",
+        popsize=settings["popsize"], maxiter=settings["maxiter"], strategy=settings["strategy"],
+        mutation=settings["mutation"], recombination=settings["recombination"], seed=seed,
+        polish=False, init="sobol", tol=1e-8, callback=on_generation)
+    bar.close()
+
+    # The polish does much of the work: run it from the best few distinct candidates of the
+    # final population (differential evolution can settle in one basin) and keep the best.
+    order = np.argsort(search.population_energies)
+    starts = [search.population[i] for i in order[:POLISH_STARTS]]
+    best, best_value = search.x, float(search.fun)
+    for start in starts:
+        polished, value, used = _polish(objective, space, start, bounds)
+        evaluations += used
+        if value < best_value:
+            best, best_value = polished, value
+    matrix = space.to_parameters(best)
+    terms = {name: float(values[0]) for name, values in objective.terms(matrix).items()}
+    return FitResult(dict(zip(PARAMETER_NAMES, map(float, matrix[0]))), float(objective(matrix)[0]), terms,
+                     evaluations, time.perf_counter() - started, preset, seed, space, history)
+
+
+def _polish(objective: Objective, space: SearchSpace, start: np.ndarray, bounds: np.ndarray):
+    """Bounded least squares from ``start``; the forward-difference Jacobian is one population
+    call (the point and its 14 perturbations). Returns (coordinates, E3, evaluations)."""
+    low, high = bounds[:, 0], bounds[:, 1]
+    evaluations = 0
+
+    def residuals_of(theta_rows):
+        nonlocal evaluations
+        evaluations += len(theta_rows)
+        return objective.residual_matrix(space.to_parameters(theta_rows))
+
+    def fun(theta):
+        return residuals_of(theta[None, :])[0]
+
+    def jac(theta):
+        steps = 1e-6 * np.maximum(1.0, np.abs(theta))
+        steps = np.where(theta + steps > high, -steps, steps)  # stay inside the bounds
+        stencil = theta + np.diag(steps)
+        rows = residuals_of(np.vstack([theta[None, :], stencil]))
+        return ((rows[1:] - rows[0]) / steps[:, None]).T
+
+    result = least_squares(fun, np.clip(start, low, high), jac=jac, bounds=(low, high), method="trf",
+                           x_scale="jac", max_nfev=200)
+    if space.constraint_violation(result.x)[0] > 0.0:
+        return result.x, np.inf, evaluations
+    return result.x, 2.0 * result.cost, evaluations
+
+
+def _progress_bar(total: int, enabled: bool):
+    from tqdm import tqdm
+    return tqdm(total=total, desc="generations", unit="gen", disable=not enabled, leave=False)

@@ -1,0 +1,191 @@
+"""Identification building blocks: measurement files, objectives, search space, parameter files."""
+import re
+
+import numpy as np
+import pytest
+
+from conftest import DATA, paper_parameters
+from fmu_src.bushing_params import PARAMETER_NAMES, ParameterError, load_parameter_file, save_ssv
+from identification.compiled_core import simulate_population
+from identification.measurements import Measurement, MeasurementError, load_measurement
+from identification.objectives import Objective, StepTest, nrmse, rms_error
+from identification.protocols import Sine, Step, sample_times
+from identification.search_space import SearchSpace, rescale_hysteresis
+
+
+def write(tmp_path, text, name="test.csv"):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def rows(count=20, time_step=0.001):
+    return "".join(f"{k * time_step:.3f},{0.1 * k:.3f},{10.0 * k:.1f}\n" for k in range(count))
+
+
+# -------------------------------------------------------------------- measurement files
+@pytest.mark.parametrize("text, fragment", [
+    ("time_s,displacement_mm\n" + "0,0\n" * 20, "lacks column(s) force"),
+    ("time_s,displacement_furlong,force_N\n" + rows(), "unknown unit 'furlong'"),
+    ("time_s,displacement_mm,force_N\n" + rows(5), "5 samples; at least 10"),
+    ("time_s,displacement_mm,force_N\n" + rows(12) + "0.005,1,1\n", "does not increase"),
+    ("time_s,displacement_mm,force_N\n" + rows(12).replace("0.300", "nan", 1), "is not finite"),
+    ("time_s,displacement_mm,force_N\n" + rows(12) + "0.1,abc,1\n", "'abc' is not a number"),
+    ("time_s,displacement_mm,force_N\n" + rows(12) + "0.1,1\n", "2 fields, header has 3"),
+])
+def test_bad_measurement_files_are_refused_with_the_reason(tmp_path, text, fragment):
+    with pytest.raises(MeasurementError, match=re.escape(fragment)):
+        load_measurement(write(tmp_path, text))
+
+
+def test_declared_units_are_converted_and_comments_kept(tmp_path):
+    text = "# SYNTHETIC\n# made by hand\ntime_s,displacement_in,force_kN,velocity_m_s\n"
+    text += "".join(f"{k * 0.01},{0.5},{2.0},{0.1}\n" for k in range(12))
+    m = load_measurement(write(tmp_path, text))
+    assert m.displacement_mm[0] == pytest.approx(12.7)
+    assert m.force_N[0] == pytest.approx(2000.0)
+    assert m.velocity_mm_s[0] == pytest.approx(100.0)
+    assert not m.velocity_derived and m.comments == ["SYNTHETIC", "made by hand"]
+
+
+def test_missing_velocity_is_derived_to_second_order(tmp_path):
+    t = sample_times(1.0, 1000.0)
+    x, v = Sine(2.0, 10.0).signals(t)
+    text = "time_s,displacement_mm,force_N\n" + "".join(f"{a:.6f},{b:.9f},0\n" for a, b in zip(t, x))
+    m = load_measurement(write(tmp_path, text))
+    assert m.velocity_derived
+    assert np.max(np.abs(m.velocity_mm_s - v)) < 2e-3 * np.max(np.abs(v))  # ~(omega*dt)^2/6
+
+
+def test_real_friction_damper_file_loads():
+    m = load_measurement(DATA.parent.parent / "shared" / "data" / "brfd" / "sine_0.5Hz30lbtension1amplitude.csv")
+    assert len(m) == 14337 and not m.velocity_derived
+    assert 20 < np.max(np.abs(m.displacement_mm)) < 30  # 1 in = 25.4 mm amplitude
+
+
+# -------------------------------------------------------------------- objectives
+def synthetic(params, protocol, duration_s, scale=1.0):
+    """A measurement whose force is ``scale`` times the model's with ``params``."""
+    t = sample_times(duration_s, 1000.0)
+    x, v = protocol.signals(t)
+    force = simulate_population([params], t, x, v)[0]
+    return Measurement(t, x, scale * force, v, source=f"{protocol}")
+
+
+def test_objective_terms_on_hand_checkable_cases():
+    params = paper_parameters("table5")
+    matrix = np.array([[params[name] for name in PARAMETER_NAMES]])
+    exact = Objective([synthetic(params, Sine(2.0, 10.0), 0.3)],
+                      StepTest(synthetic(params, Step(2.0, 0.1, 0.3), 0.3), 0.1))
+    # Zero up to the step test's own simulation grid (decimated hold, secant velocities).
+    assert exact(matrix)[0] < 1e-12
+    # Measured forces twice the model's: the sine's relative error is 1/2 everywhere (F1 = 1/4);
+    # both step errors are scaled by the measured force at the rise time, so F2 = 1/4 and
+    # F3 = 1/4 * (F_end / F_rise)^2.
+    step = StepTest(synthetic(params, Step(2.0, 0.1, 0.3), 0.3, scale=2.0), 0.1)
+    doubled = Objective([synthetic(params, Sine(2.0, 10.0), 0.3, scale=2.0)], step)
+    terms = doubled.terms(matrix)
+    expected_f3 = 0.25 * (step.measured_end / step.measured_rise) ** 2
+    assert terms["F1"][0] == pytest.approx(0.25, rel=1e-9)
+    assert terms["F2"][0] == pytest.approx(0.25, rel=1e-9)
+    # The hold is simulated in 10 ms steps against the 1 ms of this "measurement": 1e-6 apart.
+    assert terms["F3"][0] == pytest.approx(expected_f3, rel=1e-5)
+    assert doubled(matrix)[0] == pytest.approx(0.5 * 0.25 + 0.25 * 0.25 + 0.25 * expected_f3, rel=1e-6)
+    assert np.sum(doubled.residuals(matrix[0]) ** 2) == pytest.approx(doubled(matrix)[0], rel=1e-9)
+
+
+def test_error_measures():
+    measured = np.array([3.0, -4.0, 3.0, -4.0])
+    assert nrmse(0.5 * measured, measured) == pytest.approx(0.5)
+    assert rms_error(0.5 * measured, measured) == pytest.approx(0.5)  # eq. 10
+    assert rms_error(-measured, measured) == 0.0  # eq. 10 cannot see a sign error; NRMSE can
+    assert nrmse(-measured, measured) == pytest.approx(2.0)
+
+
+# -------------------------------------------------------------------- search space
+def test_rescaling_a_bouc_wen_block_leaves_the_force_unchanged():
+    # (alpha, A, beta, gamma) -> (alpha/s, s*A, s^(1-n)*beta, s^(1-n)*gamma): z becomes s*z.
+    params = paper_parameters("table5")
+    t = sample_times(0.3, 1000.0)
+    x, v = Sine(2.0, 10.0).signals(t)
+    reference = simulate_population([params], t, x, v)[0]
+    for s1, s2 in ((3.7, 0.2), (0.05, 41.0)):
+        rescaled = simulate_population([rescale_hysteresis(params, s1, s2)], t, x, v)[0]
+        np.testing.assert_allclose(rescaled, reference, rtol=1e-9, atol=1e-9 * np.max(np.abs(reference)))
+    with pytest.raises(ValueError, match="s1"):
+        rescale_hysteresis(params, -1.0, 1.0)
+
+
+def test_coordinates_round_trip_and_contain_the_paper_tables():
+    sine = load_measurement(DATA / "synthetic_table5_sine_2mm_10Hz.csv")
+    space = SearchSpace.from_measurements([sine])
+    bounds = space.bounds()
+    for table in ("table2", "table4", "table5"):
+        theta = space.to_coordinates(paper_parameters(table))
+        assert np.all((bounds[:, 0] <= theta) & (theta <= bounds[:, 1])), table
+        assert space.constraint_violation(theta)[0] == 0.0
+        back = dict(zip(PARAMETER_NAMES, space.to_parameters(theta)[0]))
+        expected = rescale_hysteresis(paper_parameters(table), paper_parameters(table)["alpha1"],
+                                      paper_parameters(table)["alpha2"])
+        for name in PARAMETER_NAMES:
+            assert back[name] == pytest.approx(expected[name], rel=1e-12), name
+
+
+def test_constraints_become_bounds_and_a_violation_measure():
+    sine = load_measurement(DATA / "synthetic_table5_sine_2mm_10Hz.csv")
+    space = SearchSpace.from_measurements([sine])
+    low = space.to_parameters(space.bounds()[:, 0])[0]
+    named = dict(zip(PARAMETER_NAMES, low))
+    assert named["A1"] >= 1.0 and named["A2"] >= 1.0 and named["beta1"] >= 0.0 and named["beta2"] >= 0.0
+    theta = space.to_coordinates(paper_parameters("table5"))
+    theta[8], theta[10] = 1.0, -1.5   # beta1 + gamma1 = -0.5 (scaled)
+    theta[9], theta[11] = 1.0, 1.25   # beta2 - gamma2 = -0.25
+    assert space.constraint_violation(theta)[0] == pytest.approx(0.75)
+
+
+# -------------------------------------------------------------------- parameter files
+def test_ssv_round_trip_is_exact_and_fmpy_reads_it(tmp_path):
+    from fmpy.ssp.ssd import read_ssv
+    params = paper_parameters("table2")
+    path = tmp_path / "table2.ssv"
+    save_ssv(path, params)
+    assert load_parameter_file(path) == params
+    assert {p.name: float(p.value) for p in read_ssv(str(path)).parameters} == params
+
+
+def test_ssv_with_a_wrong_unit_is_refused(tmp_path):
+    path = tmp_path / "bad.ssv"
+    save_ssv(path, paper_parameters("table5"))
+    path.write_text(path.read_text().replace('unit="N/mm"', 'unit="N/m"', 1))
+    with pytest.raises(ParameterError, match="unit 'N/m'"):
+        load_parameter_file(path)
+
+
+# -------------------------------------------------------------------- round trip
+def test_fit_round_trip_through_the_cli_and_a_built_fmu(tmp_path):
+    # Synthetic Table 5 tests (0.5 % force noise) -> fit with a reduced budget (seed 0) ->
+    # .json and .ssv -> an FMU built from the .ssv -> predictions of inputs not fitted on,
+    # against the noise-free truth. (With this budget 2 of 3 seeds reach the noise floor;
+    # with the default budget 3 of 3 did.)
+    import json
+
+    import build_fmu
+    from identification.__main__ import main
+    from identification.simulate import simulate
+    from test_fmu_numerics import simulate_with_fmpy
+
+    out, ssv = tmp_path / "fitted.json", tmp_path / "fitted.ssv"
+    assert main(["fit", "--sine", str(DATA / "synthetic_table5_sine_2mm_10Hz.csv"),
+                 "--step", str(DATA / "synthetic_table5_step_2mm_rise0.4s.csv"), "--rise-time", "0.4",
+                 "--seed", "0", "--popsize", "8", "--maxiter", "30", "--out", str(out), "--ssv", str(ssv)]) == 0
+    document = json.loads(out.read_text())
+    assert document["model"] == "BoucWenBushing" and document["units"] == "N-mm-s"
+    assert document["fit"]["objective_E3"] < 2e-5  # the noise alone gives 1.3e-5
+    assert load_parameter_file(ssv) == load_parameter_file(out)
+
+    fmu = build_fmu.build_fmu(ssv, tmp_path / "fmu")
+    truth = paper_parameters("table5")
+    for protocol, duration in ((Sine(1.0, 20.0), 0.5), (Sine(2.0, 10.0), 1.0)):
+        t = sample_times(duration, 1000.0)
+        x, v = protocol.signals(t)
+        assert nrmse(simulate_with_fmpy(fmu, t, x, v), simulate(truth, t, x, v)) < 0.01, protocol
