@@ -29,8 +29,29 @@ def main(argv: list[str] | None = None) -> int:
     fit_parser.add_argument("--maxiter", type=int, help="override the preset's number of generations")
     fit_parser.add_argument("--out", type=Path, required=True, help="parameter file to write (JSON)")
     fit_parser.add_argument("--ssv", type=Path, help="also write an SSP 1.0 ParameterValues file")
+
+    sensitivity_parser = commands.add_parser(
+        "sensitivity", help="rank the 16 parameters by local sensitivity (paper Tables 1 and 3)")
+    sensitivity_parser.add_argument("--params", type=Path, required=True, help="parameter file (.json or .ssv)")
+    sensitivity_parser.add_argument("--delta", type=float, default=0.1, help="relative change (default 0.1)")
+    sensitivity_parser.add_argument("--csv", type=Path, help="also write the table as CSV")
+
+    report_parser = commands.add_parser("report", help="verification report: error tables and plots (paper §5)")
+    report_parser.add_argument("--params", type=Path, required=True, help="parameter file (.json or .ssv)")
+    report_parser.add_argument("--data", action="append", type=Path, default=[], metavar="FILE",
+                               help="measured test CSV to compare with; repeatable")
+    report_parser.add_argument("--truth", type=Path,
+                               help="parameter file of the true model: adds the §5 grid of synthetic cases")
+    report_parser.add_argument("--kelvin-voigt-train", action="append", type=Path, default=[], metavar="FILE",
+                               help="fit F = k*x + c*v on these files and show it beside the model")
+    report_parser.add_argument("--plots", type=Path, help="directory for force-time/force-displacement PNGs")
+
     args = parser.parse_args(argv)
     try:
+        if args.command == "sensitivity":
+            return _sensitivity(args)
+        if args.command == "report":
+            return _report(args)
         return _fit(args)
     except (MeasurementError, ParameterError, ValueError) as exc:
         print(f"error: {exc}", file=sys.stderr)
@@ -68,6 +89,41 @@ def _fit(args) -> int:
               f"{rms_error(predicted, measurement.force_N):8.2%}")
     print(f"{result.evaluations} evaluations in {result.seconds:.1f} s; wrote {args.out}"
           + (f" and {args.ssv}" if args.ssv else ""))
+    return 0
+
+
+def _sensitivity(args) -> int:
+    from fmu_src.bushing_params import load_parameter_file
+    from identification.sensitivity import sensitivity
+    table = sensitivity(load_parameter_file(args.params), delta=args.delta)
+    print(table.format())
+    if args.csv:
+        table.write_csv(args.csv)
+        print(f"wrote {args.csv}")
+    return 0
+
+
+def _report(args) -> int:
+    from fmu_src.bushing_params import load_parameter_file
+    from identification.report import data_errors, format_data_errors, format_errors, grid_errors, plot_measurement
+    from identification.search_space import KelvinVoigtFit
+    params = load_parameter_file(args.params)
+    if not (args.data or args.truth):
+        raise ValueError("give --data files and/or --truth to report on")
+    kelvin_voigt = None
+    if args.kelvin_voigt_train:
+        kelvin_voigt = KelvinVoigtFit.fit([load_measurement(path) for path in args.kelvin_voigt_train])
+        print(f"Kelvin-Voigt fit: k = {kelvin_voigt.k:.4g} N/mm, c = {kelvin_voigt.c:.4g} N*s/mm")
+    if args.truth:
+        print(f"Against the noise-free model of {args.truth} (paper §5 grid):")
+        print(format_errors(grid_errors(params, load_parameter_file(args.truth))))
+    if args.data:
+        measurements = [load_measurement(path) for path in args.data]
+        print(format_data_errors(data_errors(params, measurements, kelvin_voigt)))
+        if args.plots:
+            for m in measurements:
+                path = plot_measurement(params, m, args.plots / (Path(m.source).stem + ".png"), kelvin_voigt)
+                print(f"wrote {path}")
     return 0
 
 
