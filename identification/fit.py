@@ -27,7 +27,7 @@ PRESETS = {
                 "recombination": 0.9},
 }
 INFEASIBLE = 1e3
-POLISH_STARTS = 4
+POLISH_STARTS = 6
 
 
 @dataclass
@@ -44,7 +44,7 @@ class FitResult:
 
     def provenance(self) -> dict:
         return {"method": f"differential evolution (rand1bin) + least_squares polish from the best "
-                          f"{POLISH_STARTS} (preset {self.preset!r})",
+                          f"{POLISH_STARTS} distinct (preset {self.preset!r})",
                 "seed": self.seed, "objective_E3": self.objective, "terms": self.terms,
                 "evaluations": self.evaluations, "seconds": round(self.seconds, 2),
                 "search_space": {"k_ref_N_per_mm": self.space.k_ref, "c_ref_Ns_per_mm": self.space.c_ref,
@@ -92,10 +92,9 @@ def fit(objective: Objective, preset: str = "default", seed: int = 0, progress: 
         polish=False, init="sobol", tol=1e-8, callback=on_generation)
     bar.close()
 
-    # The polish does much of the work: run it from the best few distinct candidates of the
-    # final population (differential evolution can settle in one basin) and keep the best.
-    order = np.argsort(search.population_energies)
-    starts = [search.population[i] for i in order[:POLISH_STARTS]]
+    # The polish does much of the work: run it from the best few mutually distant candidates
+    # of the final population (differential evolution can settle in one basin); keep the best.
+    starts = _diverse_starts(search.population, search.population_energies, bounds, POLISH_STARTS)
     best, best_value = search.x, float(search.fun)
     for start in starts:
         polished, value, used = _polish(objective, space, start, bounds)
@@ -106,6 +105,21 @@ def fit(objective: Objective, preset: str = "default", seed: int = 0, progress: 
     terms = {name: float(values[0]) for name, values in objective.terms(matrix).items()}
     return FitResult(dict(zip(PARAMETER_NAMES, map(float, matrix[0]))), float(objective(matrix)[0]), terms,
                      evaluations, time.perf_counter() - started, preset, seed, space, history)
+
+
+def _diverse_starts(population, energies, bounds, count, min_distance=0.1):
+    """The best candidates that are at least ``min_distance`` apart (in coordinates scaled by
+    the bound ranges): the best few of a population often sit in one basin."""
+    scaled = (population - bounds[:, 0]) / (bounds[:, 1] - bounds[:, 0])
+    chosen: list[int] = []
+    for i in np.argsort(energies):
+        if not np.isfinite(energies[i]) or energies[i] >= INFEASIBLE:
+            break
+        if all(np.linalg.norm(scaled[i] - scaled[j]) >= min_distance for j in chosen):
+            chosen.append(int(i))
+            if len(chosen) == count:
+                break
+    return [population[i] for i in chosen]
 
 
 def _polish(objective: Objective, space: SearchSpace, start: np.ndarray, bounds: np.ndarray):
