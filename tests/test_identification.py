@@ -212,3 +212,16 @@ def test_report_grid_is_zero_against_itself_and_names_every_case():
     assert all(e.nrmse == 0.0 and e.eq10 == 0.0 for e in own)
     other = grid_errors(paper_parameters("table2"), paper_parameters("table5"))
     assert all(e.nrmse > 0.0 for e in other)
+
+
+def test_paper_ga_preset_improves_and_respects_the_constraints():
+    from fmu_src.bushing_params import validate_parameters
+    from identification.fit import fit
+    sine = load_measurement(DATA / "synthetic_table5_sine_2mm_10Hz.csv")
+    objective = Objective([sine])
+    result = fit(objective, preset="paper", seed=3, progress=False, popsize=40, maxiter=8)
+    assert result.history[-1] < result.history[0]  # the GA's best improves
+    assert result.objective <= result.search_objective  # the polish never makes it worse
+    errors, warnings = validate_parameters(result.parameters)
+    assert errors == [] and warnings == []  # A >= 1, beta >= 0, beta1 + gamma1 > 0, beta2 - gamma2 > 0
+    assert result.provenance()["method"].startswith("the paper's GA")
