@@ -1,0 +1,100 @@
+"""Cost of evaluating fitting candidates: compiled population vs Python core vs solve_ivp.
+
+    python benchmarks/bench_identification.py [--candidates N] [--ivp-candidates M]
+
+All three simulate the paper's identification sine (2 mm, 10 Hz, 1 s at 1 kHz) for random
+candidates of the normalised search space (around the synthetic Table 5 data), in one run:
+- the numba-compiled core over the whole population at once (what the fit uses),
+- the same core as plain Python, one candidate after the other (what the FMU runs),
+- scipy's solve_ivp (Radau, rtol 1e-6) on eqs. 1-4, restarted at every sample, on a few
+  candidates (it is slow): the per-candidate loop the issue compares against.
+Then the budgets: the default preset's ~21,000 and the paper's 60,000 evaluations of the
+combined sine + step objective, estimated from the measured cost per candidate.
+"""
+from __future__ import annotations
+
+import argparse
+import platform
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO))
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--candidates", type=int, default=210)
+    parser.add_argument("--ivp-candidates", type=int, default=3)
+    args = parser.parse_args()
+
+    from scipy.integrate import solve_ivp
+    from fmu_src import bushing_core as core
+    from fmu_src.bushing_params import PARAMETER_NAMES, load_parameter_file
+    from identification.compiled_core import simulate_population
+    from identification.measurements import load_measurement
+    from identification.objectives import Objective, StepTest
+    from identification.protocols import Sine, sample_times
+    from identification.search_space import SearchSpace
+    from identification.simulate import simulate
+
+    sine = load_measurement(REPO / "data" / "synthetic_table5_sine_2mm_10Hz.csv")
+    step = load_measurement(REPO / "data" / "synthetic_table5_step_2mm_rise0.4s.csv")
+    space = SearchSpace.from_measurements([sine])
+    bounds = space.bounds()
+    # Candidates near the data's optimum region (a late generation), not uniform over the
+    # bounds, where many candidates fail at once and would flatter every method.
+    centre = space.to_coordinates(load_parameter_file(REPO / "data" / "params_table5_combined.json"))
+    rng = np.random.default_rng(0)
+    theta = np.clip(centre + 0.05 * (bounds[:, 1] - bounds[:, 0]) * rng.standard_normal((args.candidates, 14)),
+                    bounds[:, 0], bounds[:, 1])
+    matrix = space.to_parameters(theta)
+    t = sample_times(1.0, 1000.0)
+    x, v = Sine(2.0, 10.0).signals(t)
+
+    simulate_population(matrix[:2], t, x, v)  # compile outside the timing
+    started = time.perf_counter()
+    compiled = simulate_population(matrix, t, x, v)
+    compiled_cost = (time.perf_counter() - started) / len(matrix)
+
+    python_sample = matrix[:20]
+    started = time.perf_counter()
+    for row in python_sample:
+        try:
+            simulate(dict(zip(PARAMETER_NAMES, row)), t, x, v)
+        except core.StepError:
+            pass
+    python_cost = (time.perf_counter() - started) / len(python_sample)
+
+    ivp_sample = matrix[:args.ivp_candidates]
+    started = time.perf_counter()
+    for row in ivp_sample:
+        p = dict(zip(PARAMETER_NAMES, row))
+        state = np.array(core.initial_state(p, x[0]))
+        for k in range(t.size - 1):
+            state = solve_ivp(core.rhs, (0.0, t[k + 1] - t[k]), state, method="Radau", args=(x[k], v[k], p),
+                              rtol=1e-6, atol=1e-6).y[:, -1]
+    ivp_cost = (time.perf_counter() - started) / len(ivp_sample)
+
+    objective = Objective([sine], StepTest(step, 0.4))
+    objective(matrix[:2])
+    started = time.perf_counter()
+    objective(matrix)
+    objective_cost = (time.perf_counter() - started) / len(matrix)
+
+    print(f"machine: {platform.machine()}, Python {platform.python_version()}; sine 2 mm / 10 Hz, 1 s at 1 kHz; "
+          f"{len(matrix)} candidates near the optimum, {np.isnan(compiled[:, -1]).sum()} of them failed")
+    print(f"{'per candidate':45s} {'ms':>10s} {'speed-up':>9s}")
+    print(f"{'solve_ivp Radau loop (' + str(len(ivp_sample)) + ' candidates)':45s} {ivp_cost * 1e3:10.1f} {1.0:9.0f}")
+    print(f"{'Python core (20 candidates)':45s} {python_cost * 1e3:10.2f} {ivp_cost / python_cost:9.0f}")
+    print(f"{'compiled core, population at once':45s} {compiled_cost * 1e3:10.3f} {ivp_cost / compiled_cost:9.0f}")
+    print(f"combined sine + step objective: {objective_cost * 1e3:.2f} ms per candidate -> "
+          f"default preset (~21,000): {21000 * objective_cost:.0f} s, paper preset (60,000): "
+          f"{60000 * objective_cost:.0f} s, before the polish")
+
+
+if __name__ == "__main__":
+    main()
