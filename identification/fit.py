@@ -57,8 +57,9 @@ class FitResult:
                 "evaluations": self.evaluations, "seconds": round(self.seconds, 2),
                 "search_space": {"k_ref_N_per_mm": self.space.k_ref, "c_ref_Ns_per_mm": self.space.c_ref,
                                  "F_ref_N": self.space.F_ref},
-                "note": "alpha1 = alpha2 = 1: only 14 of the 16 parameters are identifiable "
-                        "(search_space.rescale_hysteresis gives the equivalent sets)"}
+                "note": ("alpha1 = alpha2 = 1: only 14 of the 16 parameters are identifiable "
+                         "(search_space.rescale_hysteresis gives the equivalent sets)" if self.space.normalise
+                         else "searched without normalisation: alpha1, alpha2 free (redundant)")}
 
 
 def fit(objective: Objective, preset: str = "default", seed: int = 0, progress: bool = True,
@@ -100,7 +101,7 @@ def fit(objective: Objective, preset: str = "default", seed: int = 0, progress: 
             lambda columns: penalised(columns.T), bounds, vectorized=True, updating="deferred",
             popsize=settings["popsize"], maxiter=settings["maxiter"], strategy=settings["strategy"],
             mutation=settings["mutation"], recombination=settings["recombination"], seed=seed,
-            polish=False, init="sobol", tol=1e-8, callback=lambda result: on_generation(result.fun))
+            polish=False, init="sobol", tol=1e-8, callback=_de_callback(on_generation))
         population, energies = search.population, search.population_energies
     bar.close()
 
@@ -119,6 +120,13 @@ def fit(objective: Objective, preset: str = "default", seed: int = 0, progress: 
     terms = {name: float(values[0]) for name, values in objective.terms(matrix).items()}
     return FitResult(dict(zip(PARAMETER_NAMES, map(float, matrix[0]))), float(objective(matrix)[0]), terms,
                      evaluations, time.perf_counter() - started, preset, seed, space, history, search_value)
+
+
+def _de_callback(on_generation):
+    # scipy hands the OptimizeResult only to a callback whose parameter has this exact name.
+    def callback(intermediate_result):
+        on_generation(intermediate_result.fun)
+    return callback
 
 
 def _genetic_algorithm(penalised, space, bounds, settings, seed, on_generation):

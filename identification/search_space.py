@@ -52,9 +52,12 @@ class SearchSpace:
     k_ref: float   # N/mm
     c_ref: float   # N*s/mm
     F_ref: float   # N
+    normalise: bool = True
+    """False searches log10(alpha1), log10(alpha2) in [-3, 1] too (16 coordinates): only for
+    measuring what the normalisation is worth (benchmarks/bench_normalisation.py)."""
 
     @classmethod
-    def from_measurements(cls, sines: Sequence[Measurement]) -> "SearchSpace":
+    def from_measurements(cls, sines: Sequence[Measurement], normalise: bool = True) -> "SearchSpace":
         kelvin_voigt = KelvinVoigtFit.fit(sines)
         peak = max(float(np.max(np.abs(m.force_N))) for m in sines)
         amplitude = max(float(np.max(np.abs(m.displacement_mm))) for m in sines)
@@ -62,19 +65,22 @@ class SearchSpace:
         # stiffness; fall back to the secant stiffness and a 1 s time scale then.
         k_ref = abs(kelvin_voigt.k) if kelvin_voigt.k > 0 else peak / amplitude
         c_ref = abs(kelvin_voigt.c) if kelvin_voigt.c > 0 else k_ref * 0.01
-        return cls(k_ref, c_ref, peak)
+        return cls(k_ref, c_ref, peak, normalise)
 
     def bounds(self) -> np.ndarray:
-        """(14, 2) lower and upper bounds of the coordinates."""
+        """(14, 2) lower and upper bounds of the coordinates ((16, 2) without normalisation)."""
         log_A_low = max(np.log10(1.0 / self.k_ref), -4.0)  # A >= 1 N/mm (paper)
-        return np.array([
+        rows = [
             (-3.0, 1.0), (-3.0, 1.0), (-5.0, 0.0),          # k0, k1, k2 / k_ref
             (-4.0, 2.0), (-4.0, 2.0), (-4.0, 2.0),          # c0, c1, c2 / c_ref
             (log_A_low, 1.0), (log_A_low, 1.0),             # A1, A2 / k_ref
             (0.0, 20.0), (0.0, 20.0),                       # beta1, beta2 (>= 0, paper)
             (-20.0, 20.0), (-20.0, 20.0),                   # gamma1, gamma2
             (0.2, 1.5), (0.2, 1.5),                         # n1, n2
-        ])
+        ]
+        if not self.normalise:
+            rows += [(-3.0, 1.0), (-3.0, 1.0)]              # log10 alpha1, alpha2
+        return np.array(rows)
 
     def to_parameters(self, coordinates: np.ndarray) -> np.ndarray:
         """(P, 14) coordinates -> (P, 16) paper parameters with alpha1 = alpha2 = 1."""
@@ -91,18 +97,25 @@ class SearchSpace:
         out[:, _INDEX["n1"]], out[:, _INDEX["n2"]] = n1, n2
         for column, name, n in ((8, "beta1", n1), (9, "beta2", n2), (10, "gamma1", n1), (11, "gamma2", n2)):
             out[:, _INDEX[name]] = theta[:, column] * self.k_ref / self.F_ref ** n
-        out[:, _INDEX["alpha1"]] = out[:, _INDEX["alpha2"]] = 1.0
+        if self.normalise:
+            out[:, _INDEX["alpha1"]] = out[:, _INDEX["alpha2"]] = 1.0
+        else:
+            out[:, _INDEX["alpha1"]], out[:, _INDEX["alpha2"]] = 10.0 ** theta[:, 14], 10.0 ** theta[:, 15]
         return out
 
     def to_coordinates(self, params: Mapping[str, float]) -> np.ndarray:
-        """The inverse of :meth:`to_parameters`, after rescaling to alpha1 = alpha2 = 1."""
-        p = rescale_hysteresis(params, params["alpha1"], params["alpha2"])
+        """The inverse of :meth:`to_parameters` (after rescaling to alpha1 = alpha2 = 1 when
+        normalised)."""
+        p = rescale_hysteresis(params, params["alpha1"], params["alpha2"]) if self.normalise else dict(params)
         theta = [np.log10(p[name] / self.k_ref) if p[name] > 0 else -np.inf for name in ("k0", "k1", "k2")]
         theta += [np.log10(p[name] / self.c_ref) for name in ("c0", "c1", "c2")]
         theta += [np.log10(p["A1"] / self.k_ref), np.log10(p["A2"] / self.k_ref)]
         theta += [p[name] * self.F_ref ** p["n" + name[-1]] / self.k_ref
                   for name in ("beta1", "beta2", "gamma1", "gamma2")]
-        return np.array(theta + [p["n1"], p["n2"]])
+        theta += [p["n1"], p["n2"]]
+        if not self.normalise:
+            theta += [np.log10(p["alpha1"]), np.log10(p["alpha2"])]
+        return np.array(theta)
 
     @staticmethod
     def constraint_violation(coordinates: np.ndarray) -> np.ndarray:
