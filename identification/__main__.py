@@ -5,8 +5,6 @@ import argparse
 import sys
 from pathlib import Path
 
-import numpy as np
-
 from fmu_src.bushing_params import ParameterError, save_parameter_file, save_ssv
 from identification.measurements import MeasurementError, load_measurement
 
@@ -62,8 +60,8 @@ def main(argv: list[str] | None = None) -> int:
 
 def _fit(args) -> int:
     from identification.fit import fit
-    from identification.objectives import Objective, StepTest, nrmse, rms_error
-    from identification.compiled_core import simulate_population
+    from identification.objectives import Objective, StepTest
+    from identification.report import data_errors, format_data_errors
 
     if (args.step is None) != (args.rise_time is None):
         raise ValueError("--step and --rise-time go together")
@@ -81,14 +79,8 @@ def _fit(args) -> int:
     if args.ssv:
         save_ssv(args.ssv, result.parameters)
 
-    matrix = np.array([[result.parameters[name] for name in result.parameters]])
     print(f"objective E3 = {result.objective:.4e}   ({', '.join(f'{k} {v:.3e}' for k, v in result.terms.items())})")
-    print(f"{'test':50s} {'NRMSE':>8s} {'eq. 10':>8s}")
-    for measurement in [*sines, *randoms, *([step.measurement] if step else [])]:
-        predicted = simulate_population(matrix, measurement.time_s, measurement.displacement_mm,
-                                        measurement.velocity_mm_s)[0]
-        print(f"{Path(measurement.source).name:50s} {nrmse(predicted, measurement.force_N):8.2%} "
-              f"{rms_error(predicted, measurement.force_N):8.2%}")
+    print(format_data_errors(data_errors(result.parameters, [*sines, *randoms, *([step.measurement] if step else [])])))
     print(f"{result.evaluations} evaluations in {result.seconds:.1f} s; wrote {args.out}"
           + (f" and {args.ssv}" if args.ssv else ""))
     return 0

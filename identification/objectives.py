@@ -113,10 +113,6 @@ class Objective:
             total = total + w1 * terms["random"]
         return np.where(np.isfinite(total), total, np.inf)
 
-    def residuals(self, params_row: np.ndarray) -> np.ndarray:
-        """Residual vector r of one candidate with sum(r^2) = E3, for least-squares polishing."""
-        return self.residual_matrix(np.atleast_2d(params_row))[0]
-
     def residual_matrix(self, matrix: np.ndarray) -> np.ndarray:
         """Residual vectors of P candidates, shape (P, m); each row's sum of squares is E3.
         Failed simulations give residuals of 1e3."""

@@ -8,6 +8,7 @@ from conftest import DATA, paper_parameters, reference_force
 from fmu_harness import BushingFmu
 from fmu_src import bushing_core as core
 from identification.measurements import load_measurement
+from identification.objectives import nrmse
 from identification.protocols import Sine, Step, sample_times
 from identification.simulate import simulate
 
@@ -24,10 +25,6 @@ def simulate_with_fmpy(fmu_path, time_s, x_mm, v_mm_s, start_values=None):
                           start_values=start_values or {})
     assert np.allclose(result["time"], time_s, rtol=0, atol=1e-9)
     return result["F"]
-
-
-def nrmse(predicted, measured):
-    return np.sqrt(np.mean((predicted - measured) ** 2)) / np.sqrt(np.mean(measured ** 2))
 
 
 @pytest.mark.parametrize("name", ["sine_2mm_10Hz", "step_2mm_rise0.4s", "random_2mm"])

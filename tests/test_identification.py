@@ -91,7 +91,7 @@ def test_objective_terms_on_hand_checkable_cases():
     # The hold is simulated in 10 ms steps against the 1 ms of this "measurement": 1e-6 apart.
     assert terms["F3"][0] == pytest.approx(expected_f3, rel=1e-5)
     assert doubled(matrix)[0] == pytest.approx(0.5 * 0.25 + 0.25 * 0.25 + 0.25 * expected_f3, rel=1e-6)
-    assert np.sum(doubled.residuals(matrix[0]) ** 2) == pytest.approx(doubled(matrix)[0], rel=1e-9)
+    assert np.sum(doubled.residual_matrix(matrix)[0] ** 2) == pytest.approx(doubled(matrix)[0], rel=1e-9)
 
 
 def test_error_measures():
