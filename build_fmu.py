@@ -1,14 +1,19 @@
-"""Build the bushing FMU: ``python build_fmu.py [--params FILE] [--out DIR]``.
+"""Build a bushing FMU: ``python build_fmu.py [--model NAME] [--params FILE] [--out DIR]``.
 
-Writes ``DIR/BoucWenBushing.fmu`` (FMI 2.0 co-simulation, pythonfmu) whose parameter start
-values are the set in FILE, project JSON or SSP 1.0 ``.ssv`` (default: the paper's Table 5,
-``data/params_table5_combined.json``).
+Writes ``DIR/<identifier>.fmu`` (FMI 2.0 co-simulation, pythonfmu) of the model NAME
+(``proposed``, the default: ``BoucWenBushing.fmu``; ``spencer``: ``SpencerBushing``;
+``bouc_wen``: ``SingleBoucWenBushing``; ``kelvin_voigt``: ``KelvinVoigtBushing``) whose
+parameter start values are the set in FILE, project JSON or SSP 1.0 ``.ssv`` (default: the
+paper's Table 5 for the proposed model, the baselines' fits to the synthetic Table 5 tests
+in ``data/`` for the others).
 
 What the build adds to pythonfmu's output, and why:
 - Unique module names. The slave module is packed as ``boucwen_bushing_<hash>.py`` with its
-  library in ``boucwen_bushing_<hash>_lib/``, the hash taken over the packed sources and the
-  default parameters: pythonfmu imports packed modules into the host's shared
+  library in ``boucwen_bushing_<hash>_lib/``, the hash taken over the packed sources, the
+  model and the default parameters: pythonfmu imports packed modules into the host's shared
   ``sys.modules``, so two FMUs with equal module names would silently run the first one's code.
+- One class per model: the packed slave module ends with ``class <identifier>(BushingSlave)``,
+  which pythonfmu picks (longest hierarchy) and which names the modelIdentifier.
 - modelDescription.xml: units on every variable and their UnitDefinitions, the
   InitialUnknowns and the output's direct dependencies (pythonfmu writes none of these), and
   a check with ``fmpy.validation.validate_fmu`` that must find no problem.
@@ -30,39 +35,53 @@ from xml.etree import ElementTree as ET
 
 REPO = Path(__file__).resolve().parent
 SOURCE_DIR = REPO / "fmu_src"
-DEFAULT_PARAMS = REPO / "data" / "params_table5_combined.json"
-LIBRARY_MODULES = ("bushing_core.py", "bushing_params.py")
+LIBRARY_MODULES = ("bushing_core.py", "bushing_params.py", "bushing_models.py", "parameter_files.py")
 SLAVE_MODULE = "bushing_slave.py"
 
 sys.path.insert(0, str(REPO))
 from fmu_src import bushing_params  # noqa: E402
+from fmu_src.bushing_models import MODEL_NAMES, get_model  # noqa: E402
+from fmu_src.parameter_files import parameter_document, read_parameter_set  # noqa: E402
 
 PACKED_LIBRARY_INIT = '''"""Packed library of the bushing FMU (written by build_fmu.py)."""
 from pathlib import Path
 
-from . import bushing_core, bushing_params
+from . import bushing_core, parameter_files
 
-DEFAULT_PARAMETERS = bushing_params.load_parameter_file(Path(__file__).with_name("default_parameters.json"))
+_DEFAULTS = parameter_files.read_parameter_set(Path(__file__).with_name("default_parameters.json"))
+MODEL = _DEFAULTS.model
+DEFAULT_PARAMETERS = _DEFAULTS.parameters
 '''
-PORT_UNITS = {"x": "m", "v": "m/s", "F": "N", "z1": "N", "z2": "N", "y": "m", "w": "m"}
+PORT_UNITS = {"x": "m", "v": "m/s", "F": "N"}
 
 
 class BuildError(RuntimeError):
     pass
 
 
-def build_fmu(params_file: str | Path = DEFAULT_PARAMS, out_dir: str | Path = REPO / "dist") -> Path:
-    """Build the FMU with the parameter set in ``params_file`` as start values; return its path."""
+def default_parameter_file(model: str = "proposed") -> Path:
+    """The parameter set an FMU of ``model`` gets when no ``--params`` is given."""
+    return REPO / "data" / get_model(model).default_file
+
+
+def build_fmu(params_file: str | Path | None = None, out_dir: str | Path = REPO / "dist",
+              model: str = "proposed") -> Path:
+    """Build the FMU of ``model`` with the parameter set in ``params_file`` as start values
+    (default: :func:`default_parameter_file`); return its path."""
     from pythonfmu.builder import FmuBuilder
 
-    params_file = Path(params_file)
-    parameters = bushing_params.load_parameter_file(params_file)
-    defaults_json = bushing_params.parameter_document(
-        parameters, {"source": f"build_fmu.py --params {params_file.name}"})
+    bushing = get_model(model)
+    params_file = Path(params_file) if params_file is not None else default_parameter_file(bushing.name)
+    parameters = read_parameter_set(params_file, bushing.name).parameters
+    defaults_json = parameter_document(parameters, bushing.name,
+                                       {"source": f"build_fmu.py --model {bushing.name} --params {params_file.name}"})
     defaults_text = json.dumps(defaults_json, indent=2) + "\n"
+    slave_text = ((SOURCE_DIR / SLAVE_MODULE).read_text()
+                  + f"\n\nclass {bushing.identifier}(BushingSlave):\n"
+                    f"    \"\"\"The {bushing.title} model (written by build_fmu.py).\"\"\"\n")
 
-    digest = hashlib.sha256()
-    for name in (SLAVE_MODULE, *LIBRARY_MODULES):
+    digest = hashlib.sha256(slave_text.encode())
+    for name in LIBRARY_MODULES:
         digest.update((SOURCE_DIR / name).read_bytes())
     digest.update(defaults_text.encode())
     module_name = f"boucwen_bushing_{digest.hexdigest()[:12]}"
@@ -72,7 +91,7 @@ def build_fmu(params_file: str | Path = DEFAULT_PARAMS, out_dir: str | Path = RE
     with tempfile.TemporaryDirectory(prefix="bushing_build_") as stage:
         stage = Path(stage)
         script = stage / f"{module_name}.py"
-        shutil.copy2(SOURCE_DIR / SLAVE_MODULE, script)
+        script.write_text(slave_text)
         library = stage / f"{module_name}_lib"
         library.mkdir()
         (library / "__init__.py").write_text(PACKED_LIBRARY_INIT)
@@ -90,7 +109,7 @@ def build_fmu(params_file: str | Path = DEFAULT_PARAMS, out_dir: str | Path = RE
             for loaded in [m for m in sys.modules if m.startswith(module_name)]:
                 del sys.modules[loaded]
 
-    _rewrite_model_description(fmu_path, parameters)
+    _rewrite_model_description(fmu_path, parameters, bushing)
     from fmpy.validation import validate_fmu
     problems = validate_fmu(str(fmu_path))
     if problems:
@@ -98,11 +117,11 @@ def build_fmu(params_file: str | Path = DEFAULT_PARAMS, out_dir: str | Path = RE
     return fmu_path
 
 
-def _rewrite_model_description(fmu_path: Path, parameters: dict[str, float]) -> None:
+def _rewrite_model_description(fmu_path: Path, parameters: dict[str, float], bushing) -> None:
     with zipfile.ZipFile(fmu_path) as archive:
         entries = {info.filename: archive.read(info.filename) for info in archive.infolist()}
     root = ET.fromstring(entries["modelDescription.xml"])
-    _add_units(root)
+    _add_units(root, {**PORT_UNITS, **bushing.units, **{s.name: s.unit for s in bushing.states}})
     _set_parameter_starts(root, parameters)
     _add_model_structure(root)
     text = parseString(ET.tostring(root, encoding="UTF-8")).toprettyxml(indent="  ", encoding="UTF-8")
@@ -112,11 +131,11 @@ def _rewrite_model_description(fmu_path: Path, parameters: dict[str, float]) -> 
             archive.writestr(name, data)
 
 
-def _add_units(root: ET.Element) -> None:
+def _add_units(root: ET.Element, units: dict[str, str]) -> None:
     units_used = set()
     for variable in root.iter("ScalarVariable"):
         name = variable.get("name")
-        unit = PORT_UNITS.get(name) or bushing_params.PARAMETER_UNITS.get(name)
+        unit = units.get(name)
         if unit is None:
             raise BuildError(f"no unit declared for variable {name!r}")
         variable.find("Real").set("unit", unit)
@@ -144,7 +163,8 @@ def _add_model_structure(root: ET.Element) -> None:
     structure = root.find("ModelStructure")
     for child in list(structure):
         structure.remove(child)
-    # F = k0*y + c0*(c2*v + k2*(x - w) + alpha2*z2)/(c0 + c2): direct feedthrough of x and v.
+    # F = k0*y + c0*(c2*v + k2*(x - w) + alpha2*z2)/(c0 + c2) (+ a constant for the
+    # baselines): direct feedthrough of x and v.
     outputs = ET.SubElement(structure, "Outputs")
     ET.SubElement(outputs, "Unknown", index=index["F"], dependencies=f"{index['x']} {index['v']}",
                   dependenciesKind="dependent dependent")
@@ -154,13 +174,15 @@ def _add_model_structure(root: ET.Element) -> None:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--params", default=str(DEFAULT_PARAMS),
-                        help="parameter set, project JSON or SSP 1.0 .ssv (paper N-mm-s units); "
-                             "default: the paper's Table 5")
+    parser.add_argument("--model", default="proposed", choices=MODEL_NAMES,
+                        help="which bushing model (default: proposed, the paper's eqs. 1-5)")
+    parser.add_argument("--params", help="parameter set of the model, project JSON or SSP 1.0 .ssv "
+                                         "(paper N-mm-s units); default: the paper's Table 5 for the "
+                                         "proposed model, data/params_<model>_fit_synthetic_table5.json otherwise")
     parser.add_argument("--out", default=str(REPO / "dist"), help="output directory (default: dist/)")
     args = parser.parse_args(argv)
     try:
-        path = build_fmu(args.params, args.out)
+        path = build_fmu(args.params, args.out, args.model)
     except (bushing_params.ParameterError, BuildError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

@@ -77,8 +77,8 @@ def time_fmu(fmu_path, inputs):
 
 def time_core(inputs_mm):
     from fmu_src import bushing_core as core
-    from fmu_src.bushing_params import load_parameter_file
-    params = load_parameter_file(REPO / "data" / "params_table5_combined.json")
+    from fmu_src.parameter_files import load_parameters
+    params = load_parameters(REPO / "data" / "params_table5_combined.json")
     model = core.compile_model(params)
     state, state_x = core.initial_state(params), 0.0
     started = time.perf_counter()

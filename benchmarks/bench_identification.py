@@ -33,7 +33,8 @@ def main() -> None:
 
     from scipy.integrate import solve_ivp
     from fmu_src import bushing_core as core
-    from fmu_src.bushing_params import PARAMETER_NAMES, load_parameter_file
+    from fmu_src.bushing_params import PARAMETER_NAMES
+    from fmu_src.parameter_files import load_parameters
     from identification.compiled_core import simulate_population
     from identification.measurements import load_measurement
     from identification.objectives import Objective, StepTest
@@ -47,7 +48,7 @@ def main() -> None:
     bounds = space.bounds()
     # Candidates near the data's optimum region (a late generation), not uniform over the
     # bounds, where many candidates fail at once and would flatter every method.
-    centre = space.to_coordinates(load_parameter_file(REPO / "data" / "params_table5_combined.json"))
+    centre = space.to_coordinates(load_parameters(REPO / "data" / "params_table5_combined.json"))
     rng = np.random.default_rng(0)
     theta = np.clip(centre + 0.05 * (bounds[:, 1] - bounds[:, 0]) * rng.standard_normal((args.candidates, 14)),
                     bounds[:, 0], bounds[:, 1])

@@ -1,4 +1,4 @@
-"""The 16 parameters of the proposed bushing model: names, units, validation, files.
+"""The 16 parameters of the proposed bushing model: names, units, validation.
 
 Units are the paper's N-mm-s units so that its tables can be typed in verbatim:
 stiffnesses k and the Bouc-Wen gains A in N/mm, dampings c in N*s/mm, beta and gamma
@@ -10,12 +10,9 @@ and the identification can raise them.
 """
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Mapping
-from xml.etree import ElementTree as ET
 
 MODEL_NAME = "BoucWenBushing"
 UNIT_SYSTEM = "N-mm-s"
@@ -62,9 +59,10 @@ UNIT_DEFINITIONS: dict[str, dict[str, str] | None] = {
     # that a BaseUnit cannot express. Declared by name only.
     "N^(1-n1)/mm": None,
     "N^(1-n2)/mm": None,
+    # the baseline models (bushing_models)
+    "mm": {"m": "1", "factor": "0.001"},
+    "N^(1-n)/mm": None,
 }
-SSV_NAMESPACES = {"ssv": "http://ssp-standard.org/SSP1/SystemStructureParameterValues",
-                  "ssc": "http://ssp-standard.org/SSP1/SystemStructureCommon"}
 
 
 class ParameterError(ValueError):
@@ -132,99 +130,3 @@ def check_parameters(params: Mapping[str, float]) -> dict[str, float]:
     if unknown:
         raise ParameterError(f"unknown parameter names {unknown}; allowed: {', '.join(PARAMETER_NAMES)}")
     return {name: float(params[name]) for name in PARAMETER_NAMES}
-
-
-def load_parameter_file(path: str | Path) -> dict[str, float]:
-    """Read a parameter set (paper units) from the project's JSON format or an SSP 1.0
-    ParameterValues file (``.ssv``).
-
-    JSON: ``{"model": "BoucWenBushing", "units": "N-mm-s", "parameters": {16 names: values},
-    "fit": {...provenance...}}``. SSV: one ``ssv:Real`` per parameter, whose ``unit``, when
-    given, must be the parameter's unit.
-    """
-    path = Path(path)
-    if not path.exists():
-        raise ParameterError(f"parameter file {path} does not exist")
-    if path.suffix.lower() == ".ssv":
-        return _load_ssv(path)
-    try:
-        document = json.loads(path.read_text(encoding="utf-8"))
-    except json.JSONDecodeError as exc:
-        raise ParameterError(f"parameter file {path} is not valid JSON: {exc}") from None
-    if not isinstance(document, dict) or "parameters" not in document:
-        raise ParameterError(f"parameter file {path} has no 'parameters' object")
-    units = document.get("units", UNIT_SYSTEM)
-    if units != UNIT_SYSTEM:
-        raise ParameterError(f"parameter file {path} declares units {units!r}; only {UNIT_SYSTEM!r} is supported")
-    model = document.get("model", MODEL_NAME)
-    if model != MODEL_NAME:
-        raise ParameterError(f"parameter file {path} is for model {model!r}, not {MODEL_NAME!r}")
-    try:
-        return check_parameters(document["parameters"])
-    except ParameterError as exc:
-        raise ParameterError(f"{path}: {exc}") from None
-
-
-def _load_ssv(path: Path) -> dict[str, float]:
-    try:
-        root = ET.parse(path).getroot()
-    except ET.ParseError as exc:
-        raise ParameterError(f"parameter file {path} is not valid XML: {exc}") from None
-    values = {}
-    for parameter in root.iterfind("ssv:Parameters/ssv:Parameter", SSV_NAMESPACES):
-        name = parameter.get("name")
-        real = parameter.find("ssv:Real", SSV_NAMESPACES)
-        if real is None:
-            raise ParameterError(f"{path}: parameter {name!r} is not an ssv:Real")
-        unit = real.get("unit")
-        if unit is not None and name in PARAMETER_UNITS and unit != PARAMETER_UNITS[name]:
-            raise ParameterError(f"{path}: parameter {name} has unit {unit!r}; "
-                                 f"expected {PARAMETER_UNITS[name]!r} (the paper's N-mm-s units)")
-        try:
-            values[name] = float(real.get("value"))
-        except (TypeError, ValueError):
-            raise ParameterError(f"{path}: parameter {name} = {real.get('value')!r} is not a number") from None
-    try:
-        return check_parameters(values)
-    except ParameterError as exc:
-        raise ParameterError(f"{path}: {exc}") from None
-
-
-def save_ssv(path: str | Path, params: Mapping[str, float], name: str = MODEL_NAME) -> None:
-    """Write an SSP 1.0 ParameterValues file with the 16 parameters and their units (beta and
-    gamma, in N^(1-n)/mm, carry none: SSP units need integer SI exponents)."""
-    values = check_parameters(params)
-    ssv, ssc = SSV_NAMESPACES["ssv"], SSV_NAMESPACES["ssc"]
-    ET.register_namespace("ssv", ssv)
-    ET.register_namespace("ssc", ssc)
-    root = ET.Element(f"{{{ssv}}}ParameterSet", version="1.0", name=name)
-    parameters = ET.SubElement(root, f"{{{ssv}}}Parameters")
-    # SSP requires a BaseUnit for every unit, which N^(1-n)/mm (beta, gamma) cannot have:
-    # those values go without a unit attribute rather than with a false one.
-    expressible = {name: unit for name, unit in PARAMETER_UNITS.items() if UNIT_DEFINITIONS[unit] is not None}
-    for parameter_name in PARAMETER_NAMES:
-        element = ET.SubElement(parameters, f"{{{ssv}}}Parameter", name=parameter_name)
-        real = ET.SubElement(element, f"{{{ssv}}}Real", value=repr(values[parameter_name]))
-        if parameter_name in expressible:
-            real.set("unit", expressible[parameter_name])
-    units = ET.SubElement(root, f"{{{ssv}}}Units")
-    for unit in sorted(set(expressible.values())):
-        element = ET.SubElement(units, f"{{{ssc}}}Unit", name=unit)
-        ET.SubElement(element, f"{{{ssc}}}BaseUnit", UNIT_DEFINITIONS[unit])
-    ET.indent(root)
-    ET.ElementTree(root).write(path, encoding="UTF-8", xml_declaration=True)
-
-
-def parameter_document(params: Mapping[str, float], provenance: Mapping | None = None) -> dict:
-    """The JSON document written by :func:`save_parameter_file`."""
-    return {
-        "model": MODEL_NAME,
-        "units": UNIT_SYSTEM,
-        "parameters": {name: float(params[name]) for name in PARAMETER_NAMES},
-        "fit": dict(provenance or {}),
-    }
-
-
-def save_parameter_file(path: str | Path, params: Mapping[str, float], provenance: Mapping | None = None) -> None:
-    check_parameters(params)
-    Path(path).write_text(json.dumps(parameter_document(params, provenance), indent=2) + "\n", encoding="utf-8")

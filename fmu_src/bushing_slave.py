@@ -1,8 +1,12 @@
-"""pythonfmu adapter: the FMI 2.0 co-simulation face of the bushing model.
+"""pythonfmu adapter: the FMI 2.0 co-simulation face of the bushing models.
 
-A thin layer: it declares the variables, converts SI ports to the paper's N-mm-s units,
-validates every value it is given and calls ``bushing_core``. Nothing here changes the
-equations.
+A thin layer: it declares the variables of one model of ``bushing_models`` (the proposed
+one, or a baseline), converts SI ports to the paper's N-mm-s units, validates every value it
+is given and calls ``bushing_core``. Nothing here changes the equations.
+
+The FMU's class is a subclass of :class:`BushingSlave` named after the model's FMI
+identifier, which build_fmu.py appends to the packed copy of this module (pythonfmu takes
+the class with the longest hierarchy), so every model has its own modelIdentifier.
 
 Error policy. pythonfmu turns a Python exception into fmi2Fatal (the instance is lost), so
 nothing here raises. A setter stores the value and logs a problem at once; a doStep that
@@ -29,12 +33,12 @@ from pythonfmu.enums import Fmi2Status
 # library, imported once and then cached, reads the default parameters.
 if __package__:
     from . import bushing_core as core
-    from . import bushing_params as params
-    DEFAULT_PARAMETERS = None  # only an FMU built by build_fmu.py has defaults
+    MODEL = None  # only an FMU built by build_fmu.py has a model and defaults
+    DEFAULT_PARAMETERS = None
 else:
     _library = importlib.import_module(__name__ + "_lib")
     core = _library.bushing_core
-    params = _library.bushing_params
+    MODEL = _library.MODEL
     DEFAULT_PARAMETERS = _library.DEFAULT_PARAMETERS
 
 MM_PER_M = 1000.0
@@ -44,25 +48,33 @@ entered where metres are expected. It is warned about, not refused."""
 FMU_VERSION = "0.1.0"
 
 
-class BoucWenBushing(Fmi2Slave):
+def _description(model) -> str:
+    if model is None or model.name == "proposed":
+        return ("Nonlinear rubber bushing, one axis: the modified Spencer/Bouc-Wen model of "
+                "'New nonlinear bushing model for general excitations using Bouc-Wen hysteretic "
+                "model' (eqs. 1-5). Ports in SI, parameters in the paper's N-mm-s units.")
+    return (f"Bushing, one axis: the {model.title} baseline model of the Bouc-Wen bushing project. "
+            "Ports in SI, parameters in N-mm-s units.")
+
+
+class BushingSlave(Fmi2Slave):
     author = "Bouc-Wen bushing project"
-    description = ("Nonlinear rubber bushing, one axis: the modified Spencer/Bouc-Wen model of "
-                   "'New nonlinear bushing model for general excitations using Bouc-Wen hysteretic "
-                   "model' (eqs. 1-5). Ports in SI, parameters in the paper's N-mm-s units.")
+    description = _description(MODEL)
     version = FMU_VERSION
     license = "MIT"
     default_experiment = DefaultExperiment(start_time=0.0, stop_time=1.0, step_size=1e-3)
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        if DEFAULT_PARAMETERS is None:
-            raise RuntimeError("BoucWenBushing runs inside an FMU built by build_fmu.py")
-        for name in params.PARAMETER_NAMES:
+        if MODEL is None:
+            raise RuntimeError("the bushing slave runs inside an FMU built by build_fmu.py")
+        for name in MODEL.parameter_names:
             setattr(self, name, DEFAULT_PARAMETERS[name])
         self.x = 0.0  # m
         self.v = 0.0  # m/s
         self._compiled = None          # core.CompiledModel of the parameters in force
-        self._parameters = None        # dict of the parameters in force (paper units)
+        self._parameters = None        # the core's 16 parameters in force (paper units)
+        self._force_offset = 0.0       # N, the model's constant force (preload)
         self._parameters_changed = True
         self._state = core.BushingState(0.0, 0.0, 0.0, 0.0)  # committed state, mm and N
         self._state_x_mm = 0.0         # displacement the committed state belongs to
@@ -72,7 +84,7 @@ class BoucWenBushing(Fmi2Slave):
         self._initial_state_pending = True  # set at exit of initialization, or first valid step
         self._travel_warned = False    # the implausible-travel warning is given once
 
-        for spec in params.PARAMETER_SPECS:
+        for spec in MODEL.specs:
             self.register_variable(Real(
                 spec.name, causality=Fmi2Causality.parameter, variability=Fmi2Variability.tunable,
                 description=f"{spec.description} [{spec.unit}]",
@@ -88,15 +100,12 @@ class BoucWenBushing(Fmi2Slave):
             "F", causality=Fmi2Causality.output, variability=Fmi2Variability.continuous,
             description="bushing force, positive for positive x (force on the base) [N]",
             getter=self._force))
-        for name, scale, unit, meaning in (
-                ("z1", 1.0, "N", "hysteretic force of the left block (eq. 1)"),
-                ("z2", 1.0, "N", "hysteretic force of the right block (eq. 2)"),
-                ("y", 1.0 / MM_PER_M, "m", "displacement of the left plate (eq. 3)"),
-                ("w", 1.0 / MM_PER_M, "m", "displacement of the right plate (eq. 4)")):
+        for state in MODEL.states:
+            scale = 1.0 / MM_PER_M if state.unit == "m" else 1.0
             self.register_variable(Real(
-                name, causality=Fmi2Causality.local, variability=Fmi2Variability.continuous,
-                description=f"internal state: {meaning} [{unit}]",
-                getter=self._state_getter(name, scale)))
+                state.name, causality=Fmi2Causality.local, variability=Fmi2Variability.continuous,
+                description=f"internal state: {state.meaning} [{state.unit}]",
+                getter=self._state_getter(state.core_field, scale)))
 
     # ---------------------------------------------------------------- variable access
     def _parameter_setter(self, name):
@@ -105,7 +114,7 @@ class BoucWenBushing(Fmi2Slave):
             self._parameters_changed = True
             self._force_is_current = False
             if not math.isfinite(value):
-                self._error(f"parameter {name} = {value} [{params.PARAMETER_UNITS[name]}] is not "
+                self._error(f"parameter {name} = {value} [{MODEL.units[name]}] is not "
                             "a finite number; the next doStep will be refused until it is")
         return set_parameter
 
@@ -140,7 +149,7 @@ class BoucWenBushing(Fmi2Slave):
                 state = self._state
                 if self._x_now_mm != self._state_x_mm:
                     state = core.apply_displacement_jump(self._compiled, state, self._x_now_mm - self._state_x_mm)
-                force = core.force(state, self._x_now_mm, self.v * MM_PER_M, self._parameters)
+                force = core.force(state, self._x_now_mm, self.v * MM_PER_M, self._parameters) + self._force_offset
             except (ArithmeticError, ValueError):
                 force = math.nan
             if math.isfinite(force):
@@ -177,7 +186,7 @@ class BoucWenBushing(Fmi2Slave):
         except core.StepError as exc:
             return self._refuse(f"doStep at t = {current_time} s refused: {exc}")
         x_end = x_mm + v_mm * step_size
-        force = core.force(state, x_end, v_mm, self._parameters)
+        force = core.force(state, x_end, v_mm, self._parameters) + self._force_offset
         if not math.isfinite(force):
             return self._refuse(f"doStep at t = {current_time} s refused: the force would be {force} N "
                                 f"(x = {self.x} m, v = {self.v} m/s); check the units of the inputs")
@@ -192,8 +201,8 @@ class BoucWenBushing(Fmi2Slave):
         warnings; True if the parameters in force are usable."""
         if self._parameters_changed:
             self._parameters_changed = False
-            values = {name: getattr(self, name) for name in params.PARAMETER_NAMES}
-            errors, warnings = params.validate_parameters(values)
+            values = {name: getattr(self, name) for name in MODEL.parameter_names}
+            errors, warnings = MODEL.validate(values)
             for message in errors:
                 self._error(message)
             if errors:
@@ -202,8 +211,9 @@ class BoucWenBushing(Fmi2Slave):
             else:
                 for message in warnings:
                     self.log(f"accepted, but {message}", Fmi2Status.warning, "logStatusWarning")
-                self._parameters = values
-                self._compiled = core.compile_model(values)
+                self._parameters = MODEL.core_parameters(values)
+                self._force_offset = MODEL.force_offset(values)
+                self._compiled = core.compile_model(self._parameters)
         return self._compiled is not None
 
     def _error(self, message):
@@ -218,7 +228,7 @@ class BoucWenBushing(Fmi2Slave):
     # state, the reported displacement and the last force must travel with it too.
     def _get_fmu_state(self):
         return {
-            "parameters": {name: getattr(self, name) for name in params.PARAMETER_NAMES},
+            "parameters": {name: getattr(self, name) for name in MODEL.parameter_names},
             "x": self.x, "v": self.v,
             "state": list(self._state),
             "state_x_mm": self._state_x_mm,

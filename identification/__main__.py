@@ -5,7 +5,9 @@ import argparse
 import sys
 from pathlib import Path
 
-from fmu_src.bushing_params import ParameterError, save_parameter_file, save_ssv
+from fmu_src.bushing_models import MODEL_NAMES
+from fmu_src.bushing_params import ParameterError
+from fmu_src.parameter_files import read_parameter_set, save_parameters
 from identification.measurements import MeasurementError, load_measurement
 
 
@@ -13,7 +15,10 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m identification",
                                      description="Identify the bushing model's parameters from measured tests.")
     commands = parser.add_subparsers(dest="command", required=True)
-    fit_parser = commands.add_parser("fit", help="fit the 16 parameters to sine (and step, random) tests")
+    fit_parser = commands.add_parser("fit", help="fit a model's parameters to sine (and step, random) tests")
+    fit_parser.add_argument("--model", default="proposed", choices=MODEL_NAMES,
+                            help="proposed (the paper's 16 parameters, default), spencer, bouc_wen or "
+                                 "kelvin_voigt (linear least squares)")
     fit_parser.add_argument("--sine", action="append", type=Path, required=True, metavar="FILE",
                             help="sine test CSV (time_s,displacement_mm,force_N[,velocity_mm_s]); repeatable")
     fit_parser.add_argument("--step", type=Path, metavar="FILE", help="step test CSV")
@@ -46,12 +51,30 @@ def main(argv: list[str] | None = None) -> int:
                                help="fit F = k*x + c*v on these files and show it beside the model")
     report_parser.add_argument("--plots", type=Path, help="directory for force-time/force-displacement PNGs")
 
+    compare_parser = commands.add_parser(
+        "compare", help="fit several models on training tests and compare them on validation files")
+    compare_parser.add_argument("--sine", action="append", type=Path, required=True, metavar="FILE",
+                                help="training sine test CSV; repeatable")
+    compare_parser.add_argument("--step", type=Path, metavar="FILE", help="training step test CSV")
+    compare_parser.add_argument("--rise-time", type=float, metavar="S", help="rise time of the step test [s]")
+    compare_parser.add_argument("--validate", action="append", type=Path, default=[], metavar="FILE",
+                                help="validation test CSV; repeatable")
+    compare_parser.add_argument("--models", default=",".join(MODEL_NAMES),
+                                help=f"comma-separated models (default: {','.join(MODEL_NAMES)})")
+    compare_parser.add_argument("--preset", default="default", choices=["default", "paper"])
+    compare_parser.add_argument("--seed", type=int, default=0)
+    compare_parser.add_argument("--maxiter", type=int, help="override the preset's number of generations")
+    compare_parser.add_argument("--out", type=Path, required=True,
+                                help="directory for the fitted parameter files, the table (CSV) and the plots")
+
     args = parser.parse_args(argv)
     try:
         if args.command == "sensitivity":
             return _sensitivity(args)
         if args.command == "report":
             return _report(args)
+        if args.command == "compare":
+            return _compare(args)
         return _fit(args)
     except (MeasurementError, ParameterError, ValueError) as exc:
         print(f"error: {exc}", file=sys.stderr)
@@ -69,27 +92,29 @@ def _fit(args) -> int:
     step = StepTest(load_measurement(args.step), args.rise_time) if args.step else None
     randoms = [load_measurement(path) for path in args.random]
     objective = Objective(sines, step, randoms)
-    print(f"fitting to {len(sines)} sine, {int(step is not None)} step and {len(randoms)} random test(s) "
-          f"(numba compiles the model on first use)", file=sys.stderr)
-    result = fit(objective, preset=args.preset, seed=args.seed, popsize=args.popsize, maxiter=args.maxiter)
+    print(f"fitting the {args.model} model to {len(sines)} sine, {int(step is not None)} step and "
+          f"{len(randoms)} random test(s) (numba compiles the model on first use)", file=sys.stderr)
+    result = fit(objective, preset=args.preset, seed=args.seed, popsize=args.popsize, maxiter=args.maxiter,
+                 model=args.model)
 
     provenance = result.provenance()
     provenance["data"] = [str(path) for path in [*args.sine, *([args.step] if args.step else []), *args.random]]
-    save_parameter_file(args.out, result.parameters, provenance)
+    save_parameters(args.out, result.parameters, args.model, provenance)
     if args.ssv:
-        save_ssv(args.ssv, result.parameters)
+        save_parameters(args.ssv, result.parameters, args.model)
 
     print(f"objective E3 = {result.objective:.4e}   ({', '.join(f'{k} {v:.3e}' for k, v in result.terms.items())})")
-    print(format_data_errors(data_errors(result.parameters, [*sines, *randoms, *([step.measurement] if step else [])])))
+    tests = [*sines, *randoms, *([step.measurement] if step else [])]
+    print(format_data_errors(data_errors(result.parameters, tests, model=args.model)))
     print(f"{result.evaluations} evaluations in {result.seconds:.1f} s; wrote {args.out}"
           + (f" and {args.ssv}" if args.ssv else ""))
     return 0
 
 
 def _sensitivity(args) -> int:
-    from fmu_src.bushing_params import load_parameter_file
+    from fmu_src.parameter_files import load_parameters
     from identification.sensitivity import sensitivity
-    table = sensitivity(load_parameter_file(args.params), delta=args.delta)
+    table = sensitivity(load_parameters(args.params, model="proposed"), delta=args.delta)
     print(table.format())
     if args.csv:
         table.write_csv(args.csv)
@@ -98,10 +123,10 @@ def _sensitivity(args) -> int:
 
 
 def _report(args) -> int:
-    from fmu_src.bushing_params import load_parameter_file
     from identification.report import data_errors, format_data_errors, format_errors, grid_errors, plot_measurement
     from identification.search_space import KelvinVoigtFit
-    params = load_parameter_file(args.params)
+    parameter_set = read_parameter_set(args.params)
+    params, model = parameter_set.parameters, parameter_set.model.name
     if not (args.data or args.truth):
         raise ValueError("give --data files and/or --truth to report on")
     kelvin_voigt = None
@@ -110,14 +135,28 @@ def _report(args) -> int:
         print(f"Kelvin-Voigt fit: k = {kelvin_voigt.k:.4g} N/mm, c = {kelvin_voigt.c:.4g} N*s/mm")
     if args.truth:
         print(f"Against the noise-free model of {args.truth} (paper §5 grid):")
-        print(format_errors(grid_errors(params, load_parameter_file(args.truth))))
+        truth = read_parameter_set(args.truth)
+        print(format_errors(grid_errors(params, truth.parameters, model, truth.model.name)))
     if args.data:
         measurements = [load_measurement(path) for path in args.data]
-        print(format_data_errors(data_errors(params, measurements, kelvin_voigt)))
+        print(format_data_errors(data_errors(params, measurements, kelvin_voigt, model)))
         if args.plots:
             for m in measurements:
-                path = plot_measurement(params, m, args.plots / (Path(m.source).stem + ".png"), kelvin_voigt)
+                path = plot_measurement(params, m, args.plots / (Path(m.source).stem + ".png"), kelvin_voigt, model)
                 print(f"wrote {path}")
+    return 0
+
+
+def _compare(args) -> int:
+    from identification.compare import compare_models
+    if (args.step is None) != (args.rise_time is None):
+        raise ValueError("--step and --rise-time go together")
+    models = [name.strip() for name in args.models.split(",") if name.strip()]
+    unknown = [name for name in models if name not in MODEL_NAMES]
+    if unknown:
+        raise ValueError(f"unknown models {unknown}; choose from {', '.join(MODEL_NAMES)}")
+    compare_models(models, args.sine, args.step, args.rise_time, args.validate or [*args.sine], args.out,
+                   preset=args.preset, seed=args.seed, maxiter=args.maxiter)
     return 0
 
 

@@ -11,11 +11,13 @@ Units as in the core: mm, mm/s, N, s; parameters in the paper's N-mm-s units.
 from __future__ import annotations
 
 import inspect
+from typing import Mapping
 
 import numba
 import numpy as np
 
 from fmu_src import bushing_core as _core
+from fmu_src.bushing_models import get_model
 from fmu_src.bushing_params import PARAMETER_NAMES
 
 _KERNELS = ("_decay_factors", "_rk4_in_xi", "_segment", "_block_step", "_gain_variation",
@@ -103,3 +105,14 @@ def parameter_matrix(parameter_sets) -> np.ndarray:
         raise ValueError(f"expected a (P, {len(PARAMETER_NAMES)}) parameter matrix "
                          f"in the order {', '.join(PARAMETER_NAMES)}, got shape {matrix.shape}")
     return np.ascontiguousarray(matrix)
+
+
+def simulate_model(model: str, params: Mapping[str, float], time_s, displacement_mm,
+                   velocity_mm_s) -> np.ndarray:
+    """Force [N] of one parameter set of any model of ``bushing_models`` (by name) on one
+    sampled input: the core's force of the model's 16 core parameters plus its constant
+    force (preload). Raises ParameterError for an invalid set."""
+    bushing = get_model(model)
+    values = bushing.check(params)
+    forces = simulate_population([bushing.core_parameters(values)], time_s, displacement_mm, velocity_mm_s)[0]
+    return forces + bushing.force_offset(values)

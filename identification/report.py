@@ -14,7 +14,7 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
-from identification.compiled_core import simulate_population
+from identification.compiled_core import simulate_model
 from identification.measurements import Measurement
 from identification.objectives import nrmse, rms_error
 from identification.protocols import Random, Sine, Step, sample_times
@@ -44,29 +44,35 @@ def grid_protocols():
     yield "random 2 mm", Random(2.0, 5.0, seed=7)
 
 
-def grid_errors(params: Mapping[str, float], truth: Mapping[str, float]) -> list[CaseError]:
-    """Errors of ``params`` against the forces of ``truth`` (noise-free) over the §5 grid."""
+def grid_errors(params: Mapping[str, float], truth: Mapping[str, float], model: str = "proposed",
+                truth_model: str = "proposed") -> list[CaseError]:
+    """Errors of ``params`` (of ``model``) against the forces of ``truth`` (of
+    ``truth_model``, noise-free) over the §5 grid."""
     errors = []
     for name, protocol in grid_protocols():
         t = sample_times(protocol.duration_s, RATE_HZ)
-        predicted, expected = simulate_population([params, truth], t, *protocol.signals(t))
+        signals = protocol.signals(t)
+        predicted = simulate_model(model, params, t, *signals)
+        expected = simulate_model(truth_model, truth, t, *signals)
         errors.append(CaseError(name, nrmse(predicted, expected), rms_error(predicted, expected)))
     return errors
 
 
 def data_errors(params: Mapping[str, float], measurements: Sequence[Measurement],
-                kelvin_voigt: KelvinVoigtFit | None = None) -> list[tuple[CaseError, CaseError | None]]:
-    """Errors on measured files, each beside the Kelvin-Voigt fit's if one is given."""
+                kelvin_voigt: KelvinVoigtFit | None = None,
+                model: str = "proposed") -> list[tuple[CaseError, CaseError | None]]:
+    """Errors of ``params`` (of ``model``) on measured files, each beside the Kelvin-Voigt
+    fit's if one is given."""
     rows = []
     for m in measurements:
-        predicted = simulate_population([params], m.time_s, m.displacement_mm, m.velocity_mm_s)[0]
+        predicted = simulate_model(model, params, m.time_s, m.displacement_mm, m.velocity_mm_s)
         name = Path(m.source).name
-        model = CaseError(name, nrmse(predicted, m.force_N), rms_error(predicted, m.force_N))
+        fitted = CaseError(name, nrmse(predicted, m.force_N), rms_error(predicted, m.force_N))
         baseline = None
         if kelvin_voigt is not None:
             linear = kelvin_voigt.force(m.displacement_mm, m.velocity_mm_s)
             baseline = CaseError(name, nrmse(linear, m.force_N), rms_error(linear, m.force_N))
-        rows.append((model, baseline))
+        rows.append((fitted, baseline))
     return rows
 
 
@@ -89,13 +95,13 @@ def format_data_errors(rows) -> str:
 
 
 def plot_measurement(params: Mapping[str, float], measurement: Measurement, path: Path,
-                     kelvin_voigt: KelvinVoigtFit | None = None) -> Path:
+                     kelvin_voigt: KelvinVoigtFit | None = None, model: str = "proposed") -> Path:
     """Force-time and force-displacement of measurement and model, like the paper's Figs. 9-19."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     m = measurement
-    predicted = simulate_population([params], m.time_s, m.displacement_mm, m.velocity_mm_s)[0]
+    predicted = simulate_model(model, params, m.time_s, m.displacement_mm, m.velocity_mm_s)
     figure, (in_time, loop) = plt.subplots(1, 2, figsize=(11, 4.2))
     in_time.plot(m.time_s, m.force_N / 1e3, color="0.5", lw=1, label="measured")
     in_time.plot(m.time_s, predicted / 1e3, color="C0", lw=1.2, label=f"model (NRMSE {nrmse(predicted, m.force_N):.1%})")

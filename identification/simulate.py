@@ -10,12 +10,12 @@ from typing import Mapping
 import numpy as np
 
 from fmu_src import bushing_core as core
-from fmu_src.bushing_params import check_parameters
+from fmu_src.bushing_models import get_model
 
 
 def simulate(params: Mapping[str, float], time_s, displacement_mm, velocity_mm_s,
-             substeps_per_sample: int = 1) -> np.ndarray:
-    """Force [N] at every sample time.
+             substeps_per_sample: int = 1, model: str = "proposed") -> np.ndarray:
+    """Force [N] at every sample time of the bushing ``model`` (``bushing_models``) with ``params``.
 
     Between samples k and k+1 the displacement is x_k + v_k*(t - t_k) and the velocity v_k,
     exactly as in the FMU with communication points at the sample times (where x_{k+1}
@@ -23,8 +23,10 @@ def simulate(params: Mapping[str, float], time_s, displacement_mm, velocity_mm_s
     the relaxed equilibrium at x_0 (``bushing_core.initial_state``). ``substeps_per_sample``
     > 1 splits each interval into equal communication steps (for fine reference runs).
     """
-    p = check_parameters(params)
-    model = core.compile_model(p)
+    bushing = get_model(model)
+    values = bushing.check(params)
+    p = bushing.core_parameters(values)
+    compiled = core.compile_model(p)
     t = np.asarray(time_s, dtype=float)
     x = np.asarray(displacement_mm, dtype=float)
     v = np.asarray(velocity_mm_s, dtype=float)
@@ -39,7 +41,7 @@ def simulate(params: Mapping[str, float], time_s, displacement_mm, velocity_mm_s
         x_k, v_k = float(x[k]), float(v[k])
         h = (float(t[k + 1]) - float(t[k])) / substeps_per_sample
         for i in range(substeps_per_sample):
-            state, _ = core.advance(model, state, state_x, x_k + v_k * h * i, v_k, h)
+            state, _ = core.advance(compiled, state, state_x, x_k + v_k * h * i, v_k, h)
             state_x = x_k + v_k * h * (i + 1)
         forces[k + 1] = core.force(state, state_x, v_k, p)
-    return forces
+    return forces + bushing.force_offset(values)

@@ -6,7 +6,7 @@ from scipy.integrate import solve_ivp
 
 import build_fmu
 from fmu_src import bushing_core as core
-from fmu_src.bushing_params import load_parameter_file
+from fmu_src.parameter_files import load_parameters
 
 REPO = Path(__file__).resolve().parents[1]
 DATA = REPO / "data"
@@ -16,7 +16,7 @@ def paper_parameters(table: str) -> dict[str, float]:
     """The paper's parameter sets as shipped in data/: 'table2', 'table4' or 'table5'."""
     files = {"table2": "params_table2_sine.json", "table4": "params_table4_step.json",
              "table5": "params_table5_combined.json"}
-    return load_parameter_file(DATA / files[table])
+    return load_parameters(DATA / files[table])
 
 
 def reference_jump(params, state, jump_mm):

@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 from conftest import DATA, paper_parameters
-from fmu_src.bushing_params import PARAMETER_NAMES, ParameterError, load_parameter_file, save_ssv
+from fmu_src.bushing_params import PARAMETER_NAMES, ParameterError
+from fmu_src.parameter_files import load_parameters, save_parameters
 from identification.compiled_core import simulate_population
 from identification.measurements import Measurement, MeasurementError, load_measurement
 from identification.objectives import Objective, StepTest, nrmse, rms_error
@@ -148,17 +149,17 @@ def test_ssv_round_trip_is_exact_and_fmpy_reads_it(tmp_path):
     from fmpy.ssp.ssd import read_ssv
     params = paper_parameters("table2")
     path = tmp_path / "table2.ssv"
-    save_ssv(path, params)
-    assert load_parameter_file(path) == params
+    save_parameters(path, params)
+    assert load_parameters(path) == params
     assert {p.name: float(p.value) for p in read_ssv(str(path)).parameters} == params
 
 
 def test_ssv_with_a_wrong_unit_is_refused(tmp_path):
     path = tmp_path / "bad.ssv"
-    save_ssv(path, paper_parameters("table5"))
+    save_parameters(path, paper_parameters("table5"))
     path.write_text(path.read_text().replace('unit="N/mm"', 'unit="N/m"', 1))
     with pytest.raises(ParameterError, match="unit 'N/m'"):
-        load_parameter_file(path)
+        load_parameters(path)
 
 
 # -------------------------------------------------------------------- round trip
@@ -181,7 +182,7 @@ def test_fit_round_trip_through_the_cli_and_a_built_fmu(tmp_path):
     document = json.loads(out.read_text())
     assert document["model"] == "BoucWenBushing" and document["units"] == "N-mm-s"
     assert document["fit"]["objective_E3"] < 2e-5  # the noise alone gives 1.3e-5
-    assert load_parameter_file(ssv) == load_parameter_file(out)
+    assert load_parameters(ssv) == load_parameters(out)
 
     fmu = build_fmu.build_fmu(ssv, tmp_path / "fmu")
     truth = paper_parameters("table5")

@@ -1,0 +1,153 @@
+"""Parameter sets on disk: the project's JSON and SSP 1.0 ParameterValues (``.ssv``), both ways.
+
+JSON: ``{"model": "<FMI identifier>", "units": "N-mm-s", "parameters": {name: value},
+"fit": {...provenance...}}``. SSV: an ``ssv:ParameterSet`` named after the model's FMI
+identifier, one ``ssv:Real`` per parameter with its unit where SSP can express it (beta and
+gamma, in N^(1-n)/mm, carry none: SSP units need integer SI exponents). Values are written
+with ``repr`` and read back bit for bit.
+
+Every read is validated against the model: missing or unknown names, non-numbers, NaN and a
+unit other than the parameter's raise ``ParameterError`` naming the file, the parameter and
+what is allowed.
+
+For fmpy users: ``simulate_fmu(fmu, start_values=load_parameters("bushing.ssv"), ...)``.
+"""
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Mapping
+from xml.etree import ElementTree as ET
+
+from .bushing_models import BushingModel, MODELS, get_model
+from .bushing_params import UNIT_DEFINITIONS, UNIT_SYSTEM, ParameterError
+
+SSV_NAMESPACES = {"ssv": "http://ssp-standard.org/SSP1/SystemStructureParameterValues",
+                  "ssc": "http://ssp-standard.org/SSP1/SystemStructureCommon"}
+
+
+@dataclass
+class ParameterSet:
+    model: BushingModel
+    parameters: dict[str, float]     # the model's units (paper N-mm-s)
+    provenance: dict = field(default_factory=dict)
+
+
+def load_parameters(path: str | Path, model: str | None = None) -> dict[str, float]:
+    """The parameters in ``path`` (JSON or .ssv), checked against ``model`` if given (a
+    command-line name such as ``"spencer"`` or an FMI identifier); without it, the model the
+    file names (default: the proposed one)."""
+    return read_parameter_set(path, model).parameters
+
+
+def read_parameter_set(path: str | Path, model: str | None = None) -> ParameterSet:
+    path = Path(path)
+    if not path.exists():
+        raise ParameterError(f"parameter file {path} does not exist")
+    expected = get_model(model) if model is not None else None
+    if path.suffix.lower() == ".ssv":
+        found, values, provenance = _read_ssv(path, expected)
+    else:
+        found, values, provenance = _read_json(path)
+    if expected is not None and found is not expected:
+        raise ParameterError(f"parameter file {path} is for the {found.name} model ({found.identifier}), "
+                             f"not {expected.name} ({expected.identifier})")
+    try:
+        return ParameterSet(found, found.check(values), provenance)
+    except ParameterError as exc:
+        raise ParameterError(f"{path}: {exc}") from None
+
+
+def _read_json(path: Path):
+    try:
+        document = json.loads(path.read_text(encoding="utf-8"))
+    except json.JSONDecodeError as exc:
+        raise ParameterError(f"parameter file {path} is not valid JSON: {exc}") from None
+    if not isinstance(document, dict) or not isinstance(document.get("parameters"), dict):
+        raise ParameterError(f"parameter file {path} has no 'parameters' object")
+    units = document.get("units", UNIT_SYSTEM)
+    if units != UNIT_SYSTEM:
+        raise ParameterError(f"parameter file {path} declares units {units!r}; only {UNIT_SYSTEM!r} is supported")
+    model = get_model(document.get("model", MODELS["proposed"].identifier))
+    return model, document["parameters"], dict(document.get("fit", {}))
+
+
+def _read_ssv(path: Path, expected: BushingModel | None):
+    try:
+        root = ET.parse(path).getroot()
+    except ET.ParseError as exc:
+        raise ParameterError(f"parameter file {path} is not valid XML: {exc}") from None
+    raw: dict[str, tuple[str | None, str | None]] = {}
+    for parameter in root.iterfind("ssv:Parameters/ssv:Parameter", SSV_NAMESPACES):
+        name = parameter.get("name")
+        real = parameter.find("ssv:Real", SSV_NAMESPACES)
+        if real is None:
+            raise ParameterError(f"{path}: parameter {name!r} is not an ssv:Real")
+        raw[name] = (real.get("value"), real.get("unit"))
+    model = _model_of_ssv(root.get("name"), set(raw)) or expected or MODELS["proposed"]
+    values = {}
+    for name, (text, unit) in raw.items():
+        if unit is not None and name in model.units and unit != model.units[name]:
+            raise ParameterError(f"{path}: parameter {name} has unit {unit!r}; expected "
+                                 f"{model.units[name]!r} (the paper's N-mm-s units)")
+        try:
+            values[name] = float(text)
+        except (TypeError, ValueError):
+            raise ParameterError(f"{path}: parameter {name} = {text!r} is not a number") from None
+    return model, values, {}
+
+
+def _model_of_ssv(set_name: str | None, names: set[str]) -> BushingModel | None:
+    """The model a ParameterSet is for: by its name (our files use the FMI identifier), else
+    the model whose parameter names it holds exactly; None if neither tells."""
+    for model in MODELS.values():
+        if set_name == model.identifier:
+            return model
+    for model in MODELS.values():
+        if names == set(model.parameter_names):
+            return model
+    return None
+
+
+def parameter_document(params: Mapping[str, float], model: str = "proposed",
+                       provenance: Mapping | None = None) -> dict:
+    """The JSON document :func:`save_parameters` writes (validated)."""
+    bushing = get_model(model)
+    return {"model": bushing.identifier, "units": UNIT_SYSTEM, "parameters": bushing.check(params),
+            "fit": dict(provenance or {})}
+
+
+def save_parameters(path: str | Path, params: Mapping[str, float], model: str = "proposed",
+                    provenance: Mapping | None = None) -> Path:
+    """Write a validated parameter set: ``.ssv`` as SSP 1.0 ParameterValues, else JSON."""
+    path = Path(path)
+    if path.suffix.lower() == ".ssv":
+        _write_ssv(path, params, get_model(model))
+    else:
+        text = json.dumps(parameter_document(params, model, provenance), indent=2) + "\n"
+        path.write_text(text, encoding="utf-8")
+    return path
+
+
+def _write_ssv(path: Path, params: Mapping[str, float], model: BushingModel) -> None:
+    values = model.check(params)
+    ssv, ssc = SSV_NAMESPACES["ssv"], SSV_NAMESPACES["ssc"]
+    ET.register_namespace("ssv", ssv)
+    ET.register_namespace("ssc", ssc)
+    root = ET.Element(f"{{{ssv}}}ParameterSet", version="1.0", name=model.identifier)
+    parameters = ET.SubElement(root, f"{{{ssv}}}Parameters")
+    # SSP requires a BaseUnit for every unit, which N^(1-n)/mm (beta, gamma) cannot have:
+    # those values go without a unit attribute rather than with a false one.
+    expressible = {name: unit for name, unit in model.units.items() if UNIT_DEFINITIONS[unit] is not None}
+    for name in model.parameter_names:
+        element = ET.SubElement(parameters, f"{{{ssv}}}Parameter", name=name)
+        real = ET.SubElement(element, f"{{{ssv}}}Real", value=repr(values[name]))
+        if name in expressible:
+            real.set("unit", expressible[name])
+    units = ET.SubElement(root, f"{{{ssv}}}Units")
+    for unit in sorted(set(expressible.values())):
+        element = ET.SubElement(units, f"{{{ssc}}}Unit", name=unit)
+        ET.SubElement(element, f"{{{ssc}}}BaseUnit", UNIT_DEFINITIONS[unit])
+    ET.indent(root)
+    ET.ElementTree(root).write(path, encoding="UTF-8", xml_declaration=True)

@@ -1,0 +1,107 @@
+"""The comparison study (paper §3.1, §4.3, Figs. 15-17): fit several models on the same
+training tests, compare them on validation files.
+
+Writes into the output directory: ``params_<model>.json`` per model (with provenance),
+``comparison.csv`` (NRMSE and the paper's eq. 10 error per validation file and model) and
+one PNG per validation file overlaying the measured and predicted force over time and the
+force-displacement loops. Prints the table.
+"""
+from __future__ import annotations
+
+import csv
+import sys
+import time
+from pathlib import Path
+from typing import Sequence
+
+from fmu_src.bushing_models import get_model
+from fmu_src.parameter_files import save_parameters
+from identification.compiled_core import simulate_model
+from identification.measurements import Measurement, load_measurement
+from identification.objectives import Objective, StepTest, nrmse, rms_error
+
+MODEL_STYLES = {"proposed": ("C0", "-"), "spencer": ("C2", "-."), "bouc_wen": ("C1", ":"),
+                "kelvin_voigt": ("C3", "--")}
+
+
+def compare_models(models: Sequence[str], sine_files: Sequence[Path], step_file: Path | None,
+                   rise_time_s: float | None, validation_files: Sequence[Path], out_dir: Path,
+                   preset: str = "default", seed: int = 0, maxiter: int | None = None) -> dict:
+    """Fit every model, evaluate it on every validation file; returns
+    ``{"parameters": {model: params}, "errors": {(file, model): (nrmse, eq10)}}``."""
+    from identification.fit import fit
+
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    sines = [load_measurement(path) for path in sine_files]
+    step = StepTest(load_measurement(step_file), rise_time_s) if step_file else None
+    validation = [load_measurement(path) for path in validation_files]
+    objective = Objective(sines, step)
+
+    parameters = {}
+    for model in models:
+        print(f"fitting {get_model(model).title} ...", file=sys.stderr)
+        started = time.perf_counter()
+        result = fit(objective, preset=preset, seed=seed, maxiter=maxiter, model=model)
+        provenance = result.provenance()
+        provenance["data"] = [str(p) for p in [*sine_files, *([step_file] if step_file else [])]]
+        save_parameters(out_dir / f"params_{model}.json", result.parameters, model, provenance)
+        parameters[model] = result.parameters
+        print(f"  E3 = {result.objective:.4e} in {time.perf_counter() - started:.0f} s", file=sys.stderr)
+
+    errors = {}
+    predictions = {}
+    for m in validation:
+        name = Path(m.source).name
+        for model in models:
+            predicted = simulate_model(model, parameters[model], m.time_s, m.displacement_mm, m.velocity_mm_s)
+            predictions[name, model] = predicted
+            errors[name, model] = (nrmse(predicted, m.force_N), rms_error(predicted, m.force_N))
+        plot_comparison(m, {model: predictions[name, model] for model in models},
+                        out_dir / f"compare_{Path(m.source).stem}.png")
+
+    print(format_comparison(errors, models, [Path(m.source).name for m in validation]))
+    with open(out_dir / "comparison.csv", "w", newline="") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(["file", "model", "nrmse", "eq10_rms_error"])
+        for (name, model), (error, eq10) in errors.items():
+            writer.writerow([name, model, f"{error:.6g}", f"{eq10:.6g}"])
+    print(f"wrote {out_dir}/comparison.csv, params_<model>.json and compare_*.png", file=sys.stderr)
+    return {"parameters": parameters, "errors": errors}
+
+
+def format_comparison(errors: dict, models: Sequence[str], files: Sequence[str]) -> str:
+    """NRMSE per file (rows) and model (columns), the eq. 10 error in brackets."""
+    width = max(len(name) for name in files) + 2
+    lines = [f"{'file':{width}s}" + "".join(f"{model:>22s}" for model in models)]
+    for name in files:
+        cells = "".join(f"{errors[name, model][0]:>12.2%} ({errors[name, model][1]:+6.1%})" for model in models)
+        lines.append(f"{name:{width}s}{cells}")
+    lines.append("NRMSE = rms(F_pre - F_exp)/rms(F_exp); (eq. 10) = (rms F_exp - rms F_pre)/rms F_exp")
+    return "\n".join(lines)
+
+
+def plot_comparison(measurement: Measurement, predictions: dict, path: Path) -> Path:
+    """Measured and predicted force over time and against displacement (paper Figs. 15-17)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    m = measurement
+    figure, (in_time, loop) = plt.subplots(1, 2, figsize=(12, 4.4))
+    in_time.plot(m.time_s, m.force_N / 1e3, color="0.55", lw=1.4, label="measured")
+    loop.plot(m.displacement_mm, m.force_N / 1e3, color="0.55", lw=1.2)
+    for model, predicted in predictions.items():
+        color, style = MODEL_STYLES.get(model, ("k", "-"))
+        label = f"{get_model(model).title} (NRMSE {nrmse(predicted, m.force_N):.1%})"
+        in_time.plot(m.time_s, predicted / 1e3, color=color, ls=style, lw=1.1, label=label)
+        loop.plot(m.displacement_mm, predicted / 1e3, color=color, ls=style, lw=1.0)
+    in_time.set(xlabel="time [s]", ylabel="force [kN]", title=Path(m.source).name)
+    loop.set(xlabel="displacement [mm]", ylabel="force [kN]", title="force-displacement")
+    in_time.legend(loc="best", fontsize=7)
+    for axes in (in_time, loop):
+        axes.grid(alpha=0.3)
+    figure.tight_layout()
+    path = Path(path)
+    figure.savefig(path, dpi=90)
+    plt.close(figure)
+    return path

@@ -1,0 +1,104 @@
+"""The baseline models as FMUs: the FMU issue's checks (validation, units, equal to the
+model, bad values, state) for each, and all four models side by side in one process."""
+import numpy as np
+import pytest
+from fmpy import read_model_description
+from fmpy.validation import validate_fmu
+
+import build_fmu
+from fmu_harness import BushingFmu
+from fmu_src.bushing_models import MODELS
+from fmu_src.parameter_files import load_parameters
+from identification.compiled_core import simulate_model
+from identification.protocols import Sine, sample_times
+from test_fmu_numerics import simulate_with_fmpy
+
+BASELINES = ("spencer", "bouc_wen", "kelvin_voigt")
+MM = 1e-3
+BAD_VALUES = {"spencer": ("c1", 0.0, "c1 = 0.0 N.s/mm must be > 0"),
+              "bouc_wen": ("n", -1.0, "n = -1.0 must be > 0"),
+              "kelvin_voigt": ("k", float("nan"), "k = nan [N/mm] is not a finite number")}
+
+
+@pytest.fixture(scope="session")
+def baseline_fmus(tmp_path_factory):
+    """One FMU per baseline, built with its default parameter set from data/."""
+    return {model: build_fmu.build_fmu(out_dir=tmp_path_factory.mktemp(model), model=model) for model in BASELINES}
+
+
+@pytest.mark.parametrize("model", BASELINES)
+def test_baseline_fmu_validates_and_declares_its_own_identifier_and_units(baseline_fmus, model):
+    path = baseline_fmus[model]
+    assert validate_fmu(str(path)) == []
+    description = read_model_description(str(path))
+    assert description.coSimulation.modelIdentifier == MODELS[model].identifier
+    variables = {v.name: v for v in description.modelVariables}
+    assert {"x", "v", "F"} <= set(variables)
+    assert (variables["x"].unit, variables["v"].unit, variables["F"].unit) == ("m", "m/s", "N")
+    defaults = load_parameters(build_fmu.default_parameter_file(model), model)
+    for name, unit in MODELS[model].units.items():
+        assert variables[name].unit == unit and float(variables[name].start) == defaults[name]
+
+
+@pytest.mark.parametrize("model", BASELINES)
+def test_baseline_fmu_equals_the_model_through_fmpy(baseline_fmus, model):
+    t = sample_times(0.3, 1000.0)
+    x, v = Sine(2.0, 10.0).signals(t)
+    params = load_parameters(build_fmu.default_parameter_file(model), model)
+    np.testing.assert_allclose(simulate_with_fmpy(baseline_fmus[model], t, x, v),
+                               simulate_model(model, params, t, x, v), rtol=1e-9, atol=1e-9)
+
+
+@pytest.mark.parametrize("model", BASELINES)
+def test_baseline_fmu_refuses_a_bad_parameter_and_recovers(baseline_fmus, model):
+    name, value, fragment = BAD_VALUES[model]
+    fmu = BushingFmu(baseline_fmus[model])
+    assert fmu.step(0.0, 0.01, 1e-3) == "ok"
+    good = fmu.get(name)
+    force = fmu.get("F")
+    fmu.set(name, value)
+    assert fmu.step(1e-5, 0.01, 1e-3) == "discard"
+    assert any(fragment in message for message in fmu.messages_with("error")), fmu.messages
+    assert np.isfinite(fmu.get("F")) and fmu.get("F") == force
+    fmu.set(name, good)
+    assert fmu.step(1e-5, 0.01, 1e-3) == "ok"
+    fmu.free()
+
+
+@pytest.mark.parametrize("model", BASELINES)
+def test_baseline_fmu_state_restores_bit_for_bit(baseline_fmus, model):
+    fmu = BushingFmu(baseline_fmus[model])
+    sine = Sine(2.0, 10.0)
+
+    def drive(first, count):
+        out = []
+        for k in range(first, first + count):
+            x, v = sine.signals(np.array([k * 1e-3]))
+            assert fmu.step(x[0] * MM, v[0] * MM, 1e-3) == "ok"
+            out.append(fmu.get("F"))
+        return out
+
+    drive(0, 30)
+    saved = fmu.fmu.getFMUstate()
+    first = drive(30, 25)
+    fmu.fmu.setFMUstate(saved)
+    assert drive(30, 25) == first
+    fmu.free()
+
+
+def test_all_four_models_run_side_by_side_in_one_process(fmu_path, baseline_fmus):
+    # pythonfmu shares sys.modules between FMUs: each must still run its own model.
+    paths = {"proposed": fmu_path, **baseline_fmus}
+    instances = {model: BushingFmu(path, instance_name=model) for model, path in paths.items()}
+    t = sample_times(0.05, 1000.0)
+    x, v = Sine(2.0, 10.0).signals(t)
+    forces = {model: [] for model in paths}
+    for k in range(t.size - 1):
+        for model, fmu in instances.items():
+            assert fmu.step(x[k] * MM, v[k] * MM, 1e-3) == "ok"
+            forces[model].append(fmu.get("F"))
+    for model in paths:
+        params = load_parameters(build_fmu.default_parameter_file(model), model)
+        np.testing.assert_allclose(forces[model], simulate_model(model, params, t, x, v)[1:], rtol=1e-9, atol=1e-9)
+        instances[model].free()
+    assert len({round(f[-1], 3) for f in forces.values()}) == 4
