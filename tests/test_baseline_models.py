@@ -145,6 +145,9 @@ def test_baseline_parameter_files_round_trip_and_name_their_model(tmp_path, mode
     path = save_parameters(tmp_path / f"p{suffix}", params, model)
     parameter_set = read_parameter_set(path)
     assert parameter_set.model is MODELS[model] and parameter_set.parameters == params
+    if suffix == ".ssv":
+        from fmpy.ssp.ssd import read_ssv
+        assert {p.name: float(p.value) for p in read_ssv(str(path)).parameters} == params
     with pytest.raises(ParameterError, match="not proposed"):
         load_parameters(path, model="proposed")
 

@@ -154,6 +154,11 @@ def test_ssv_round_trip_is_exact_and_fmpy_reads_it(tmp_path):
     assert {p.name: float(p.value) for p in read_ssv(str(path)).parameters} == params
 
 
+@pytest.mark.parametrize("name", ["params_table2_sine", "params_table4_step", "params_table5_combined"])
+def test_shipped_ssv_files_hold_the_papers_tables(name):
+    assert load_parameters(DATA / f"{name}.ssv") == load_parameters(DATA / f"{name}.json")
+
+
 def test_ssv_with_a_wrong_unit_is_refused(tmp_path):
     path = tmp_path / "bad.ssv"
     save_parameters(path, paper_parameters("table5"))
