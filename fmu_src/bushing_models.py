@@ -141,21 +141,26 @@ def _spencer_to_core(p):
     return core
 
 
-def _spencer_check(p):
+def _single_block_checks(p, springs):
+    """Checks shared by Spencer and the single Bouc-Wen (both name their element c0, n, beta, gamma)."""
     errors, warnings = [], []
+    if not p["n"] > 0:
+        errors.append(f"n = {p['n']} must be > 0 (exponent of |z|)")
+    errors += [f"{name} = {p[name]} N/mm must be >= 0 (a negative spring is unstable)"
+               for name in springs if p[name] < 0]
+    if p["c0"] < 0:
+        warnings.append(f"c0 = {p['c0']} N.s/mm is a negative damping (unphysical)")
+    if not p["beta"] + p["gamma"] > 0:
+        warnings.append(f"beta + gamma = {p['beta'] + p['gamma']} should be > 0 (bounded hysteresis)")
+    return errors, warnings
+
+
+def _spencer_check(p):
+    errors, warnings = _single_block_checks(p, ("k0", "k1"))
     if not p["c0"] + p["c1"] > 0:
         errors.append(f"c0 + c1 = {p['c0'] + p['c1']} N.s/mm must be > 0 (it divides dy/dt)")
     if not p["c1"] > 0:
         errors.append(f"c1 = {p['c1']} N.s/mm must be > 0 (the dashpot to ground)")
-    if not p["n"] > 0:
-        errors.append(f"n = {p['n']} must be > 0 (exponent of |z|)")
-    for name in ("k0", "k1"):
-        if p[name] < 0:
-            errors.append(f"{name} = {p[name]} N/mm must be >= 0 (a negative spring is unstable)")
-    if p["c0"] < 0:
-        warnings.append(f"c0 = {p['c0']} N.s/mm is a negative damping (unphysical)")
-    if not p["gamma"] + p["beta"] > 0:
-        warnings.append(f"gamma + beta = {p['gamma'] + p['beta']} should be > 0 (bounded hysteresis)")
     return errors, warnings
 
 
@@ -179,16 +184,7 @@ def _bouc_wen_to_core(p):
 
 
 def _bouc_wen_check(p):
-    errors, warnings = [], []
-    if not p["n"] > 0:
-        errors.append(f"n = {p['n']} must be > 0 (exponent of |z|)")
-    if p["k0"] < 0:
-        errors.append(f"k0 = {p['k0']} N/mm must be >= 0 (a negative spring is unstable)")
-    if p["c0"] < 0:
-        warnings.append(f"c0 = {p['c0']} N.s/mm is a negative damping (unphysical)")
-    if not p["beta"] + p["gamma"] > 0:
-        warnings.append(f"beta + gamma = {p['beta'] + p['gamma']} should be > 0 (bounded hysteresis)")
-    return errors, warnings
+    return _single_block_checks(p, ("k0",))
 
 
 # ---------------------------------------------------------------- Kelvin-Voigt

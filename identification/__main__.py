@@ -19,10 +19,7 @@ def main(argv: list[str] | None = None) -> int:
     fit_parser.add_argument("--model", default="proposed", choices=MODEL_NAMES,
                             help="proposed (the paper's 16 parameters, default), spencer, bouc_wen or "
                                  "kelvin_voigt (linear least squares)")
-    fit_parser.add_argument("--sine", action="append", type=Path, required=True, metavar="FILE",
-                            help="sine test CSV (time_s,displacement_mm,force_N[,velocity_mm_s]); repeatable")
-    fit_parser.add_argument("--step", type=Path, metavar="FILE", help="step test CSV")
-    fit_parser.add_argument("--rise-time", type=float, metavar="S", help="rise time of the step test [s]")
+    _add_training_arguments(fit_parser)
     fit_parser.add_argument("--random", action="append", type=Path, default=[], metavar="FILE",
                             help="random-input test CSV; repeatable")
     fit_parser.add_argument("--preset", default="default", choices=["default", "paper"],
@@ -53,10 +50,7 @@ def main(argv: list[str] | None = None) -> int:
 
     compare_parser = commands.add_parser(
         "compare", help="fit several models on training tests and compare them on validation files")
-    compare_parser.add_argument("--sine", action="append", type=Path, required=True, metavar="FILE",
-                                help="training sine test CSV; repeatable")
-    compare_parser.add_argument("--step", type=Path, metavar="FILE", help="training step test CSV")
-    compare_parser.add_argument("--rise-time", type=float, metavar="S", help="rise time of the step test [s]")
+    _add_training_arguments(compare_parser)
     compare_parser.add_argument("--validate", action="append", type=Path, default=[], metavar="FILE",
                                 help="validation test CSV; repeatable")
     compare_parser.add_argument("--models", default=",".join(MODEL_NAMES),
@@ -79,6 +73,13 @@ def main(argv: list[str] | None = None) -> int:
     except (MeasurementError, ParameterError, ValueError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
+
+
+def _add_training_arguments(parser) -> None:
+    parser.add_argument("--sine", action="append", type=Path, required=True, metavar="FILE",
+                        help="training sine test CSV (time_s,displacement_mm,force_N[,velocity_mm_s]); repeatable")
+    parser.add_argument("--step", type=Path, metavar="FILE", help="training step test CSV")
+    parser.add_argument("--rise-time", type=float, metavar="S", help="rise time of the step test [s]")
 
 
 def _fit(args) -> int:

@@ -17,12 +17,9 @@ from typing import Sequence
 from fmu_src.bushing_models import get_model
 from fmu_src.parameter_files import save_parameters
 from identification.compiled_core import simulate_model
-from identification.measurements import Measurement, load_measurement
+from identification.measurements import load_measurement
 from identification.objectives import Objective, StepTest, nrmse, rms_error
-
-MODEL_STYLES = {"proposed": ("C0", "-"), "spencer": ("C2", "-."), "bouc_wen": ("C1", ":"),
-                "kelvin_voigt": ("C3", "--")}
-
+from identification.report import plot_comparison
 
 def compare_models(models: Sequence[str], sine_files: Sequence[Path], step_file: Path | None,
                    rise_time_s: float | None, validation_files: Sequence[Path], out_dir: Path,
@@ -79,29 +76,3 @@ def format_comparison(errors: dict, models: Sequence[str], files: Sequence[str])
         lines.append(f"{name:{width}s}{cells}")
     lines.append("NRMSE = rms(F_pre - F_exp)/rms(F_exp); (eq. 10) = (rms F_exp - rms F_pre)/rms F_exp")
     return "\n".join(lines)
-
-
-def plot_comparison(measurement: Measurement, predictions: dict, path: Path) -> Path:
-    """Measured and predicted force over time and against displacement (paper Figs. 15-17)."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    m = measurement
-    figure, (in_time, loop) = plt.subplots(1, 2, figsize=(12, 4.4))
-    in_time.plot(m.time_s, m.force_N / 1e3, color="0.55", lw=1.4, label="measured")
-    loop.plot(m.displacement_mm, m.force_N / 1e3, color="0.55", lw=1.2)
-    for model, predicted in predictions.items():
-        color, style = MODEL_STYLES.get(model, ("k", "-"))
-        label = f"{get_model(model).title} (NRMSE {nrmse(predicted, m.force_N):.1%})"
-        in_time.plot(m.time_s, predicted / 1e3, color=color, ls=style, lw=1.1, label=label)
-        loop.plot(m.displacement_mm, predicted / 1e3, color=color, ls=style, lw=1.0)
-    in_time.set(xlabel="time [s]", ylabel="force [kN]", title=Path(m.source).name)
-    loop.set(xlabel="displacement [mm]", ylabel="force [kN]", title="force-displacement")
-    in_time.legend(loc="best", fontsize=7)
-    for axes in (in_time, loop):
-        axes.grid(alpha=0.3)
-    figure.tight_layout()
-    path = Path(path)
-    figure.savefig(path, dpi=90)
-    plt.close(figure)
-    return path

@@ -12,8 +12,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Mapping, Sequence
 
-import numpy as np
-
+from fmu_src.bushing_models import get_model
 from identification.compiled_core import simulate_model
 from identification.measurements import Measurement
 from identification.objectives import nrmse, rms_error
@@ -96,30 +95,41 @@ def format_data_errors(rows) -> str:
 
 def plot_measurement(params: Mapping[str, float], measurement: Measurement, path: Path,
                      kelvin_voigt: KelvinVoigtFit | None = None, model: str = "proposed") -> Path:
-    """Force-time and force-displacement of measurement and model, like the paper's Figs. 9-19."""
+    """Force-time and force-displacement of measurement and model (and a Kelvin-Voigt fit),
+    like the paper's Figs. 9-19."""
+    m = measurement
+    predictions = {model: simulate_model(model, params, m.time_s, m.displacement_mm, m.velocity_mm_s)}
+    if kelvin_voigt is not None:
+        predictions["kelvin_voigt"] = kelvin_voigt.force(m.displacement_mm, m.velocity_mm_s)
+    return plot_comparison(m, predictions, path)
+
+
+MODEL_STYLES = {"proposed": ("C0", "-"), "spencer": ("C2", "-."), "bouc_wen": ("C1", ":"),
+                "kelvin_voigt": ("C3", "--")}
+
+
+def plot_comparison(measurement: Measurement, predictions: dict, path: Path) -> Path:
+    """Measured and predicted force over time and against displacement (paper Figs. 15-17)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     m = measurement
-    predicted = simulate_model(model, params, m.time_s, m.displacement_mm, m.velocity_mm_s)
-    figure, (in_time, loop) = plt.subplots(1, 2, figsize=(11, 4.2))
-    in_time.plot(m.time_s, m.force_N / 1e3, color="0.5", lw=1, label="measured")
-    in_time.plot(m.time_s, predicted / 1e3, color="C0", lw=1.2, label=f"model (NRMSE {nrmse(predicted, m.force_N):.1%})")
-    loop.plot(m.displacement_mm, m.force_N / 1e3, color="0.5", lw=0.8)
-    loop.plot(m.displacement_mm, predicted / 1e3, color="C0", lw=1.0)
-    if kelvin_voigt is not None:
-        linear = kelvin_voigt.force(m.displacement_mm, m.velocity_mm_s)
-        in_time.plot(m.time_s, linear / 1e3, color="C3", lw=0.8, ls="--",
-                     label=f"Kelvin-Voigt (NRMSE {nrmse(linear, m.force_N):.1%})")
-        loop.plot(m.displacement_mm, linear / 1e3, color="C3", lw=0.8, ls="--")
+    figure, (in_time, loop) = plt.subplots(1, 2, figsize=(12, 4.4))
+    in_time.plot(m.time_s, m.force_N / 1e3, color="0.55", lw=1.4, label="measured")
+    loop.plot(m.displacement_mm, m.force_N / 1e3, color="0.55", lw=1.2)
+    for model, predicted in predictions.items():
+        color, style = MODEL_STYLES.get(model, ("k", "-"))
+        label = f"{get_model(model).title} (NRMSE {nrmse(predicted, m.force_N):.1%})"
+        in_time.plot(m.time_s, predicted / 1e3, color=color, ls=style, lw=1.1, label=label)
+        loop.plot(m.displacement_mm, predicted / 1e3, color=color, ls=style, lw=1.0)
     in_time.set(xlabel="time [s]", ylabel="force [kN]", title=Path(m.source).name)
     loop.set(xlabel="displacement [mm]", ylabel="force [kN]", title="force-displacement")
-    in_time.legend(loc="best", fontsize=8)
+    in_time.legend(loc="best", fontsize=7)
     for axes in (in_time, loop):
         axes.grid(alpha=0.3)
     figure.tight_layout()
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    figure.savefig(path, dpi=100)
+    figure.savefig(path, dpi=90)
     plt.close(figure)
     return path
