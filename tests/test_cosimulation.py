@@ -50,3 +50,26 @@ def test_libcosim_applies_each_components_parameter_set(rig_runs, component):
     if params != default:
         wrong = simulate_population([default], t, np.append(x_sent, 0.0), np.append(v_sent, 0.0))[0, 1:]
         assert np.max(np.abs(force - wrong)) > 0.01 * np.max(np.abs(force))
+
+
+def test_a_refused_step_reaches_libcosims_log_with_its_category(rig_runs, tmp_path):
+    import re
+    import shutil
+    import subprocess
+
+    system_dir, _, _ = rig_runs
+    broken = tmp_path / "BrokenRig"
+    shutil.copytree(system_dir, broken)
+    ssv = broken / "resources" / "bushing_front_left.ssv"
+    # An invalid value written past our own checked writer, as a hand-edited file would be.
+    ssv.write_text(re.sub(r'(<ssv:Parameter name="c1">\s*<ssv:Real value=")[^"]*', r"\g<1>0.0", ssv.read_text()))
+    # libcosim logs from its own threads to the process's console: run it in a child to read that.
+    script = ("from libcosimpy.CosimExecution import CosimExecution\n"
+              "from libcosimpy.CosimLogging import CosimLogLevel, log_output_level\n"
+              "log_output_level(CosimLogLevel.WARNING)\n"
+              f"execution = CosimExecution.from_ssp_file({str(broken)!r}, step_size={int(STEP * 1e9)})\n"
+              "print('step', execution.step())\n")
+    result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+    assert "step False" in result.stdout, result.stdout + result.stderr[-2000:]
+    log = result.stdout + result.stderr  # libcosim's console sink writes to stdout
+    assert "category=logStatusError" in log and "c1 = 0.0 N.s/mm must be > 0" in log
