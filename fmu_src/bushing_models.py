@@ -29,12 +29,11 @@ control and the FMU's error handling are the ones of the proposed model.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Callable, Mapping
 
 from . import bushing_params as proposed
-from .bushing_params import ParameterError, ParameterSpec
+from .bushing_params import ParameterError, ParameterSpec, number_errors
 
 RIGID = 1e12
 """How much stiffer (or more viscous) than the rest a limit element is made (see above)."""
@@ -73,16 +72,7 @@ class BushingModel:
         """(errors, warnings) for a parameter set of this model, never raising. Errors make it
         unusable (missing, non-numbers, NaN, what the equations cannot take); warnings are
         physically doubtful but simulable values."""
-        missing = [name for name in self.parameter_names if name not in params]
-        if missing:
-            return [f"missing parameters of the {self.name} model: {', '.join(missing)}"], []
-        errors = []
-        for name, unit in self.units.items():
-            value = params[name]
-            if not isinstance(value, (int, float)) or isinstance(value, bool):
-                errors.append(f"{name} = {value!r} is not a number (unit {unit})")
-            elif not math.isfinite(value):
-                errors.append(f"{name} = {value} [{unit}] must be a finite number")
+        errors = number_errors(params, self.units, f" of the {self.name} model")
         if errors:
             return errors, []
         return self._check({name: float(params[name]) for name in self.parameter_names})
@@ -216,7 +206,7 @@ _W = StateSpec("w", "w", "m", "displacement of the right plate (eq. 4)")
 MODELS: dict[str, BushingModel] = {
     "proposed": BushingModel(
         "proposed", proposed.MODEL_NAME, "proposed (paper eqs. 1-5)", proposed.PARAMETER_SPECS,
-        (_Z1, _Z2, _Y, _W), "params_table5_combined.json", dict, proposed.validate_parameters),
+        (_Z1, _Z2, _Y, _W), "params_table5_combined.json", dict, proposed.range_checks),
     "spencer": BushingModel(
         "spencer", "SpencerBushing", "Spencer (1997)", SPENCER_SPECS,
         (StateSpec("z", "z2", "N", "hysteretic force"),

@@ -69,6 +69,22 @@ class ParameterError(ValueError):
     """A parameter set that the model cannot simulate; the message lists every problem."""
 
 
+def number_errors(params: Mapping[str, float], units: Mapping[str, str], model_label: str = "") -> list[str]:
+    """Missing names, non-numbers and NaN/Inf among ``params`` (``units``: name -> unit of
+    every parameter the model needs); shared by every model of ``bushing_models``."""
+    missing = [name for name in units if name not in params]
+    if missing:
+        return [f"missing parameters{model_label}: {', '.join(missing)}"]
+    errors = []
+    for name, unit in units.items():
+        value = params[name]
+        if not isinstance(value, (int, float)) or isinstance(value, bool):
+            errors.append(f"{name} = {value!r} is not a number (unit {unit})")
+        elif not math.isfinite(value):
+            errors.append(f"{name} = {value} [{unit}] must be a finite number")
+    return errors
+
+
 def validate_parameters(params: Mapping[str, float]) -> tuple[list[str], list[str]]:
     """Check a parameter set (paper units).
 
@@ -77,21 +93,16 @@ def validate_parameters(params: Mapping[str, float]) -> tuple[list[str], list[st
     constraints (A >= 1, beta >= 0, beta1 + gamma1 > 0, beta2 - gamma2 > 0), which the
     equations do not need but a fitted bushing should satisfy.
     """
+    errors = number_errors(params, PARAMETER_UNITS)
+    if errors:
+        return errors, []
+    return range_checks({name: float(params[name]) for name in PARAMETER_NAMES})
+
+
+def range_checks(p: Mapping[str, float]) -> tuple[list[str], list[str]]:
+    """(errors, warnings) of :func:`validate_parameters` for a complete set of finite floats."""
     errors: list[str] = []
     warnings: list[str] = []
-    missing = [name for name in PARAMETER_NAMES if name not in params]
-    if missing:
-        errors.append(f"missing parameters: {', '.join(missing)}")
-        return errors, warnings
-    p = {name: params[name] for name in PARAMETER_NAMES}
-    for name, value in p.items():
-        if not isinstance(value, (int, float)) or isinstance(value, bool):
-            errors.append(f"{name} = {value!r} is not a number (unit {PARAMETER_UNITS[name]})")
-        elif not math.isfinite(value):
-            errors.append(f"{name} = {value} [{PARAMETER_UNITS[name]}] must be a finite number")
-    if errors:
-        return errors, warnings
-
     if not p["c1"] > 0:
         errors.append(f"c1 = {p['c1']} N.s/mm must be > 0 (it divides eq. 3)")
     if not p["c0"] + p["c2"] > 0:
@@ -119,14 +130,3 @@ def validate_parameters(params: Mapping[str, float]) -> tuple[list[str], list[st
         if p[name] < 0:
             warnings.append(f"{name} = {p[name]} N.s/mm is a negative damping (unphysical)")
     return errors, warnings
-
-
-def check_parameters(params: Mapping[str, float]) -> dict[str, float]:
-    """Return the 16 parameters as floats, or raise ParameterError listing every error."""
-    errors, _ = validate_parameters(params)
-    if errors:
-        raise ParameterError("invalid bushing parameters: " + "; ".join(errors))
-    unknown = sorted(set(params) - set(PARAMETER_NAMES))
-    if unknown:
-        raise ParameterError(f"unknown parameter names {unknown}; allowed: {', '.join(PARAMETER_NAMES)}")
-    return {name: float(params[name]) for name in PARAMETER_NAMES}

@@ -21,6 +21,7 @@ from identification.measurements import load_measurement
 from identification.objectives import Objective, StepTest, nrmse, rms_error
 from identification.report import plot_comparison
 
+
 def compare_models(models: Sequence[str], sine_files: Sequence[Path], step_file: Path | None,
                    rise_time_s: float | None, validation_files: Sequence[Path], out_dir: Path,
                    preset: str = "default", seed: int = 0, maxiter: int | None = None) -> dict:
@@ -47,15 +48,13 @@ def compare_models(models: Sequence[str], sine_files: Sequence[Path], step_file:
         print(f"  E3 = {result.objective:.4e} in {time.perf_counter() - started:.0f} s", file=sys.stderr)
 
     errors = {}
-    predictions = {}
     for m in validation:
         name = Path(m.source).name
-        for model in models:
-            predicted = simulate_model(model, parameters[model], m.time_s, m.displacement_mm, m.velocity_mm_s)
-            predictions[name, model] = predicted
+        predictions = {model: simulate_model(model, parameters[model], m.time_s, m.displacement_mm, m.velocity_mm_s)
+                       for model in models}
+        for model, predicted in predictions.items():
             errors[name, model] = (nrmse(predicted, m.force_N), rms_error(predicted, m.force_N))
-        plot_comparison(m, {model: predictions[name, model] for model in models},
-                        out_dir / f"compare_{Path(m.source).stem}.png")
+        plot_comparison(m, predictions, out_dir / f"compare_{Path(m.source).stem}.png")
 
     print(format_comparison(errors, models, [Path(m.source).name for m in validation]))
     with open(out_dir / "comparison.csv", "w", newline="") as handle:

@@ -20,7 +20,7 @@ import numpy as np
 from scipy.optimize import differential_evolution, least_squares
 
 from fmu_src.bushing_models import get_model
-from fmu_src.bushing_params import PARAMETER_NAMES
+from identification.compiled_core import parameter_matrix
 from identification.objectives import Objective
 from identification.search_space import KelvinVoigtFit, SearchSpace
 
@@ -142,9 +142,7 @@ def fit_kelvin_voigt(objective: Objective) -> FitResult:
     started = time.perf_counter()
     line = KelvinVoigtFit.fit([*objective.sines, *objective.randoms])
     parameters = {"k": line.k, "c": line.c, "preload": 0.0}
-    bushing = get_model("kelvin_voigt")
-    core = bushing.core_parameters(parameters)
-    matrix = np.array([[core[name] for name in PARAMETER_NAMES]])
+    matrix = parameter_matrix([get_model("kelvin_voigt").core_parameters(parameters)])
     terms = {name: float(values[0]) for name, values in objective.terms(matrix).items()}
     return FitResult(parameters, float(objective(matrix)[0]), terms, 1, time.perf_counter() - started,
                      "linear", 0, None, model="kelvin_voigt")

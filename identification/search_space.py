@@ -23,7 +23,7 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from fmu_src.bushing_models import get_model
-from fmu_src.bushing_params import PARAMETER_NAMES
+from identification.compiled_core import parameter_matrix
 from identification.measurements import Measurement
 
 
@@ -158,8 +158,7 @@ class SearchSpace:
         if self.model == "proposed":
             return rows
         names, bushing = self.bushing.parameter_names, self.bushing
-        cores = [bushing.core_parameters(dict(zip(names, row))) for row in rows]
-        return np.array([[core[name] for name in PARAMETER_NAMES] for core in cores])
+        return parameter_matrix([bushing.core_parameters(dict(zip(names, row))) for row in rows])
 
     def to_coordinates(self, params: Mapping[str, float]) -> np.ndarray:
         """The inverse of :meth:`to_model_parameters` (after rescaling every alpha to 1 when

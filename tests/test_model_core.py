@@ -6,7 +6,8 @@ import pytest
 
 from conftest import paper_parameters, reference_force
 from fmu_src import bushing_core as core
-from fmu_src.bushing_params import ParameterError, check_parameters, validate_parameters
+from fmu_src.bushing_models import MODELS
+from fmu_src.bushing_params import ParameterError, validate_parameters
 from identification.protocols import Random, Sine, Step, sample_times
 from identification.simulate import simulate
 
@@ -120,7 +121,7 @@ def test_invalid_parameters_are_errors_naming_value_unit_and_range(name, value, 
     errors, _ = validate_parameters(params)
     assert any(fragment in message for message in errors), errors
     with pytest.raises(ParameterError, match=name):
-        check_parameters(params)
+        MODELS["proposed"].check(params)
 
 
 @pytest.mark.parametrize("change, fragment", [
