@@ -35,12 +35,12 @@ def main() -> None:
     from fmu_src import bushing_core as core
     from fmu_src.bushing_params import PARAMETER_NAMES
     from fmu_src.parameter_files import load_parameters
-    from identification.compiled_core import simulate_population
+    from identification.compiled_core import simulate_population_held
     from identification.measurements import load_measurement
     from identification.objectives import Objective, StepTest
     from identification.protocols import Sine, sample_times
     from identification.search_space import SearchSpace
-    from identification.simulate import simulate
+    from python_core import simulate_python_core
 
     sine = load_measurement(REPO / "data" / "synthetic_table5_sine_2mm_10Hz.csv")
     step = load_measurement(REPO / "data" / "synthetic_table5_step_2mm_rise0.4s.csv")
@@ -56,16 +56,16 @@ def main() -> None:
     t = sample_times(1.0, 1000.0)
     x, v = Sine(2.0, 10.0).signals(t)
 
-    simulate_population(matrix[:2], t, x, v)  # compile outside the timing
+    simulate_population_held(matrix[:2], t, x, v)  # compile outside the timing
     started = time.perf_counter()
-    compiled = simulate_population(matrix, t, x, v)
+    compiled = simulate_population_held(matrix, t, x, v)
     compiled_cost = (time.perf_counter() - started) / len(matrix)
 
     python_sample = matrix[:20]
     started = time.perf_counter()
     for row in python_sample:
         try:
-            simulate(dict(zip(PARAMETER_NAMES, row)), t, x, v)
+            simulate_python_core(dict(zip(PARAMETER_NAMES, row)), t, x, v)
         except core.StepError:
             pass
     python_cost = (time.perf_counter() - started) / len(python_sample)

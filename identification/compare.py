@@ -16,10 +16,10 @@ from typing import Sequence
 
 from fmu_src.bushing_models import get_model
 from fmu_src.parameter_files import save_parameters
-from identification.compiled_core import simulate_model
 from identification.measurements import load_measurement
 from identification.objectives import Objective, StepTest, nrmse, rms_error
 from identification.report import plot_comparison
+from identification.simulate import simulate
 
 
 def compare_models(models: Sequence[str], sine_files: Sequence[Path], step_file: Path | None,
@@ -50,7 +50,7 @@ def compare_models(models: Sequence[str], sine_files: Sequence[Path], step_file:
     errors = {}
     for m in validation:
         name = Path(m.source).name
-        predictions = {model: simulate_model(model, parameters[model], m.time_s, m.displacement_mm, m.velocity_mm_s)
+        predictions = {model: simulate(parameters[model], m.time_s, m.displacement_mm, m.measured_velocity_mm_s, model=model)
                        for model in models}
         for model, predicted in predictions.items():
             errors[name, model] = (nrmse(predicted, m.force_N), rms_error(predicted, m.force_N))

@@ -45,9 +45,13 @@ _GAMMA1, _GAMMA2, _N1, _N2, _A1, _A2 = _I["gamma1"], _I["gamma2"], _I["n1"], _I[
 
 
 @numba.njit(error_model="numpy", parallel=True)
-def _simulate_population(matrix, t, x, v, max_substeps):
-    count, samples = matrix.shape[0], t.size
-    forces = np.full((count, samples), np.nan)
+def _simulate_population(matrix, t, x, v, out_index, out_velocity, max_substeps):
+    """Forces of every parameter set (rows of ``matrix``) at the communication points
+    ``t[out_index]``; the input over [t_k, t_k+1] is x_k + v_k*(t - t_k), as in the FMU, and the
+    force at an output point is eq. 5 with the velocity ``out_velocity`` (the FMU's direct
+    feedthrough of the velocity set at that instant)."""
+    count, samples, outputs = matrix.shape[0], t.size, out_index.size
+    forces = np.full((count, outputs), np.nan)
     for i in numba.prange(count):
         p = matrix[i]
         C = p[_C0] + p[_C2]
@@ -59,8 +63,15 @@ def _simulate_population(matrix, t, x, v, max_substeps):
         state_x = x[0]
         y = p[_K1] * state_x / K1 if K1 > 0.0 else state_x  # bushing_core.initial_state
         z1, w, z2 = 0.0, state_x, 0.0
-        forces[i, 0] = p[_K0] * y + p[_C0] * ((p[_C2] * v[0] + p[_K2] * (state_x - w) + p[_ALPHA2] * z2) / C)
+        j = 0
+        if out_index[0] == 0:
+            # bushing_core.force: eq. 5 with eq. 4
+            forces[i, 0] = p[_K0] * y + p[_C0] * ((p[_C2] * out_velocity[0] + p[_K2] * (state_x - w)
+                                                    + p[_ALPHA2] * z2) / C)
+            j = 1
         for k in range(samples - 1):
+            if j == outputs:
+                break
             h = t[k + 1] - t[k]
             status = _OK
             if x[k] != state_x:
@@ -70,29 +81,54 @@ def _simulate_population(matrix, t, x, v, max_substeps):
             if status != _OK:
                 break  # this candidate failed: NaN from here on
             state_x = x[k] + v[k] * h
-            # bushing_core.force: eq. 5 with eq. 4
-            forces[i, k + 1] = p[_K0] * y + p[_C0] * ((p[_C2] * v[k] + p[_K2] * (state_x - w) + p[_ALPHA2] * z2) / C)
+            if out_index[j] == k + 1:
+                forces[i, j] = p[_K0] * y + p[_C0] * ((p[_C2] * out_velocity[j] + p[_K2] * (state_x - w)
+                                                        + p[_ALPHA2] * z2) / C)
+                j += 1
     return forces
 
 
-def simulate_population(parameter_sets, time_s, displacement_mm, velocity_mm_s,
-                        max_substeps: int = _core.DEFAULT_MAX_SUBSTEPS) -> np.ndarray:
-    """Forces [N], shape (P, samples), of P parameter sets on one sampled input.
+def simulate_population_held(parameter_sets, time_s, displacement_mm, velocity_mm_s,
+                             max_substeps: int = _core.DEFAULT_MAX_SUBSTEPS) -> np.ndarray:
+    """Forces [N], shape (P, samples), of P parameter sets under the FMU's input convention.
 
-    The same convention as ``identification.simulate.simulate`` and the FMU with a
-    communication point at every sample. ``parameter_sets`` is a (P, 16) array in
-    ``PARAMETER_NAMES`` order or a sequence of mappings; the sets must be valid
-    (``bushing_params.validate_parameters``). A candidate whose step fails (overflow,
-    non-finite state, too many substeps) gets NaN from that sample on. Runs on all cores.
+    The FMU with a communication point at every sample: over [t_k, t_k+1] the displacement is
+    x_k + v_k*(t - t_k) and the velocity v_k held (a displacement jump where x_k+1 differs from
+    x_k + v_k*h), and the force at t_k+1 is read before the next inputs are set (velocity v_k).
+    This is what a co-simulation master sees; the identification's forward model
+    (``identification.forward_model``) drives the same kernel with a finer, consistent input.
+    ``parameter_sets`` is a (P, 16) array in ``PARAMETER_NAMES`` order or a sequence of
+    mappings; the sets must be valid. A candidate whose step fails (overflow, non-finite
+    state, too many substeps) gets NaN from that sample on. Runs on all cores.
     """
-    matrix = parameter_matrix(parameter_sets)
+    t, x, v = _input_arrays(time_s, displacement_mm, velocity_mm_s)
+    out_velocity = np.concatenate([v[:1], v[:-1]])
+    return _simulate_population(parameter_matrix(parameter_sets), t, x, v, np.arange(t.size), out_velocity,
+                                max_substeps)
+
+
+def simulate_population_at(parameter_sets, time_s, displacement_mm, velocity_mm_s, output_index,
+                           output_velocity_mm_s, max_substeps: int = _core.DEFAULT_MAX_SUBSTEPS) -> np.ndarray:
+    """Forces [N], shape (P, outputs), at the communication points ``time_s[output_index]``
+    (increasing), with the force's viscous feedthrough taken at ``output_velocity_mm_s``; the
+    input between communication points as in :func:`simulate_population_held`."""
+    t, x, v = _input_arrays(time_s, displacement_mm, velocity_mm_s)
+    out_index = np.ascontiguousarray(output_index, dtype=np.int64)
+    out_velocity = np.ascontiguousarray(output_velocity_mm_s, dtype=float)
+    if not (out_index.ndim == 1 and out_index.size >= 1 and out_index.shape == out_velocity.shape
+            and np.all(np.diff(out_index) > 0) and 0 <= out_index[0] and out_index[-1] < t.size):
+        raise ValueError("output_index must be increasing indices into time_s, one output velocity each")
+    return _simulate_population(parameter_matrix(parameter_sets), t, x, v, out_index, out_velocity, max_substeps)
+
+
+def _input_arrays(time_s, displacement_mm, velocity_mm_s):
     t = np.ascontiguousarray(time_s, dtype=float)
     x = np.ascontiguousarray(displacement_mm, dtype=float)
     v = np.ascontiguousarray(velocity_mm_s, dtype=float)
     if not (t.ndim == 1 and t.shape == x.shape == v.shape and t.size >= 2):
         raise ValueError(f"time, displacement and velocity must be 1-D arrays of equal length >= 2, "
                          f"got shapes {t.shape}, {x.shape}, {v.shape}")
-    return _simulate_population(matrix, t, x, v, max_substeps)
+    return t, x, v
 
 
 def parameter_matrix(parameter_sets) -> np.ndarray:
@@ -107,12 +143,13 @@ def parameter_matrix(parameter_sets) -> np.ndarray:
     return np.ascontiguousarray(matrix)
 
 
-def simulate_model(model: str, params: Mapping[str, float], time_s, displacement_mm,
-                   velocity_mm_s) -> np.ndarray:
-    """Force [N] of one parameter set of any model of ``bushing_models`` (by name) on one
-    sampled input: the core's force of the model's 16 core parameters plus its constant
-    force (preload). Raises ParameterError for an invalid set."""
+def simulate_model_held(model: str, params: Mapping[str, float], time_s, displacement_mm,
+                        velocity_mm_s) -> np.ndarray:
+    """Force [N] of one parameter set of any model of ``bushing_models`` (by name) under the
+    FMU's input convention (:func:`simulate_population_held`): the core's force of the model's
+    16 core parameters plus its constant force (preload). Raises ParameterError for an
+    invalid set."""
     bushing = get_model(model)
     values = bushing.check(params)
-    forces = simulate_population([bushing.core_parameters(values)], time_s, displacement_mm, velocity_mm_s)[0]
+    forces = simulate_population_held([bushing.core_parameters(values)], time_s, displacement_mm, velocity_mm_s)[0]
     return forces + bushing.force_offset(values)

@@ -43,6 +43,12 @@ class Measurement:
     def __len__(self) -> int:
         return self.time_s.size
 
+    @property
+    def measured_velocity_mm_s(self) -> np.ndarray | None:
+        """The velocity column if the file has one, else None (the forward model then derives
+        the velocity from its interpolant of the displacement)."""
+        return None if self.velocity_derived else self.velocity_mm_s
+
 
 def derive_velocity(time_s: np.ndarray, displacement_mm: np.ndarray) -> np.ndarray:
     """dx/dt [mm/s] by second-order finite differences (see the module docstring)."""

@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from identification.compiled_core import simulate_population
+from identification.compiled_core import simulate_population_held
 from identification.measurements import Measurement
 
 WINDOW_S = 0.005
@@ -67,7 +67,7 @@ class StepTest:
             raise ValueError(f"the measured force at the rise time is zero in {self.measurement.source}")
 
     def simulate(self, matrix: np.ndarray) -> np.ndarray:
-        return simulate_population(matrix, self.grid_time, self.grid_displacement, self.grid_velocity,
+        return simulate_population_held(matrix, self.grid_time, self.grid_displacement, self.grid_velocity,
                                    FIT_MAX_SUBSTEPS)
 
     def errors(self, matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -129,7 +129,7 @@ class Objective:
 
 def _relative_errors(matrix, measurement: Measurement) -> np.ndarray:
     """(F_pre - F_exp) / rms(F_exp) / sqrt(samples): its sum of squares is the squared NRMSE."""
-    predicted = simulate_population(matrix, measurement.time_s, measurement.displacement_mm,
+    predicted = simulate_population_held(matrix, measurement.time_s, measurement.displacement_mm,
                                     measurement.velocity_mm_s, FIT_MAX_SUBSTEPS)
     scale = np.sqrt(np.mean(measurement.force_N ** 2)) * np.sqrt(measurement.force_N.size)
     return (predicted - measurement.force_N) / scale

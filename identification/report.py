@@ -13,11 +13,11 @@ from pathlib import Path
 from typing import Mapping, Sequence
 
 from fmu_src.bushing_models import get_model
-from identification.compiled_core import simulate_model
 from identification.measurements import Measurement
 from identification.objectives import nrmse, rms_error
 from identification.protocols import Random, Sine, Step, sample_times
 from identification.search_space import KelvinVoigtFit
+from identification.simulate import simulate
 
 SINE_FREQUENCIES_HZ = (1.0, 10.0, 20.0, 30.0)
 SINE_AMPLITUDES_MM = (0.5, 1.0, 2.0, 3.0)
@@ -51,8 +51,8 @@ def grid_errors(params: Mapping[str, float], truth: Mapping[str, float], model: 
     for name, protocol in grid_protocols():
         t = sample_times(protocol.duration_s, RATE_HZ)
         signals = protocol.signals(t)
-        predicted = simulate_model(model, params, t, *signals)
-        expected = simulate_model(truth_model, truth, t, *signals)
+        predicted = simulate(params, t, *signals, model=model)
+        expected = simulate(truth, t, *signals, model=truth_model)
         errors.append(CaseError(name, nrmse(predicted, expected), rms_error(predicted, expected)))
     return errors
 
@@ -64,7 +64,7 @@ def data_errors(params: Mapping[str, float], measurements: Sequence[Measurement]
     fit's if one is given."""
     rows = []
     for m in measurements:
-        predicted = simulate_model(model, params, m.time_s, m.displacement_mm, m.velocity_mm_s)
+        predicted = simulate(params, m.time_s, m.displacement_mm, m.measured_velocity_mm_s, model=model)
         name = Path(m.source).name
         fitted = CaseError(name, nrmse(predicted, m.force_N), rms_error(predicted, m.force_N))
         baseline = None
@@ -98,7 +98,7 @@ def plot_measurement(params: Mapping[str, float], measurement: Measurement, path
     """Force-time and force-displacement of measurement and model (and a Kelvin-Voigt fit),
     like the paper's Figs. 9-19."""
     m = measurement
-    predictions = {model: simulate_model(model, params, m.time_s, m.displacement_mm, m.velocity_mm_s)}
+    predictions = {model: simulate(params, m.time_s, m.displacement_mm, m.measured_velocity_mm_s, model=model)}
     if kelvin_voigt is not None:
         predictions["kelvin_voigt"] = kelvin_voigt.force(m.displacement_mm, m.velocity_mm_s)
     return plot_comparison(m, predictions, path)

@@ -19,8 +19,9 @@ from typing import Mapping
 import numpy as np
 
 from fmu_src.bushing_params import PARAMETER_NAMES, PARAMETER_UNITS
-from identification.compiled_core import simulate_population
+from identification.forward_model import prepare_input
 from identification.protocols import Sine, Step, sample_times
+from identification.simulate import simulate_driven
 
 # "Significance priority" as printed in the paper: Table 1 (sine), Table 3 (step, t = T_r and 10 s).
 PAPER_RANKS = {
@@ -81,9 +82,9 @@ def sensitivity(params: Mapping[str, float], delta: float = 0.1, sine: Sine = Si
     matrix = np.array(candidates)
 
     t = sample_times(sine.duration_s, rate_hz)
-    sine_forces = simulate_population(matrix, t, *sine.signals(t))
+    sine_forces = simulate_driven(matrix, prepare_input(t, *sine.signals(t)))
     t_step = sample_times(step.duration_s, rate_hz)
-    step_forces = simulate_population(matrix, t_step, *step.signals(t_step))
+    step_forces = simulate_driven(matrix, prepare_input(t_step, *step.signals(t_step)))
     rise_index = int(np.argmin(np.abs(t_step - step.rise_time_s)))
 
     values = {measure: {} for measure in MEASURES}

@@ -1,7 +1,15 @@
-"""Simulate the bushing model core on sampled inputs (the same code the FMU runs).
+"""Simulate any of the project's models on a sampled test: the identification's forward model.
+
+``simulate(parameters, time_s, displacement_mm, velocity_mm_s=None, model="proposed")``
+returns the force [N] at every sample of a parameter set of the proposed model, Spencer's,
+the single Bouc-Wen or Kelvin-Voigt (``fmu_src.bushing_models``), driven by a smooth
+interpolant of the sampled displacement (``identification.forward_model``): the
+continuous-time model, which the fit compares with measurements. The FMU, a co-simulation
+slave, sees its inputs held over each communication step instead
+(``compiled_core.simulate_population_held``).
 
 Units: time in s, displacement in mm, velocity in mm/s, force in N, parameters in the
-paper's N-mm-s units.
+paper's N-mm-s units. The bushing starts in relaxed equilibrium at the first displacement.
 """
 from __future__ import annotations
 
@@ -9,39 +17,46 @@ from typing import Mapping
 
 import numpy as np
 
-from fmu_src import bushing_core as core
 from fmu_src.bushing_models import get_model
+from identification.compiled_core import parameter_matrix, simulate_population_at
+from identification.forward_model import DrivenInput, prepare_input
 
 
-def simulate(params: Mapping[str, float], time_s, displacement_mm, velocity_mm_s,
-             substeps_per_sample: int = 1, model: str = "proposed") -> np.ndarray:
-    """Force [N] at every sample time of the bushing ``model`` (``bushing_models``) with ``params``.
+def simulate(parameters, time_s, displacement_mm, velocity_mm_s=None, model: str | None = None,
+             steps_per_sample: int | None = None) -> np.ndarray:
+    """Force [N] at every sample.
 
-    Between samples k and k+1 the displacement is x_k + v_k*(t - t_k) and the velocity v_k,
-    exactly as in the FMU with communication points at the sample times (where x_{k+1}
-    differs from x_k + v_k*h the model takes it as a displacement jump); the state starts in
-    the relaxed equilibrium at x_0 (``bushing_core.initial_state``). ``substeps_per_sample``
-    > 1 splits each interval into equal communication steps (for fine reference runs).
+    ``parameters``: a mapping of the model's parameters (paper units), or a
+    ``parameter_files.ParameterSet`` (which names its model). ``model``: the model's name or
+    FMI identifier (default: the one of the ParameterSet, else ``"proposed"``).
+    ``velocity_mm_s``: the test's velocity at the samples, if known (else derived from the
+    interpolant). ``steps_per_sample``: communication steps per sample interval (default:
+    chosen from the signal, see ``forward_model``); more give a finer reference solution.
+    Raises ``ParameterError`` for an invalid set, ``ValueError`` for bad arrays.
     """
-    bushing = get_model(model)
-    values = bushing.check(params)
-    p = bushing.core_parameters(values)
-    compiled = core.compile_model(p)
-    t = np.asarray(time_s, dtype=float)
-    x = np.asarray(displacement_mm, dtype=float)
-    v = np.asarray(velocity_mm_s, dtype=float)
-    if not (t.shape == x.shape == v.shape and t.ndim == 1):
-        raise ValueError(f"time, displacement and velocity must be 1-D arrays of equal length, "
-                         f"got shapes {t.shape}, {x.shape}, {v.shape}")
-    state_x = float(x[0])
-    state = core.initial_state(p, state_x)
-    forces = np.empty_like(t)
-    forces[0] = core.force(state, state_x, v[0], p)
-    for k in range(t.size - 1):
-        x_k, v_k = float(x[k]), float(v[k])
-        h = (float(t[k + 1]) - float(t[k])) / substeps_per_sample
-        for i in range(substeps_per_sample):
-            state, _ = core.advance(compiled, state, state_x, x_k + v_k * h * i, v_k, h)
-            state_x = x_k + v_k * h * (i + 1)
-        forces[k + 1] = core.force(state, state_x, v_k, p)
-    return forces + bushing.force_offset(values)
+    values, bushing = _parameters_and_model(parameters, model)
+    driven = prepare_input(time_s, displacement_mm, velocity_mm_s, steps=steps_per_sample)
+    return simulate_driven(_core_matrix(bushing, [values]), driven)[0] + bushing.force_offset(values)
+
+
+def simulate_driven(core_matrix: np.ndarray, driven: DrivenInput, max_substeps: int | None = None) -> np.ndarray:
+    """Forces [N], shape (P, outputs), of a (P, 16) matrix of core parameters on a prepared
+    input, at its output samples (``driven.sample_index``). NaN from where a candidate fails."""
+    kwargs = {} if max_substeps is None else {"max_substeps": max_substeps}
+    return simulate_population_at(core_matrix, driven.time_s, driven.displacement_mm, driven.velocity_mm_s,
+                                  driven.output_index, driven.output_velocity_mm_s, **kwargs)
+
+
+def _core_matrix(bushing, parameter_sets) -> np.ndarray:
+    return parameter_matrix([bushing.core_parameters(values) for values in parameter_sets])
+
+
+def _parameters_and_model(parameters, model):
+    if hasattr(parameters, "model") and hasattr(parameters, "parameters"):  # a ParameterSet
+        bushing = get_model(model) if model is not None else parameters.model
+        return bushing.check(parameters.parameters), bushing
+    if not isinstance(parameters, Mapping):
+        raise TypeError(f"parameters must be a mapping of names to values or a ParameterSet, "
+                        f"not {type(parameters).__name__}")
+    bushing = get_model(model or "proposed")
+    return bushing.check(parameters), bushing

@@ -52,6 +52,36 @@ def reference_force(params, time_s, x_mm, v_mm_s, rtol=1e-10, atol=1e-9):
     return np.array(forces)
 
 
+def paper_equations(t, state, p, displacement, velocity):
+    """Eqs. 1-4 of the paper, typed from the paper once more, independently of ``fmu_src``:
+    d/dt of (y, z1, w, z2) for the input functions ``displacement(t)`` [mm] and
+    ``velocity(t)`` [mm/s], parameters ``p`` in N-mm-s units."""
+    y, z1, w, z2 = state
+    x, xd = displacement(t), velocity(t)
+    yd = (p["c1"] * xd + p["k1"] * (x - y) - p["k0"] * y + p["alpha1"] * z1) / p["c1"]      # eq. 3
+    wd = (p["c2"] * xd + p["k2"] * (x - w) + p["alpha2"] * z2) / (p["c0"] + p["c2"])       # eq. 4
+    z1d = (xd - yd) * (p["A1"] - (p["gamma1"] + p["beta1"] * np.sign(xd - yd) * np.sign(z1))
+                       * abs(z1) ** p["n1"])                                                 # eq. 1
+    z2d = (xd - wd) * (p["A2"] - (p["gamma2"] + p["beta2"] * np.sign(xd - wd) * np.sign(z2))
+                       * abs(z2) ** p["n2"])                                                 # eq. 2
+    return [yd, z1d, wd, z2d]
+
+
+def paper_force(p, time_s, displacement, velocity, rtol=1e-10, atol=1e-10):
+    """Eq. 5, F = k0*y + c0*dw/dt [N], at ``time_s`` for a smooth input given as functions of
+    time, from scipy's Radau on :func:`paper_equations`, starting in relaxed equilibrium at
+    x(0) (y = k1*x/(k0 + k1), w = x, z = 0)."""
+    x0 = displacement(time_s[0])
+    start = [p["k1"] * x0 / (p["k0"] + p["k1"]), 0.0, x0, 0.0]
+    solution = solve_ivp(paper_equations, (time_s[0], time_s[-1]), start, method="Radau", t_eval=time_s,
+                         args=(p, displacement, velocity), rtol=rtol, atol=atol)
+    assert solution.success, solution.message
+    y, _, w, z2 = solution.y
+    x, xd = displacement(time_s), velocity(time_s)
+    wd = (p["c2"] * xd + p["k2"] * (x - w) + p["alpha2"] * z2) / (p["c0"] + p["c2"])
+    return p["k0"] * y + p["c0"] * wd
+
+
 @pytest.fixture(scope="session")
 def fmu_path(tmp_path_factory) -> Path:
     """The FMU built with the default parameters (Table 5)."""

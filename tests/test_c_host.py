@@ -13,7 +13,7 @@ from fmpy import extract, read_model_description
 
 from conftest import paper_parameters
 from identification.protocols import Sine
-from identification.simulate import simulate
+from python_core import simulate_python_core
 
 HOST_SOURCE = Path(__file__).with_name("c_host") / "fmi2_host.c"
 
@@ -45,5 +45,5 @@ def test_fmu_runs_in_a_c_host_with_libpython_preloaded(fmu_path, tmp_path):
     rows = np.array([[float(value) for value in line.split()] for line in result.stdout.splitlines()])
     t = np.arange(steps + 1) * h
     x, v = Sine(2.0, 10.0).signals(t)
-    expected = simulate(paper_parameters("table5"), t, x, v)[1:]
+    expected = simulate_python_core(paper_parameters("table5"), t, x, v)[1:]
     np.testing.assert_allclose(rows[:, 1], expected, rtol=1e-9, atol=1e-6)

@@ -4,7 +4,7 @@ import pytest
 
 from conftest import paper_parameters
 from fmu_src.bushing_params import PARAMETER_NAMES
-from identification.compiled_core import simulate_population
+from identification.compiled_core import simulate_population_held
 from identification.protocols import Random, Sine, sample_times
 from test_fmu_numerics import simulate_with_fmpy
 
@@ -24,7 +24,7 @@ def test_compiled_forces_agree_with_the_fmu_for_every_candidate(fmu_path, protoc
     t = sample_times(duration_s, 1000.0)
     x, v = protocol.signals(t)
     sets = population()
-    compiled = simulate_population(sets, t, x, v)
+    compiled = simulate_population_held(sets, t, x, v)
     for params, forces in zip(sets, compiled):
         via_fmu = simulate_with_fmpy(fmu_path, t, x, v, start_values=params)
         np.testing.assert_allclose(forces, via_fmu, rtol=1e-9, atol=1e-9 * np.max(np.abs(via_fmu)))
@@ -37,7 +37,7 @@ def test_failing_candidate_gets_nan_without_disturbing_the_others():
     x = np.concatenate([np.zeros(20), np.full(t.size - 20, 2.0)])
     v = np.zeros(t.size)
     good = paper_parameters("table5")
-    forces = simulate_population([good, dict(good, n2=1.5), good], t, x, v)
+    forces = simulate_population_held([good, dict(good, n2=1.5), good], t, x, v)
     assert np.all(np.isfinite(forces[0])) and np.array_equal(forces[0], forces[2])
     # The step from sample 20 (where x jumps) gives the force at sample 21.
     assert np.all(np.isfinite(forces[1][:21])) and np.all(np.isnan(forces[1][21:]))
@@ -45,17 +45,17 @@ def test_failing_candidate_gets_nan_without_disturbing_the_others():
 
 def test_parameter_matrix_rejects_wrong_shapes():
     with pytest.raises(ValueError, match=str(len(PARAMETER_NAMES))):
-        simulate_population(np.ones((3, 5)), np.arange(3.0), np.zeros(3), np.zeros(3))
+        simulate_population_held(np.ones((3, 5)), np.arange(3.0), np.zeros(3), np.zeros(3))
 
 
 def test_compiled_forces_equal_the_python_core_on_a_random_population():
-    from identification.simulate import simulate
+    from python_core import simulate_python_core
     rng = np.random.default_rng(2)
     base = np.array([paper_parameters("table5")[name] for name in PARAMETER_NAMES])
     matrix = base * rng.uniform(0.7, 1.3, (40, len(PARAMETER_NAMES)))
     t = sample_times(0.3, 1000.0)
     x, v = Sine(2.0, 10.0).signals(t)
-    compiled = simulate_population(matrix, t, x, v)
+    compiled = simulate_population_held(matrix, t, x, v)
     for row, forces in zip(matrix, compiled):
-        python = simulate(dict(zip(PARAMETER_NAMES, row)), t, x, v)
+        python = simulate_python_core(dict(zip(PARAMETER_NAMES, row)), t, x, v)
         np.testing.assert_allclose(forces, python, rtol=1e-9, atol=1e-9 * np.max(np.abs(python)))

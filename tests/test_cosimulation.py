@@ -10,7 +10,7 @@ sys.path.insert(0, str(REPO / "examples" / "cosim"))
 
 import shaker_rig  # noqa: E402
 from fmu_src.parameter_files import load_parameters  # noqa: E402
-from identification.compiled_core import simulate_population  # noqa: E402
+from identification.compiled_core import simulate_population_held  # noqa: E402
 
 STEP = 1e-3
 STOP = 0.15
@@ -43,12 +43,12 @@ def test_libcosim_applies_each_components_parameter_set(rig_runs, component):
     v_sent = np.concatenate([[0.0], libcosim[f"{shaker_rig.BODY}.v_rel"][:-1]]) * 1e3   # mm/s
     t = STEP * np.arange(x_sent.size + 1)
     params = load_parameters(system_dir / "resources" / f"{component}.ssv")
-    expected = simulate_population([params], t, np.append(x_sent, 0.0), np.append(v_sent, 0.0))[0, 1:]
+    expected = simulate_population_held([params], t, np.append(x_sent, 0.0), np.append(v_sent, 0.0))[0, 1:]
     force = libcosim[f"{component}.F"]
     np.testing.assert_allclose(force, expected, rtol=1e-9, atol=1e-9 * np.max(np.abs(expected)))
     default = load_parameters(REPO / "data" / "params_table5_combined.json")
     if params != default:
-        wrong = simulate_population([default], t, np.append(x_sent, 0.0), np.append(v_sent, 0.0))[0, 1:]
+        wrong = simulate_population_held([default], t, np.append(x_sent, 0.0), np.append(v_sent, 0.0))[0, 1:]
         assert np.max(np.abs(force - wrong)) > 0.01 * np.max(np.abs(force))
 
 

@@ -9,7 +9,7 @@ import build_fmu
 from fmu_harness import BushingFmu
 from fmu_src.bushing_models import MODELS
 from fmu_src.parameter_files import load_parameters
-from identification.compiled_core import simulate_model
+from identification.compiled_core import simulate_model_held
 from identification.protocols import Sine, sample_times
 from test_fmu_numerics import simulate_with_fmpy
 
@@ -46,7 +46,7 @@ def test_baseline_fmu_equals_the_model_through_fmpy(baseline_fmus, model):
     x, v = Sine(2.0, 10.0).signals(t)
     params = load_parameters(build_fmu.default_parameter_file(model), model)
     np.testing.assert_allclose(simulate_with_fmpy(baseline_fmus[model], t, x, v),
-                               simulate_model(model, params, t, x, v), rtol=1e-9, atol=1e-9)
+                               simulate_model_held(model, params, t, x, v), rtol=1e-9, atol=1e-9)
 
 
 @pytest.mark.parametrize("model", BASELINES)
@@ -99,6 +99,6 @@ def test_all_four_models_run_side_by_side_in_one_process(fmu_path, baseline_fmus
             forces[model].append(fmu.get("F"))
     for model in paths:
         params = load_parameters(build_fmu.default_parameter_file(model), model)
-        np.testing.assert_allclose(forces[model], simulate_model(model, params, t, x, v)[1:], rtol=1e-9, atol=1e-9)
+        np.testing.assert_allclose(forces[model], simulate_model_held(model, params, t, x, v)[1:], rtol=1e-9, atol=1e-9)
         instances[model].free()
     assert len({round(f[-1], 3) for f in forces.values()}) == 4

@@ -5,7 +5,7 @@ import pytest
 from conftest import paper_parameters
 from fmu_harness import BushingFmu
 from identification.protocols import Sine, sample_times
-from identification.simulate import simulate
+from python_core import simulate_python_core
 
 MM = 1e-3
 STEP = 1e-3
@@ -88,7 +88,7 @@ def test_instances_with_different_parameters_stay_independent(fmu_path):
             assert instance.step(x[k] * MM, v[k] * MM, STEP) == "ok"
             forces[name].append(instance.get("F"))
     for name, instance in zip(tables, instances):
-        np.testing.assert_allclose(forces[name], simulate(paper_parameters(name), t, x, v), rtol=1e-12, atol=1e-9)
+        np.testing.assert_allclose(forces[name], simulate_python_core(paper_parameters(name), t, x, v), rtol=1e-12, atol=1e-9)
         instance.free()
 
 
@@ -99,7 +99,7 @@ def test_two_builds_with_different_defaults_run_their_own_code_in_one_process(fm
         fmu = BushingFmu(path, v0_m_s=v[0] * MM)
         forces = [fmu.get("F")] + drive(fmu, 0, t.size - 1)
         fmu.free()
-        np.testing.assert_allclose(forces, simulate(paper_parameters(table), t, x, v), rtol=1e-12, atol=1e-9)
+        np.testing.assert_allclose(forces, simulate_python_core(paper_parameters(table), t, x, v), rtol=1e-12, atol=1e-9)
 
 
 def test_fmu_can_be_instantiated_many_times_after_its_extraction_was_deleted(fmu_path):

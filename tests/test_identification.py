@@ -7,7 +7,7 @@ import pytest
 from conftest import DATA, paper_parameters
 from fmu_src.bushing_params import PARAMETER_NAMES, ParameterError
 from fmu_src.parameter_files import load_parameters, save_parameters
-from identification.compiled_core import simulate_population
+from identification.compiled_core import simulate_population_held
 from identification.measurements import Measurement, MeasurementError, load_measurement
 from identification.objectives import Objective, StepTest, nrmse, rms_error
 from identification.protocols import Sine, Step, sample_times
@@ -69,7 +69,7 @@ def synthetic(params, protocol, duration_s, scale=1.0):
     """A measurement whose force is ``scale`` times the model's with ``params``."""
     t = sample_times(duration_s, 1000.0)
     x, v = protocol.signals(t)
-    force = simulate_population([params], t, x, v)[0]
+    force = simulate_population_held([params], t, x, v)[0]
     return Measurement(t, x, scale * force, v, source=f"{protocol}")
 
 
@@ -109,9 +109,9 @@ def test_rescaling_a_bouc_wen_block_leaves_the_force_unchanged():
     params = paper_parameters("table5")
     t = sample_times(0.3, 1000.0)
     x, v = Sine(2.0, 10.0).signals(t)
-    reference = simulate_population([params], t, x, v)[0]
+    reference = simulate_population_held([params], t, x, v)[0]
     for s1, s2 in ((3.7, 0.2), (0.05, 41.0)):
-        rescaled = simulate_population([rescale_hysteresis(params, s1, s2)], t, x, v)[0]
+        rescaled = simulate_population_held([rescale_hysteresis(params, s1, s2)], t, x, v)[0]
         np.testing.assert_allclose(rescaled, reference, rtol=1e-9, atol=1e-9 * np.max(np.abs(reference)))
     with pytest.raises(ValueError, match="s1"):
         rescale_hysteresis(params, -1.0, 1.0)
@@ -177,7 +177,7 @@ def test_fit_round_trip_through_the_cli_and_a_built_fmu(tmp_path):
 
     import build_fmu
     from identification.__main__ import main
-    from identification.simulate import simulate
+    from python_core import simulate_python_core
     from test_fmu_numerics import simulate_with_fmpy
 
     out, ssv = tmp_path / "fitted.json", tmp_path / "fitted.ssv"
@@ -194,7 +194,7 @@ def test_fit_round_trip_through_the_cli_and_a_built_fmu(tmp_path):
     for protocol, duration in ((Sine(1.0, 20.0), 0.5), (Sine(2.0, 10.0), 1.0)):
         t = sample_times(duration, 1000.0)
         x, v = protocol.signals(t)
-        assert nrmse(simulate_with_fmpy(fmu, t, x, v), simulate(truth, t, x, v)) < 0.01, protocol
+        assert nrmse(simulate_with_fmpy(fmu, t, x, v), simulate_python_core(truth, t, x, v)) < 0.01, protocol
 
 
 # -------------------------------------------------------------------- sensitivity and report

@@ -9,7 +9,7 @@ from fmu_src import bushing_core as core
 from fmu_src.bushing_models import MODELS
 from fmu_src.bushing_params import ParameterError, validate_parameters
 from identification.protocols import Random, Sine, Step, sample_times
-from identification.simulate import simulate
+from python_core import simulate_python_core
 
 
 def radau_error(params, protocol, duration_s, rate_hz):
@@ -18,7 +18,7 @@ def radau_error(params, protocol, duration_s, rate_hz):
     t = sample_times(duration_s, rate_hz)
     x, v = protocol.signals(t)
     reference = reference_force(params, t, x, v)
-    return np.max(np.abs(simulate(params, t, x, v) - reference)) / np.max(np.abs(reference))
+    return np.max(np.abs(simulate_python_core(params, t, x, v) - reference)) / np.max(np.abs(reference))
 
 
 @pytest.mark.parametrize("table", ["table2", "table4", "table5"])
@@ -55,7 +55,7 @@ def test_without_hysteresis_steady_sine_converges_to_analytic_complex_stiffness(
     for rate in (4000.0, 16000.0):
         t = sample_times(3.0, rate)
         x, v = Sine(amplitude, frequency).signals(t)
-        force = simulate(params, t, x, v)
+        force = simulate_python_core(params, t, x, v)
         analytic = np.imag(stiffness * amplitude * np.exp(1j * w * t))
         last_period = t >= 3.0 - 1.0 / frequency  # transients (slowest: 0.26 s) have died out
         errors.append(np.max(np.abs(force[last_period] - analytic[last_period])) / np.max(np.abs(analytic)))
