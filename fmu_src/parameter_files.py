@@ -1,7 +1,9 @@
 """Parameter sets on disk: the project's JSON and SSP 1.0 ParameterValues (``.ssv``), both ways.
 
 JSON: ``{"model": "<FMI identifier>", "units": "N-mm-s", "parameters": {name: value},
-"fit": {...provenance...}}``. SSV: an ``ssv:ParameterSet`` named after the model's FMI
+"fit": {...provenance...}}``. An ensemble (the parameter sets a fit cannot tell apart) is the
+same document with ``"ensemble": [{name: value}, ...]`` added; its ``parameters`` are the
+best member, so every reader of parameter files takes an ensemble file too. SSV: an ``ssv:ParameterSet`` named after the model's FMI
 identifier, one ``ssv:Real`` per parameter with its unit where SSP can express it (beta and
 gamma, in N^(1-n)/mm, carry none: SSP units need integer SI exponents). Values are written
 with ``repr`` and read back bit for bit.
@@ -34,6 +36,13 @@ class ParameterSet:
     provenance: dict = field(default_factory=dict)
 
 
+@dataclass
+class ParameterEnsemble:
+    model: BushingModel
+    members: list[dict[str, float]]   # the first is the best fit
+    provenance: dict = field(default_factory=dict)
+
+
 def load_parameters(path: str | Path, model: str | None = None) -> dict[str, float]:
     """The parameters in ``path`` (JSON or .ssv), checked against ``model`` if given (a
     command-line name such as ``"spencer"`` or an FMI identifier); without it, the model the
@@ -59,12 +68,54 @@ def read_parameter_set(path: str | Path, model: str | None = None) -> ParameterS
         raise ParameterError(f"{path}: {exc}") from None
 
 
-def _read_json(path: Path):
+def read_ensemble(path: str | Path, model: str | None = None) -> ParameterEnsemble:
+    """The members of an ensemble file (best first), or the one set of a parameter file
+    (JSON or .ssv), each validated like :func:`read_parameter_set`."""
+    path = Path(path)
+    best = read_parameter_set(path, model)
+    if path.suffix.lower() == ".ssv":
+        return ParameterEnsemble(best.model, [best.parameters], best.provenance)
+    members = _json_document(path).get("ensemble")
+    if members is None:
+        return ParameterEnsemble(best.model, [best.parameters], best.provenance)
+    if not isinstance(members, list) or not members or not all(isinstance(m, dict) for m in members):
+        raise ParameterError(f"{path}: 'ensemble' must be a non-empty list of parameter objects")
+    checked = []
+    for number, member in enumerate(members, start=1):
+        try:
+            checked.append(best.model.check(member))
+        except ParameterError as exc:
+            raise ParameterError(f"{path}, ensemble member {number}: {exc}") from None
+    return ParameterEnsemble(best.model, checked, best.provenance)
+
+
+def save_ensemble(path: str | Path, members, model: str = "proposed", provenance: Mapping | None = None) -> Path:
+    """Write an ensemble (best member first) as JSON; see the module docstring."""
+    path = Path(path)
+    if path.suffix.lower() == ".ssv":
+        raise ParameterError(f"{path}: an ensemble is written as JSON (.json), SSP holds one parameter set")
+    members = list(members)
+    if not members:
+        raise ParameterError("an ensemble needs at least one parameter set")
+    document = parameter_document(members[0], model, provenance)
+    document["ensemble"] = [get_model(model).check(member) for member in members]
+    path.write_text(json.dumps(document, indent=2) + "\n", encoding="utf-8")
+    return path
+
+
+def _json_document(path: Path) -> dict:
     try:
         document = json.loads(path.read_text(encoding="utf-8"))
     except json.JSONDecodeError as exc:
         raise ParameterError(f"parameter file {path} is not valid JSON: {exc}") from None
-    if not isinstance(document, dict) or not isinstance(document.get("parameters"), dict):
+    if not isinstance(document, dict):
+        raise ParameterError(f"parameter file {path} is not a JSON object")
+    return document
+
+
+def _read_json(path: Path):
+    document = _json_document(path)
+    if not isinstance(document.get("parameters"), dict):
         raise ParameterError(f"parameter file {path} has no 'parameters' object")
     units = document.get("units", UNIT_SYSTEM)
     if units != UNIT_SYSTEM:

@@ -1,36 +1,54 @@
-"""Command line: ``python -m identification fit ...`` (see ``--help``)."""
+"""Command line: ``python -m identification fit ...`` (see ``--help`` of each command)."""
 from __future__ import annotations
 
 import argparse
+import os
 import sys
+import warnings
 from pathlib import Path
 
 from fmu_src.bushing_models import MODEL_NAMES
 from fmu_src.bushing_params import ParameterError
-from fmu_src.parameter_files import read_parameter_set, save_parameters
+from fmu_src.parameter_files import read_parameter_set
+from identification.engine import EngineError
 from identification.measurements import MeasurementError, load_measurement
+from identification.rig_tests import load_manifest, training_tests
+
+
+class UsageError(Exception):
+    """A command-line option with a value that cannot be used."""
+
+
+def positive_int(text: str) -> int:
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{value} is not allowed: give an integer >= 1")
+    return value
+
+
+def positive_float(text: str) -> float:
+    value = float(text)
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"{value} is not allowed: give a number > 0")
+    return value
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m identification",
                                      description="Identify the bushing model's parameters from measured tests.")
     commands = parser.add_subparsers(dest="command", required=True)
-    fit_parser = commands.add_parser("fit", help="fit a model's parameters to sine (and step, random) tests")
-    fit_parser.add_argument("--model", default="proposed", choices=MODEL_NAMES,
+
+    fit_parser = commands.add_parser("fit", help="fit a model's parameters to rig tests, with convergence evidence")
+    fit_parser.add_argument("--model", choices=MODEL_NAMES,
                             help="proposed (the paper's 16 parameters, default), spencer, bouc_wen or "
-                                 "kelvin_voigt (linear least squares)")
+                                 "kelvin_voigt (linear least squares); default: the manifest's, else proposed")
     _add_training_arguments(fit_parser)
-    fit_parser.add_argument("--random", action="append", type=Path, default=[], metavar="FILE",
-                            help="random-input test CSV; repeatable")
-    fit_parser.add_argument("--preset", default="default", choices=["default", "paper"],
-                            help="default: differential evolution (about 21,000 evaluations); paper: the "
-                                 "paper's GA, population 300 x 200 generations")
-    fit_parser.add_argument("--seed", type=int, default=0)
-    fit_parser.add_argument("--popsize", type=int,
-                            help="override the preset's population (default preset: a multiplier of 14)")
-    fit_parser.add_argument("--maxiter", type=int, help="override the preset's number of generations")
+    _add_search_arguments(fit_parser)
     fit_parser.add_argument("--out", type=Path, required=True, help="parameter file to write (JSON)")
     fit_parser.add_argument("--ssv", type=Path, help="also write an SSP 1.0 ParameterValues file")
+    fit_parser.add_argument("--ensemble", type=Path,
+                            help="also write the ensemble: every parameter set within the 95 %% confidence threshold")
+    fit_parser.add_argument("--plots", type=Path, help="directory for the waterfall and the training tests' plots")
 
     sensitivity_parser = commands.add_parser(
         "sensitivity", help="rank the 16 parameters by local sensitivity (paper Tables 1 and 3)")
@@ -51,13 +69,11 @@ def main(argv: list[str] | None = None) -> int:
     compare_parser = commands.add_parser(
         "compare", help="fit several models on training tests and compare them on validation files")
     _add_training_arguments(compare_parser)
+    _add_search_arguments(compare_parser)
     compare_parser.add_argument("--validate", action="append", type=Path, default=[], metavar="FILE",
-                                help="validation test CSV; repeatable")
+                                help="validation test CSV; repeatable (default: the training files)")
     compare_parser.add_argument("--models", default=",".join(MODEL_NAMES),
                                 help=f"comma-separated models (default: {','.join(MODEL_NAMES)})")
-    compare_parser.add_argument("--preset", default="default", choices=["default", "paper"])
-    compare_parser.add_argument("--seed", type=int, default=0)
-    compare_parser.add_argument("--maxiter", type=int, help="override the preset's number of generations")
     compare_parser.add_argument("--out", type=Path, required=True,
                                 help="directory for the fitted parameter files, the table (CSV) and the plots")
 
@@ -70,45 +86,102 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "compare":
             return _compare(args)
         return _fit(args)
-    except (MeasurementError, ParameterError, ValueError) as exc:
+    except (MeasurementError, ParameterError, EngineError, UsageError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
 
 
 def _add_training_arguments(parser) -> None:
-    parser.add_argument("--sine", action="append", type=Path, required=True, metavar="FILE",
-                        help="training sine test CSV (time_s,displacement_mm,force_N[,velocity_mm_s]); repeatable")
-    parser.add_argument("--step", type=Path, metavar="FILE", help="training step test CSV")
-    parser.add_argument("--rise-time", type=float, metavar="S", help="rise time of the step test [s]")
+    group = parser.add_argument_group("training tests (CSV time_s,displacement_mm,force_N[,velocity_mm_s])")
+    group.add_argument("--sine", action="append", type=Path, default=[], metavar="FILE",
+                       help="sine test; repeatable")
+    group.add_argument("--step", action="append", type=Path, default=[], metavar="FILE",
+                       help="step test (a ramp, then held as long as the file says); repeatable")
+    group.add_argument("--rise-time", action="append", type=positive_float, default=[], metavar="S",
+                       help="rise time [s] of each --step, in the same order; repeatable")
+    group.add_argument("--random", action="append", type=Path, default=[], metavar="FILE",
+                       help="random-input test; repeatable")
+    group.add_argument("--tests", type=Path, metavar="MANIFEST",
+                       help='tests.json: {"sine": [...], "step": [{"file": ..., "rise_time_s": ...}], '
+                            '"random": [...], "model": ...}, paths relative to it')
+
+
+def _add_search_arguments(parser) -> None:
+    group = parser.add_argument_group("search")
+    group.add_argument("--preset", default="default", choices=["default", "paper"],
+                       help="default: screened Sobol starts + successive halving of trust-region least squares; "
+                            "paper: the paper's GA (300 x 200) instead of the screening")
+    group.add_argument("--seed", type=int, default=0, help="root seed of the search (default 0)")
+    group.add_argument("--screening", type=positive_int, metavar="N",
+                       help="Sobol points screened (default preset: 8192)")
+    group.add_argument("--starts", type=positive_int, metavar="N",
+                       help="least-squares starts of the first stage (default 128; later stages shrink in proportion)")
+    group.add_argument("--workers", type=positive_int, metavar="N",
+                       help=f"local worker processes (default: all {os.cpu_count()} cores)")
+    group.add_argument("--scheduler", metavar="ADDRESS",
+                       help="run the starts on a Dask cluster instead, e.g. tcp://10.0.0.5:8786")
+    group.add_argument("--quiet", action="store_true", help="no progress bars")
+
+
+def _training_tests(args):
+    """The tests of --sine/--step/--rise-time/--random or --tests, and the manifest's model."""
+    given = args.sine or args.step or args.random or args.rise_time
+    if args.tests is not None:
+        if given:
+            raise UsageError("give the tests either in --tests MANIFEST or as --sine/--step/--random, not both")
+        manifest = load_manifest(args.tests)
+        return manifest.tests, manifest.model
+    return training_tests(args.sine, args.step, args.rise_time, args.random), None
+
+
+def check_output(path: Path | None, option: str, directory: bool = False) -> None:
+    """Refuse, before any work, an output that cannot be written (exit 2, nothing lost)."""
+    if path is None:
+        return
+    folder = path if directory and path.exists() else path.parent
+    if path.exists() and directory != path.is_dir():
+        raise UsageError(f"{option} {path}: is {'a file' if directory else 'a directory'}, "
+                         f"expected {'a directory' if directory else 'a file'}")
+    if not (folder.resolve().is_dir() or (directory and folder.parent.resolve().is_dir())):
+        raise UsageError(f"{option} {path}: the directory {folder} does not exist")
+    check = folder if folder.exists() else folder.parent
+    if not os.access(check, os.W_OK) or (path.exists() and not os.access(path, os.W_OK)):
+        raise UsageError(f"{option} {path}: not writable")
 
 
 def _fit(args) -> int:
-    from identification.fit import fit
-    from identification.objectives import Objective, StepTest
-    from identification.report import data_errors, format_data_errors
+    from identification.fit import FitNotConvergedWarning, fit
+    from identification.plots import plot_comparison, plot_waterfall
+    from identification.simulate import simulate
 
-    if (args.step is None) != (args.rise_time is None):
-        raise ValueError("--step and --rise-time go together")
-    sines = [load_measurement(path) for path in args.sine]
-    step = StepTest(load_measurement(args.step), args.rise_time) if args.step else None
-    randoms = [load_measurement(path) for path in args.random]
-    objective = Objective(sines, step, randoms)
-    print(f"fitting the {args.model} model to {len(sines)} sine, {int(step is not None)} step and "
-          f"{len(randoms)} random test(s) (numba compiles the model on first use)", file=sys.stderr)
-    result = fit(objective, preset=args.preset, seed=args.seed, popsize=args.popsize, maxiter=args.maxiter,
-                 model=args.model)
-
-    provenance = result.provenance()
-    provenance["data"] = [str(path) for path in [*args.sine, *([args.step] if args.step else []), *args.random]]
-    save_parameters(args.out, result.parameters, args.model, provenance)
-    if args.ssv:
-        save_parameters(args.ssv, result.parameters, args.model)
-
-    print(f"objective E3 = {result.objective:.4e}   ({', '.join(f'{k} {v:.3e}' for k, v in result.terms.items())})")
-    tests = [*sines, *randoms, *([step.measurement] if step else [])]
-    print(format_data_errors(data_errors(result.parameters, tests, model=args.model)))
-    print(f"{result.evaluations} evaluations in {result.seconds:.1f} s; wrote {args.out}"
-          + (f" and {args.ssv}" if args.ssv else ""))
+    for path, option in ((args.out, "--out"), (args.ssv, "--ssv"), (args.ensemble, "--ensemble")):
+        check_output(path, option)
+    check_output(args.plots, "--plots", directory=True)
+    tests, manifest_model = _training_tests(args)
+    model = args.model or manifest_model or "proposed"
+    if model not in MODEL_NAMES:
+        raise UsageError(f"the manifest's model {model!r} is not one of {', '.join(MODEL_NAMES)}")
+    counts = {kind: sum(t.kind == kind for t in tests) for kind in ("sine", "step", "random")}
+    print(f"fitting the {model} model to {counts['sine']} sine, {counts['step']} step and {counts['random']} "
+          "random test(s)", file=sys.stderr)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", FitNotConvergedWarning)   # printed below as WARNING
+        result = fit(tests, model=model, preset=args.preset, seed=args.seed, workers=args.workers,
+                     scheduler=args.scheduler, progress=not args.quiet, screening=args.screening,
+                     starts=args.starts)
+    written = result.save(args.out, args.ssv, args.ensemble, data=[t.measurement.source for t in tests])
+    print(result.summary())
+    if args.plots:
+        if result.records:
+            written.append(plot_waterfall([r.misfit for r in result.records], [r.stage for r in result.records],
+                                          result.misfit, result.threshold, args.plots / "waterfall.png"))
+        for test in tests:
+            m = test.measurement
+            predicted = simulate(result.parameters, m.time_s, m.displacement_mm, m.measured_velocity_mm_s)
+            written.append(plot_comparison(m, {model: predicted}, args.plots / f"fit_{Path(m.source).stem}.png"))
+    print("wrote " + ", ".join(str(path) for path in written))
+    if not result.converged:
+        print(f"WARNING: {result.warning}", file=sys.stderr)
     return 0
 
 
@@ -129,7 +202,7 @@ def _report(args) -> int:
     parameter_set = read_parameter_set(args.params)
     params, model = parameter_set.parameters, parameter_set.model.name
     if not (args.data or args.truth):
-        raise ValueError("give --data files and/or --truth to report on")
+        raise UsageError("give --data files and/or --truth to report on")
     kelvin_voigt = None
     if args.kelvin_voigt_train:
         kelvin_voigt = KelvinVoigtFit.fit([load_measurement(path) for path in args.kelvin_voigt_train])
@@ -150,14 +223,15 @@ def _report(args) -> int:
 
 def _compare(args) -> int:
     from identification.compare import compare_models
-    if (args.step is None) != (args.rise_time is None):
-        raise ValueError("--step and --rise-time go together")
+    tests, _ = _training_tests(args)
     models = [name.strip() for name in args.models.split(",") if name.strip()]
     unknown = [name for name in models if name not in MODEL_NAMES]
     if unknown:
-        raise ValueError(f"unknown models {unknown}; choose from {', '.join(MODEL_NAMES)}")
-    compare_models(models, args.sine, args.step, args.rise_time, args.validate or [*args.sine], args.out,
-                   preset=args.preset, seed=args.seed, maxiter=args.maxiter)
+        raise UsageError(f"unknown models {unknown}; choose from {', '.join(MODEL_NAMES)}")
+    check_output(args.out, "--out", directory=True)
+    validation = args.validate or [Path(t.measurement.source) for t in tests]
+    compare_models(models, tests, validation, args.out, preset=args.preset, seed=args.seed, workers=args.workers,
+                   scheduler=args.scheduler, screening=args.screening, starts=args.starts)
     return 0
 
 

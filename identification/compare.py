@@ -10,47 +10,45 @@ from __future__ import annotations
 
 import csv
 import sys
-import time
+import warnings
 from pathlib import Path
 from typing import Sequence
 
 from fmu_src.bushing_models import get_model
-from fmu_src.parameter_files import save_parameters
+from identification.engine import make_engine
+from identification.fit import FitNotConvergedWarning, fit
 from identification.measurements import load_measurement
-from identification.objectives import Objective, StepTest, nrmse, rms_error
-from identification.report import plot_comparison
+from identification.objectives import nrmse, rms_error
+from identification.rig_tests import RigTest
+from identification.plots import plot_comparison
 from identification.simulate import simulate
 
 
-def compare_models(models: Sequence[str], sine_files: Sequence[Path], step_file: Path | None,
-                   rise_time_s: float | None, validation_files: Sequence[Path], out_dir: Path,
-                   preset: str = "default", seed: int = 0, maxiter: int | None = None) -> dict:
-    """Fit every model, evaluate it on every validation file; returns
+def compare_models(models: Sequence[str], tests: Sequence[RigTest], validation_files: Sequence[Path], out_dir: Path,
+                   preset: str = "default", seed: int = 0, workers: int | None = None, scheduler=None,
+                   screening: int | None = None, starts: int | None = None) -> dict:
+    """Fit every model on ``tests``, evaluate it on every validation file; returns
     ``{"parameters": {model: params}, "errors": {(file, model): (nrmse, eq10)}}``."""
-    from identification.fit import fit
-
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    sines = [load_measurement(path) for path in sine_files]
-    step = StepTest(load_measurement(step_file), rise_time_s) if step_file else None
     validation = [load_measurement(path) for path in validation_files]
-    objective = Objective(sines, step)
-
     parameters = {}
-    for model in models:
-        print(f"fitting {get_model(model).title} ...", file=sys.stderr)
-        started = time.perf_counter()
-        result = fit(objective, preset=preset, seed=seed, maxiter=maxiter, model=model)
-        provenance = result.provenance()
-        provenance["data"] = [str(p) for p in [*sine_files, *([step_file] if step_file else [])]]
-        save_parameters(out_dir / f"params_{model}.json", result.parameters, model, provenance)
-        parameters[model] = result.parameters
-        print(f"  E3 = {result.objective:.4e} in {time.perf_counter() - started:.0f} s", file=sys.stderr)
+    with make_engine(workers, scheduler) as engine, warnings.catch_warnings():
+        warnings.simplefilter("ignore", FitNotConvergedWarning)   # reported below, per model
+        for model in models:
+            print(f"fitting {get_model(model).title} ...", file=sys.stderr)
+            result = fit(tests, model=model, preset=preset, seed=seed, engine=engine, screening=screening,
+                         starts=starts)
+            result.save(out_dir / f"params_{model}.json", data=[t.measurement.source for t in tests])
+            parameters[model] = result.parameters.parameters
+            state = "converged" if result.converged else f"WARNING: {result.warning}"
+            print(f"  misfit {result.misfit:.4f} in {result.seconds:.0f} s; {state}", file=sys.stderr)
 
     errors = {}
     for m in validation:
         name = Path(m.source).name
-        predictions = {model: simulate(parameters[model], m.time_s, m.displacement_mm, m.measured_velocity_mm_s, model=model)
+        predictions = {model: simulate(parameters[model], m.time_s, m.displacement_mm, m.measured_velocity_mm_s,
+                                       model=model)
                        for model in models}
         for model, predicted in predictions.items():
             errors[name, model] = (nrmse(predicted, m.force_N), rms_error(predicted, m.force_N))

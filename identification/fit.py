@@ -1,239 +1,363 @@
-"""Fit a model's parameters: global search in the normalised space, then a local polish.
+"""Fit a model's parameters to training tests, and say how sure the fit is.
 
-``fit(objective, model="proposed") -> FitResult``; the baselines ``spencer`` and
-``bouc_wen`` go the same way in their own spaces, ``kelvin_voigt`` by linear least squares
-(:func:`fit_kelvin_voigt`). The ``default`` preset runs scipy's differential evolution
-with the whole population evaluated in one compiled call (``vectorized=True``); the
-``paper`` preset runs the paper's genetic algorithm (population 300, 200 generations,
-uniform crossover with probability 0.8, mutation probability 0.05 per coordinate) from
-pymoo. Both then polish with scipy's bounded ``least_squares`` on the residuals whose sum of
-squares is E3, from the best mutually distant candidates of the final population. The paper's constraints beta1 + gamma1 > 0 and beta2 - gamma2 > 0 are
-a penalty (an infeasible candidate scores 1e3 + its violation, worse than any feasible one);
-A >= 1 and beta >= 0 are bounds (``search_space``).
+``fit(tests, model="proposed", preset="default", seed=0, workers=None, scheduler=None)``:
+
+1. the noise level of every test from its own data (``identification.noise``);
+2. the search (``identification.multistart``): screened Sobol starts, then successive
+   halving of bounded trust-region least squares on the misfit (``identification.objectives``),
+   every start a task of the engine (``identification.engine``: this process, local worker
+   processes, or a Dask cluster; the same seed gives the same bits on each);
+3. the evidence (pyPESTO's multi-start practice): how many of the last stage's starts reach
+   the best misfit within the ensemble threshold, and whether every training test is at its
+   noise floor (NRMSE <= FLOOR_FACTOR x its noise level). A fit that is not both is
+   ``converged = False`` and says why (``FitResult.warning``);
+4. how sure (``identification.ensemble``): the singular values of the residual Jacobian and
+   the parameter sets within the 95 % confidence threshold.
+
+The ``paper`` preset replaces the Sobol screening by the paper's genetic algorithm (pymoo:
+population 300, 200 generations, uniform crossover 0.8, mutation probability 0.05 per
+coordinate) and keeps the rest. Kelvin-Voigt is fitted by linear least squares (the
+optimum is exact, so only the floor is checked).
 """
 from __future__ import annotations
 
+import sys
 import time
-from dataclasses import dataclass, field
+import warnings
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Sequence
 
 import numpy as np
-from scipy.optimize import differential_evolution, least_squares
 
 from fmu_src.bushing_models import get_model
+from fmu_src.parameter_files import ParameterSet, save_ensemble, save_parameters
 from identification.compiled_core import parameter_matrix
-from identification.objectives import Objective
+from identification.engine import make_engine
+from identification.ensemble import (Identifiability, ensemble_candidates, identifiability, misfit_threshold,
+                                     select_members)
+from identification.measurements import Measurement
+from identification.multistart import Problem, SearchSettings, StartRecord, jacobian, screen, successive_halving
+from identification.noise import NoiseEstimate, estimate_noise
+from identification.objectives import Objective, nrmse
+from identification.rig_tests import Manifest, RigTest
 from identification.search_space import KelvinVoigtFit, SearchSpace
+from identification.simulate import simulate
 
 PRESETS = {
-    # popsize is scipy's multiplier: 15 x 14 coordinates = 210 candidates per generation.
-    # rand1bin with dithered mutation explores more than scipy's best1bin: on the synthetic
-    # Table 5 tests it reached the noise floor for 3 of 3 seeds, best1bin for 1 of 3.
-    "default": {"popsize": 15, "maxiter": 100, "strategy": "rand1bin", "mutation": (0.5, 1.0),
-                "recombination": 0.9},
-    # The paper's GA (VisualDOC): 300 x 200 = 60,000 evaluations. "Probability of mutation 0.05"
-    # is read per coordinate (polynomial mutation), every individual being a candidate for it.
-    "paper": {"popsize": 300, "maxiter": 200, "crossover_probability": 0.8, "mutation_probability": 0.05},
+    "default": SearchSettings(screening=8192, stages=((128, 10), (24, 30), (6, 300))),
+    # the paper's GA as the global stage (its final population ranks the starts)
+    "paper": SearchSettings(screening=300, stages=((128, 10), (24, 30), (6, 300))),
 }
-INFEASIBLE = 1e3
-POLISH_STARTS = 6
+PAPER_GA = {"population": 300, "generations": 200, "crossover_probability": 0.8, "mutation_probability": 0.05}
+FLOOR_FACTOR = 1.25
+"""A test is at its noise floor when the fit's NRMSE on it is at most this times its noise level."""
+MIN_AGREEING = 2
+MIN_FINAL_STARTS = 3
+"""A reduced budget (``starts``) keeps at least this many starts to the end: with two, one
+stray start already makes the agreement fail."""
+
+
+class FitNotConvergedWarning(UserWarning):
+    """A fit that ended above the noise floor or whose starts do not agree."""
+
+
+@dataclass
+class TestFit:
+    """One training test at the fitted parameters."""
+    name: str
+    kind: str
+    noise: NoiseEstimate
+    nrmse: float
+
+    @property
+    def at_floor(self) -> bool:
+        return bool(self.nrmse <= FLOOR_FACTOR * self.noise.relative)
+
+    def as_dict(self) -> dict:
+        return {"file": self.name, "kind": self.kind, "noise_N": _round(self.noise.sigma_N),
+                "noise_fraction": _round(self.noise.relative), "nrmse": _round(self.nrmse),
+                "nrmse_over_noise": _round(self.nrmse / self.noise.relative), "at_floor": self.at_floor}
 
 
 @dataclass
 class FitResult:
-    parameters: dict[str, float]          # the model's, paper units, alpha = 1 representative
-    objective: float                      # E3 (dimensionless, see objectives)
-    terms: dict[str, float]
-    evaluations: int
-    seconds: float
+    parameters: ParameterSet               # the best fit, with its provenance
+    misfit: float                          # chi^2/n, 1 at the noise floor
+    tests: list[TestFit]
+    records: list[StartRecord]             # every start, the last stage's first, by misfit
+    threshold: float                       # misfit increase within the 95 % confidence region
+    ensemble: list[dict[str, float]]       # the best first
+    identifiability: Identifiability | None
     preset: str
     seed: int
-    space: SearchSpace | None   # None for the linear Kelvin-Voigt fit
-    history: list[float] = field(default_factory=list)  # best E3 after each generation
-    search_objective: float = float("nan")  # the global search's best E3, before the polish
-    model: str = "proposed"
+    evaluations: int
+    seconds: float
+    engine: str = "1 process"
+    space: SearchSpace | None = None
+    final_starts: int = 1
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def model(self) -> str:
+        return self.parameters.model.name
+
+    @property
+    def agreeing(self) -> int:
+        """Starts of the last stage whose misfit is within the threshold of the best."""
+        final = [r for r in self.records if r.stage == self.records[0].stage] if self.records else []
+        return int(sum(r.misfit <= self.misfit + self.threshold for r in final)) if final else 1
+
+    @property
+    def at_floor(self) -> bool:
+        return all(t.at_floor for t in self.tests)
+
+    @property
+    def converged(self) -> bool:
+        enough = self.agreeing >= MIN_AGREEING or self.space is None   # Kelvin-Voigt: exact optimum
+        return self.at_floor and enough
+
+    @property
+    def warning(self) -> str | None:
+        """The ``not converged`` message with its figures, or None."""
+        if self.converged:
+            return None
+        worst = max(self.tests, key=lambda t: t.nrmse / t.noise.relative)
+        reasons = []
+        if not self.at_floor:
+            reasons.append(f"training NRMSE {worst.nrmse:.2%} on {worst.name} is {worst.nrmse / worst.noise.relative:.2f}x "
+                           f"its noise level {worst.noise.relative:.2%} (the floor is {FLOOR_FACTOR}x)")
+        if self.space is not None and self.agreeing < MIN_AGREEING:
+            reasons.append(f"only {self.agreeing} of {self.final_starts} final starts reach the best misfit")
+        hint = ("more starts (--starts, --screening) may find a better optimum"
+                if self.space is not None and self.agreeing < MIN_AGREEING else
+                "the starts agree, so the model may not describe these data to their noise level "
+                "(or the noise estimate is low: correlated noise reads low)")
+        return f"not converged: {'; '.join(reasons)}; {hint}"
 
     def provenance(self) -> dict:
-        if self.model == "kelvin_voigt":
-            return {"method": "linear least squares F = k*x + c*v on the sine (and random) tests",
-                    "objective_E3": self.objective, "terms": self.terms, "seconds": round(self.seconds, 2)}
-        search = ("the paper's GA (pymoo)" if self.preset == "paper" else "differential evolution (rand1bin)")
-        return {"method": f"{search} + least_squares polish from the best {POLISH_STARTS} distinct "
-                          f"candidates (preset {self.preset!r})",
-                "seed": self.seed, "objective_E3": self.objective, "global_search_E3": self.search_objective,
-                "terms": self.terms,
-                "evaluations": self.evaluations, "seconds": round(self.seconds, 2),
-                "search_space": {"k_ref_N_per_mm": self.space.k_ref, "c_ref_Ns_per_mm": self.space.c_ref,
-                                 "F_ref_N": self.space.F_ref},
-                "note": ("alpha = 1 in every Bouc-Wen block: the (alpha, A, beta, gamma) redundancy "
-                         "(search_space.rescale_hysteresis gives the equivalent sets)" if self.space.normalise
-                         else "searched without normalisation: alpha free (redundant)")}
+        """What the parameter file records of the fit: everything but timings and engine, so
+        that the same seed gives the same file on any engine."""
+        out = {"method": self._method(), "preset": self.preset, "seed": self.seed,
+               "converged": self.converged, "misfit_chi2_per_residual": _round(self.misfit),
+               "tests": [t.as_dict() for t in self.tests]}
+        if self.space is not None:
+            out.update({"starts_agreeing": self.agreeing, "final_starts": self.final_starts,
+                        "agreement_threshold_misfit": _round(self.threshold),
+                        "ensemble_members": len(self.ensemble),
+                        "search_space": {"k_ref_N_per_mm": _round(self.space.k_ref),
+                                         "c_ref_Ns_per_mm": _round(self.space.c_ref),
+                                         "F_ref_N": _round(self.space.F_ref),
+                                         "shortest_time_constant_s": _round(self.space.shortest_time_constant_s)},
+                        "note": "alpha = 1 in every Bouc-Wen block: the (alpha, A, beta, gamma) redundancy "
+                                "(search_space.rescale_hysteresis gives the equivalent sets)"})
+        if self.identifiability is not None:
+            out["weak_directions"] = [{k: (_round(v) if not isinstance(v, dict) else {n: _round(x) for n, x in v.items()})
+                                       for k, v in entry.items()} for entry in self.identifiability.weakest()]
+        return out
+
+    def _method(self) -> str:
+        if self.space is None:
+            return "linear least squares F = k*x + c*v on the tests other than steps"
+        stages = ", ".join(f"{s} x {e}" for s, e in PRESETS[self.preset].stages)
+        first = ("the paper's GA (pymoo, population 300, 200 generations)" if self.preset == "paper"
+                 else f"{PRESETS[self.preset].screening} scrambled Sobol points")
+        return (f"{first}, then successive halving of bounded trust-region least squares "
+                f"(starts x evaluations: {stages}) on chi^2/n over every sample")
+
+    def summary(self) -> str:
+        """A report like lmfit's fit_report: figures first, then the warnings."""
+        lines = [f"{self.parameters.model.title} fitted to {len(self.tests)} test(s), preset {self.preset!r}, "
+                 f"seed {self.seed}, {self.evaluations} simulations in {self.seconds:.1f} s on {self.engine}",
+                 f"misfit chi^2/n = {self.misfit:.4f} (1 = the noise floor)"]
+        lines.append(f"{'test':44s} {'kind':7s} {'noise':>8s} {'NRMSE':>8s} {'ratio':>6s}  floor")
+        for t in self.tests:
+            lines.append(f"{t.name:44s} {t.kind:7s} {t.noise.relative:8.2%} {t.nrmse:8.2%} "
+                         f"{t.nrmse / t.noise.relative:6.2f}  {'yes' if t.at_floor else 'NO'}")
+        if self.space is not None:
+            lines.append(f"starts: {self.agreeing} of {self.final_starts} final starts agree (misfit within "
+                         f"{self.threshold:.2e} of the best: delta chi^2 at 95 % for {len(self.space.names)} parameters); "
+                         f"ensemble: {len(self.ensemble)} parameter sets")
+        if self.identifiability is not None:
+            lines.append(self.identifiability.format())
+        lines += self.notes
+        lines.append("converged: yes" if self.converged else f"converged: no ({self.warning})")
+        return "\n".join(lines)
+
+    def save(self, path: str | Path, ssv: str | Path | None = None, ensemble: str | Path | None = None,
+             data: Sequence[str] = ()) -> list[Path]:
+        """Write the parameter file (JSON with provenance), optionally an .ssv and the ensemble."""
+        provenance = dict(self.provenance(), data=[str(d) for d in data])
+        written = [save_parameters(path, self.parameters.parameters, self.model, provenance)]
+        if ssv is not None:
+            written.append(save_parameters(ssv, self.parameters.parameters, self.model))
+        if ensemble is not None:
+            written.append(save_ensemble(ensemble, self.ensemble, self.model, provenance))
+        return written
 
 
-def fit(objective: Objective, preset: str = "default", seed: int = 0, progress: bool = True,
-        space: SearchSpace | None = None, popsize: int | None = None, maxiter: int | None = None,
-        model: str = "proposed") -> FitResult:
-    """Identify the parameters of ``model`` minimising ``objective``; ``popsize``/``maxiter``
-    override the preset."""
-    model = get_model(model).name
-    if model == "kelvin_voigt":
-        return fit_kelvin_voigt(objective)
-    if preset not in PRESETS:
-        raise ValueError(f"unknown preset {preset!r}; choose one of {', '.join(PRESETS)}")
-    settings = dict(PRESETS[preset])
-    settings.update({k: v for k, v in (("popsize", popsize), ("maxiter", maxiter)) if v is not None})
-    space = space or SearchSpace.from_measurements(objective.sines, model=model)
-    bounds = space.bounds()
-    evaluations = 0
-    history: list[float] = []
+def as_tests(measurements) -> list[RigTest]:
+    """RigTests from a Manifest, RigTests, Measurements (kind ``random``) or file paths."""
+    from identification.measurements import load_measurement
+    if isinstance(measurements, Manifest):
+        return list(measurements.tests)
+    if isinstance(measurements, (RigTest, Measurement, str, Path)):
+        measurements = [measurements]
+    tests = []
+    for item in measurements:
+        if isinstance(item, RigTest):
+            tests.append(item)
+        elif isinstance(item, Measurement):
+            tests.append(RigTest(item))
+        else:
+            tests.append(RigTest(load_measurement(item)))
+    if not tests:
+        raise ValueError("no training tests given")
+    return tests
 
-    def penalised(theta: np.ndarray) -> np.ndarray:
-        nonlocal evaluations
-        theta = np.atleast_2d(theta)
-        evaluations += theta.shape[0]
-        violation = space.constraint_violation(theta)
-        values = np.full(theta.shape[0], np.inf)
-        feasible = violation == 0.0
-        if feasible.any():
-            values[feasible] = objective(space.to_parameters(theta[feasible]))
-        values[~feasible] = INFEASIBLE + violation[~feasible]
-        return values
 
-    bar = _progress_bar(settings["maxiter"], progress)
+def fit(measurements, model: str = "proposed", preset: str = "default", seed: int = 0, workers: int | None = None,
+        scheduler=None, engine=None, progress: bool = True, screening: int | None = None,
+        starts: int | None = None) -> FitResult:
+    """Identify ``model``'s parameters from training tests (see the module docstring).
+
+    ``measurements``: a ``rig_tests.Manifest``, ``RigTest``s, ``Measurement``s or CSV paths.
+    ``workers``/``scheduler``: where the starts run (default: every local core); ``engine``: an
+    engine to reuse (not closed). ``screening``, ``starts``: override the preset's number of
+    Sobol points and of first-stage starts (later stages shrink in proportion, at least
+    MIN_FINAL_STARTS remain). Emits a ``FitNotConvergedWarning`` when the fit is not converged.
+    """
     started = time.perf_counter()
-
-    def on_generation(best_value):
-        history.append(float(best_value))
-        bar.set_postfix_str(f"E3 {best_value:.3e}, {evaluations} evaluations")
-        bar.update(1)
-
-    if preset == "paper":
-        population, energies = _genetic_algorithm(penalised, space, bounds, settings, seed, on_generation)
+    tests = as_tests(measurements)
+    bushing = get_model(model)
+    noise = [estimate_noise(t.measurement.force_N) for t in tests]
+    if bushing.name == "kelvin_voigt":
+        result = _fit_kelvin_voigt(tests, noise, started)
     else:
-        search = differential_evolution(
-            lambda columns: penalised(columns.T), bounds, vectorized=True, updating="deferred",
-            popsize=settings["popsize"], maxiter=settings["maxiter"], strategy=settings["strategy"],
-            mutation=settings["mutation"], recombination=settings["recombination"], seed=seed,
-            polish=False, init="sobol", tol=1e-8, callback=_de_callback(on_generation))
-        population, energies = search.population, search.population_energies
-    bar.close()
-
-    # The polish does much of the work: run it from the best few mutually distant candidates
-    # of the final population (differential evolution can settle in one basin); keep the best.
-    starts = _diverse_starts(population, energies, bounds, POLISH_STARTS)
-    best_index = int(np.argmin(energies))
-    best, best_value = population[best_index], float(energies[best_index])
-    search_value = best_value
-    for start in starts:
-        polished, value, used = _polish(objective, space, start, bounds)
-        evaluations += used
-        if value < best_value:
-            best, best_value = polished, value
-    matrix = space.to_parameters(best)
-    terms = {name: float(values[0]) for name, values in objective.terms(matrix).items()}
-    parameters = dict(zip(space.bushing.parameter_names, map(float, space.to_model_parameters(best)[0])))
-    return FitResult(parameters, float(objective(matrix)[0]), terms, evaluations, time.perf_counter() - started,
-                     preset, seed, space, history, search_value, space.model)
+        if preset not in PRESETS:
+            raise ValueError(f"unknown preset {preset!r}; choose one of {', '.join(PRESETS)}")
+        settings = _settings(PRESETS[preset], screening, starts)
+        owned = engine is None
+        engine = engine or make_engine(workers, scheduler)
+        try:
+            result = _search(tests, noise, bushing.name, preset, settings, seed, engine, progress, started)
+        finally:
+            if owned:
+                engine.close()
+    if not result.converged:
+        warnings.warn(result.warning, FitNotConvergedWarning, stacklevel=2)
+    return result
 
 
-def fit_kelvin_voigt(objective: Objective) -> FitResult:
-    """F = k*x + c*v by linear least squares on the sine and random tests (no optimizer; the
-    step test, dominated by relaxation a linear spring cannot show, is left out). E3 is
-    reported on all tests, as for the other models."""
-    started = time.perf_counter()
-    line = KelvinVoigtFit.fit([*objective.sines, *objective.randoms])
-    parameters = {"k": line.k, "c": line.c, "preload": 0.0}
-    matrix = parameter_matrix([get_model("kelvin_voigt").core_parameters(parameters)])
-    terms = {name: float(values[0]) for name, values in objective.terms(matrix).items()}
-    return FitResult(parameters, float(objective(matrix)[0]), terms, 1, time.perf_counter() - started,
-                     "linear", 0, None, model="kelvin_voigt")
+def _settings(base: SearchSettings, screening: int | None, starts: int | None) -> SearchSettings:
+    if starts is not None:
+        if starts < 1:
+            raise ValueError(f"starts = {starts}: give 1 or more")
+        first = base.stages[0][0]
+        stages = tuple((max(min(MIN_FINAL_STARTS, starts), round(count * starts / first)) if i else starts, evaluations)
+                       for i, (count, evaluations) in enumerate(base.stages))
+        base = replace(base, stages=stages)
+    if screening is not None:
+        base = replace(base, screening=screening)
+    return SearchSettings(base.screening, base.stages)   # validates
 
 
-def _de_callback(on_generation):
-    # scipy hands the OptimizeResult only to a callback whose parameter has this exact name.
-    def callback(intermediate_result):
-        on_generation(intermediate_result.fun)
-    return callback
+def _search(tests, noise, model, preset, settings, seed, engine, progress, started) -> FitResult:
+    measurements = [t.measurement for t in tests]
+    space = SearchSpace.from_measurements(measurements, model, steps=[t.kind == "step" for t in tests])
+    problem = Problem(Objective(tests, noise), space)
+    ga_evaluations = PAPER_GA["population"] * PAPER_GA["generations"]
+    bars = _Progress(progress, settings, ga_evaluations if preset == "paper" else settings.screening)
+    if preset == "paper":
+        from identification.multistart import genetic_algorithm
+        theta, misfits = genetic_algorithm(problem, engine, seed, bars.screening, **PAPER_GA)
+    else:
+        theta, misfits = screen(problem, engine, settings.screening, seed, bars.screening)
+    evaluations = ga_evaluations if preset == "paper" else len(misfits)
+    records = successive_halving(problem, engine, theta, misfits, settings.stages, bars.stage)
+    bars.close()
+    evaluations += sum(r.evaluations - 1 for r in records)
+
+    best = min(records, key=lambda r: (r.misfit, r.start))
+    residuals, n, d = problem.objective.size, problem.objective.size, len(space.names)
+    threshold = misfit_threshold(best.misfit, residuals, d)
+    scaled_jacobian, _ = jacobian(problem, best.theta)
+    ident = identifiability(scaled_jacobian * np.sqrt(n), space.names, threshold * n)
+    candidates = ensemble_candidates(best.theta, ident, space.bounds())
+    candidate_misfits = problem.misfit(candidates)
+    evaluations += 2 * d + 1 + len(candidates)
+    members = select_members(best.theta, [(r.theta, r.misfit) for r in records], candidates, candidate_misfits,
+                             best.misfit + threshold, space.bounds())
+    rows = space.to_model_parameters(np.array(members))
+    names = space.bushing.parameter_names
+    ensemble = [dict(zip(names, map(float, row))) for row in rows]
+    parameters = ParameterSet(space.bushing, ensemble[0])
+    result = FitResult(parameters, float(best.misfit), _test_fits(tests, noise, parameters), records, threshold,
+                       ensemble, ident, preset, seed, evaluations, time.perf_counter() - started, engine.description,
+                       space, final_starts=settings.stages[-1][0])
+    result.parameters.provenance = result.provenance()
+    return result
 
 
-def _genetic_algorithm(penalised, space, bounds, settings, seed, on_generation):
-    """The paper's GA with pymoo; returns the final population and its objective values."""
-    from pymoo.algorithms.soo.nonconvex.ga import GA
-    from pymoo.core.callback import Callback
-    from pymoo.core.problem import Problem
-    from pymoo.operators.crossover.ux import UniformCrossover
-    from pymoo.operators.mutation.pm import PolynomialMutation
-    from pymoo.optimize import minimize
-
-    constraints = space.constraint_matrix()
-
-    class Identification(Problem):
-        def __init__(self):
-            super().__init__(n_var=bounds.shape[0], n_obj=1, n_ieq_constr=constraints.shape[0],
-                             xl=bounds[:, 0], xu=bounds[:, 1])
-
-        def _evaluate(self, theta, out, *args, **kwargs):
-            # pymoo handles the constraints itself (feasible first): g <= 0 is feasible.
-            out["F"] = np.minimum(penalised(theta), INFEASIBLE)
-            out["G"] = -(theta @ constraints.T)
-
-    class Progress(Callback):
-        def notify(self, algorithm):
-            on_generation(float(algorithm.opt.get("F").min()))
-
-    algorithm = GA(pop_size=settings["popsize"], crossover=UniformCrossover(prob=settings["crossover_probability"]),
-                   mutation=PolynomialMutation(prob=1.0, prob_var=settings["mutation_probability"]),
-                   eliminate_duplicates=True)
-    result = minimize(Identification(), algorithm, ("n_gen", settings["maxiter"]), seed=seed,
-                      callback=Progress(), verbose=False)
-    population = result.pop.get("X")
-    energies = result.pop.get("F")[:, 0].copy()
-    energies[result.pop.get("CV")[:, 0] > 0.0] = np.inf
-    return population, energies
+def _fit_kelvin_voigt(tests, noise, started) -> FitResult:
+    """F = k*x + c*v by linear least squares on the tests other than steps (a linear spring
+    cannot show the step's relaxation; all tests if there are only steps)."""
+    bushing = get_model("kelvin_voigt")
+    linear = KelvinVoigtFit.fit([t.measurement for t in tests if t.kind != "step"]
+                                or [t.measurement for t in tests])
+    values = {"k": linear.k, "c": linear.c, "preload": 0.0}
+    parameters = ParameterSet(bushing, values)
+    objective = Objective(tests, noise)
+    misfit = float(objective(parameter_matrix([bushing.core_parameters(values)]))[0])
+    result = FitResult(parameters, misfit, _test_fits(tests, noise, parameters), [], 0.0, [values], None,
+                       "linear", 0, 1, time.perf_counter() - started)
+    result.parameters.provenance = result.provenance()
+    return result
 
 
-def _diverse_starts(population, energies, bounds, count, min_distance=0.1):
-    """The best candidates that are at least ``min_distance`` apart (in coordinates scaled by
-    the bound ranges): the best few of a population often sit in one basin."""
-    scaled = (population - bounds[:, 0]) / (bounds[:, 1] - bounds[:, 0])
-    chosen: list[int] = []
-    for i in np.argsort(energies):
-        if not np.isfinite(energies[i]) or energies[i] >= INFEASIBLE:
-            break
-        if all(np.linalg.norm(scaled[i] - scaled[j]) >= min_distance for j in chosen):
-            chosen.append(int(i))
-            if len(chosen) == count:
-                break
-    return [population[i] for i in chosen]
+def _test_fits(tests, noise, parameters: ParameterSet) -> list[TestFit]:
+    fits = []
+    for test, level in zip(tests, noise):
+        m = test.measurement
+        predicted = simulate(parameters, m.time_s, m.displacement_mm, m.measured_velocity_mm_s)
+        fits.append(TestFit(test.name, test.kind, level, nrmse(predicted, m.force_N)))
+    return fits
 
 
-def _polish(objective: Objective, space: SearchSpace, start: np.ndarray, bounds: np.ndarray):
-    """Bounded least squares from ``start``; the forward-difference Jacobian is one population
-    call (the point and its 14 perturbations). Returns (coordinates, E3, evaluations)."""
-    low, high = bounds[:, 0], bounds[:, 1]
-    evaluations = 0
-
-    def residuals_of(theta_rows):
-        nonlocal evaluations
-        evaluations += len(theta_rows)
-        return objective.residual_matrix(space.to_parameters(theta_rows))
-
-    def fun(theta):
-        return residuals_of(theta[None, :])[0]
-
-    def jac(theta):
-        steps = 1e-6 * np.maximum(1.0, np.abs(theta))
-        steps = np.where(theta + steps > high, -steps, steps)  # stay inside the bounds
-        stencil = theta + np.diag(steps)
-        rows = residuals_of(np.vstack([theta[None, :], stencil]))
-        return ((rows[1:] - rows[0]) / steps[:, None]).T
-
-    result = least_squares(fun, np.clip(start, low, high), jac=jac, bounds=(low, high), method="trf",
-                           x_scale="jac", max_nfev=200)
-    if space.constraint_violation(result.x)[0] > 0.0:
-        return result.x, np.inf, evaluations
-    return result.x, 2.0 * result.cost, evaluations
+def _round(value):
+    """Floats as the parameter file stores them (12 significant digits: stable text)."""
+    return float(f"{value:.12g}") if isinstance(value, float) else value
 
 
-def _progress_bar(total: int, enabled: bool):
-    from tqdm import tqdm
-    return tqdm(total=total, desc="generations", unit="gen", disable=not enabled, leave=False)
+class _Progress:
+    """tqdm bars for the screening and each least-squares stage (on stderr)."""
+
+    def __init__(self, enabled: bool, settings: SearchSettings, screening_total: int):
+        self.enabled = enabled and sys.stderr is not None
+        self.settings = settings
+        self.screening_total = screening_total
+        self._bar = None
+        self._stage = None
+
+    def screening(self, count: int):
+        self._advance("screening", self.screening_total, "points", count)
+
+    def stage(self, index: int, count: int):
+        starts, evaluations = self.settings.stages[index]
+        self._advance(f"stage {index + 1}/{len(self.settings.stages)} ({starts} starts x {evaluations})", starts,
+                      "starts", count)
+
+    def _advance(self, name, total, unit, count):
+        if not self.enabled:
+            return
+        from tqdm import tqdm
+        if self._stage != name:
+            self.close()
+            self._bar = tqdm(total=total, desc=name, unit=unit, leave=False, file=sys.stderr)
+            self._stage = name
+        self._bar.update(count)
+
+    def close(self):
+        if self._bar is not None:
+            self._bar.close()
+            self._bar = None

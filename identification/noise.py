@@ -10,8 +10,11 @@ is the sum of the squared coefficients), while a smooth force sampled fast contr
 |F| (omega h)^8 / 113 per harmonic. The eighth order is needed: a bushing's force is rich in
 harmonics (the noise-free Table 5 force on a 3 mm, 30 Hz sine at 1 kHz reads as 0.46 % noise
 to the fourth difference, 0.07 % to the eighth). The noise level is the median absolute
-value of d over 0.6745 (the normal distribution's MAD), which ignores the few samples where
-the force has a corner (a step's ramp start and end), where d is large.
+value of d over 0.6745 (the normal distribution's MAD), refined by the rms of the d within
+three such levels, divided by the truncated normal's 0.9733 (as efficient as the rms, as robust
+as the median): it ignores the few samples where the force has a corner (a step's ramp start
+and end), where d is large. Its scatter for white noise is about 4.6 % (one standard
+deviation) over 1000 samples, 1.5 % over 10000.
 
 Assumptions: the noise is white (independent from sample to sample) and additive in N, and
 the force is smooth between samples. Noise that the rig's anti-aliasing filter has
@@ -26,6 +29,8 @@ import numpy as np
 
 _EIGHTH_DIFFERENCE = np.array([1.0, -8.0, 28.0, -56.0, 70.0, -56.0, 28.0, -8.0, 1.0]) / np.sqrt(12870.0)
 _NORMAL_MAD = 0.6744897501960817
+_TRIM = 3.0
+_TRIMMED_VARIANCE = 0.9733369246625415   # E[d^2 | |d| <= 3] for a standard normal d
 MIN_SAMPLES = 50
 
 
@@ -48,5 +53,7 @@ def estimate_noise(force_N) -> NoiseEstimate:
         raise ValueError(f"the noise estimate needs a 1-D force record of at least {MIN_SAMPLES} samples, "
                          f"got shape {force.shape}")
     differences = np.convolve(force, _EIGHTH_DIFFERENCE, mode="valid")
-    sigma = float(np.median(np.abs(differences)) / _NORMAL_MAD)
+    robust = float(np.median(np.abs(differences)) / _NORMAL_MAD)
+    kept = differences[np.abs(differences) <= _TRIM * robust]
+    sigma = float(np.sqrt(np.mean(kept ** 2) / _TRIMMED_VARIANCE)) if kept.size else robust
     return NoiseEstimate(sigma, float(np.sqrt(np.mean(force ** 2))))

@@ -17,6 +17,7 @@ from identification.measurements import Measurement
 from identification.objectives import nrmse, rms_error
 from identification.protocols import Random, Sine, Step, sample_times
 from identification.search_space import KelvinVoigtFit
+from identification.plots import plot_comparison
 from identification.simulate import simulate
 
 SINE_FREQUENCIES_HZ = (1.0, 10.0, 20.0, 30.0)
@@ -102,34 +103,3 @@ def plot_measurement(params: Mapping[str, float], measurement: Measurement, path
     if kelvin_voigt is not None:
         predictions["kelvin_voigt"] = kelvin_voigt.force(m.displacement_mm, m.velocity_mm_s)
     return plot_comparison(m, predictions, path)
-
-
-MODEL_STYLES = {"proposed": ("C0", "-"), "spencer": ("C2", "-."), "bouc_wen": ("C1", ":"),
-                "kelvin_voigt": ("C3", "--")}
-
-
-def plot_comparison(measurement: Measurement, predictions: dict, path: Path) -> Path:
-    """Measured and predicted force over time and against displacement (paper Figs. 15-17)."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    m = measurement
-    figure, (in_time, loop) = plt.subplots(1, 2, figsize=(12, 4.4))
-    in_time.plot(m.time_s, m.force_N / 1e3, color="0.55", lw=1.4, label="measured")
-    loop.plot(m.displacement_mm, m.force_N / 1e3, color="0.55", lw=1.2)
-    for model, predicted in predictions.items():
-        color, style = MODEL_STYLES.get(model, ("k", "-"))
-        label = f"{get_model(model).title} (NRMSE {nrmse(predicted, m.force_N):.1%})"
-        in_time.plot(m.time_s, predicted / 1e3, color=color, ls=style, lw=1.1, label=label)
-        loop.plot(m.displacement_mm, predicted / 1e3, color=color, ls=style, lw=1.0)
-    in_time.set(xlabel="time [s]", ylabel="force [kN]", title=Path(m.source).name)
-    loop.set(xlabel="displacement [mm]", ylabel="force [kN]", title="force-displacement")
-    in_time.legend(loc="best", fontsize=7)
-    for axes in (in_time, loop):
-        axes.grid(alpha=0.3)
-    figure.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    figure.savefig(path, dpi=90)
-    plt.close(figure)
-    return path

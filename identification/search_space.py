@@ -1,4 +1,4 @@
-"""Where the identification searches: a normalised, data-scaled space per model.
+"""Where the identification searches: a box of dimensionless coordinates, scaled by the data.
 
 Redundancy. In each Bouc-Wen block the map (alpha, A, beta, gamma) ->
 (alpha/s, s*A, s^(1-n)*beta, s^(1-n)*gamma) leaves the force unchanged (z scales by s), so
@@ -7,16 +7,32 @@ Spencer's 9 dynamic ones and 6 of the single Bouc-Wen's 7. The search fixes ever
 and maps back with alpha = 1; any other representative follows from
 :func:`rescale_hysteresis`. Spencer's x0 (a constant force) is fixed at 0.
 
-Coordinates (all dimensionless, scaled by the data so that another bushing, or a friction
-damper, needs no hand-tuning): log10(k / k_ref) of the stiffnesses and the gains A,
-log10(c / c_ref) of the dampings, beta * F_ref^n / k_ref and gamma * F_ref^n / k_ref of the
-shape parameters, and n itself, with k_ref [N/mm] and c_ref [N*s/mm] from a Kelvin-Voigt
-least-squares fit F = k*x + c*v of the sine tests and F_ref [N] their peak force. The
-paper's constraints become bounds (A >= 1, beta >= 0) and linear inequalities on the shape
-coordinates (beta1 + gamma1 > 0, beta2 - gamma2 > 0; beta + gamma > 0 for the baselines).
+Scales, from the data (so that another bushing, or a friction damper, needs no
+hand-tuning): k_ref [N/mm] and c_ref [N*s/mm] of a Kelvin-Voigt least-squares fit
+F = k*x + c*v of the tests other than steps (of the steps if there are no others), F_ref [N]
+their peak force, tau_ref = c_ref/k_ref [s].
+
+Coordinates, each with bounds (the box):
+
+- stiffness: log10(k/k_ref); gain: log10(A/k_ref), with A >= 1 N/mm (the paper's constraint);
+- damping: log10(c/c_ref);
+- time constant: log10(tau/tau_ref) of a dashpot over the stiffness it works against,
+  tau = c/(sum of those stiffnesses) (c1 over k0 + k1 + A1, c0 over k2 + A2 in the proposed
+  model). Its lower bound is TIME_CONSTANT_FLOOR times the sample interval: faster modes are
+  invisible in the samples and made fits drift to stiff corners (c1 -> 0.002 N*s/mm, a time
+  constant near 1e-7 s at 1 kHz) that no data support and that make every solver stiff;
+- shape: beta*F_ref^n/k_ref (beta >= 0, the paper's constraint);
+- shape sum: beta' + sign*gamma' of a block (gamma' = gamma*F_ref^n/k_ref), >= 0, which is the
+  paper's constraint beta1 + gamma1 > 0 (sign +1) and beta2 - gamma2 > 0 (sign -1) as a bound;
+- exponent: n.
+
+Every constraint is a bound, so bounded least squares and any box optimizer can search
+the space as it is. ``tests/test_search_space.py`` checks that the paper's Tables 2, 4, 5,
+each parameter moved by +-50 %, lie inside with a margin.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Mapping, Sequence
 
@@ -26,6 +42,8 @@ from fmu_src.bushing_models import get_model
 from identification.compiled_core import parameter_matrix
 from identification.measurements import Measurement
 
+TIME_CONSTANT_FLOOR = 0.01
+"""The smallest time constant searched, as a fraction of the (shortest) sample interval."""
 
 
 @dataclass(frozen=True)
@@ -49,107 +67,138 @@ class KelvinVoigtFit:
 @dataclass(frozen=True)
 class Coordinate:
     parameter: str
-    kind: str        # "stiffness" (log10 of k/k_ref), "damping" (log10 of c/c_ref), "gain"
-                     # (log10 of A/k_ref, A >= 1), "shape" (value*F_ref^n/k_ref), "exponent"
+    kind: str        # stiffness, gain, damping, time_constant, shape, shape_sum, exponent
     low: float
     high: float
-    exponent: str = ""   # for "shape": the parameter n of the same block
+    exponent: str = ""                  # shape, shape_sum: the block's n
+    over: tuple[str, ...] = ()          # time_constant: the stiffnesses the dashpot works against
+    partner: str = ""                   # shape_sum: the block's beta-like parameter
+    sign: float = 1.0                   # shape_sum: coordinate = partner' + sign*parameter'
 
 
 def _proposed_coordinates():
     return (Coordinate("k0", "stiffness", -3.0, 1.0), Coordinate("k1", "stiffness", -3.0, 1.0),
-            Coordinate("k2", "stiffness", -5.0, 0.0), Coordinate("c0", "damping", -4.0, 2.0),
-            Coordinate("c1", "damping", -4.0, 2.0), Coordinate("c2", "damping", -4.0, 2.0),
+            Coordinate("k2", "stiffness", -5.0, 0.0),
+            Coordinate("c0", "time_constant", -math.inf, 6.0, over=("k2", "A2")),
+            Coordinate("c1", "time_constant", -math.inf, 4.0, over=("k0", "k1", "A1")),
+            Coordinate("c2", "damping", -4.0, 2.0),
             Coordinate("A1", "gain", -4.0, 1.0), Coordinate("A2", "gain", -4.0, 1.0),
             Coordinate("beta1", "shape", 0.0, 20.0, "n1"), Coordinate("beta2", "shape", 0.0, 20.0, "n2"),
-            Coordinate("gamma1", "shape", -20.0, 20.0, "n1"), Coordinate("gamma2", "shape", -20.0, 20.0, "n2"),
-            Coordinate("n1", "exponent", 0.2, 1.5), Coordinate("n2", "exponent", 0.2, 1.5))
+            Coordinate("gamma1", "shape_sum", 0.0, 40.0, "n1", partner="beta1", sign=1.0),
+            Coordinate("gamma2", "shape_sum", 0.0, 40.0, "n2", partner="beta2", sign=-1.0),
+            Coordinate("n1", "exponent", 0.1, 1.5), Coordinate("n2", "exponent", 0.1, 1.5))
 
 
-# Per model: the searched coordinates, the alphas fixed at 1 by the normalisation, the
-# parameters fixed at 0, and the constraints as {coordinate parameter: coefficient} > 0.
+# Per model: the searched coordinates, the alphas fixed at 1 and the parameters fixed at 0.
 MODEL_SPACES = {
-    "proposed": (_proposed_coordinates(), ("alpha1", "alpha2"), (),
-                 ({"beta1": 1.0, "gamma1": 1.0}, {"beta2": 1.0, "gamma2": -1.0})),
-    # Spencer's gamma sits where eq. 1 has beta (bushing_models): gamma >= 0, gamma + beta > 0.
+    "proposed": (_proposed_coordinates(), ("alpha1", "alpha2"), ()),
+    # Spencer's gamma sits where eq. 1 has beta (bushing_models): gamma >= 0, gamma + beta > 0;
+    # its dashpot to ground c1 works against k0 and the Bouc-Wen element.
     "spencer": ((Coordinate("k0", "stiffness", -5.0, 1.0), Coordinate("k1", "stiffness", -3.0, 1.0),
-                 Coordinate("c0", "damping", -4.0, 2.0), Coordinate("c1", "damping", -4.0, 2.0),
+                 Coordinate("c0", "damping", -4.0, 2.0),
+                 Coordinate("c1", "time_constant", -math.inf, 6.0, over=("k0", "A")),
                  Coordinate("A", "gain", -4.0, 1.0), Coordinate("gamma", "shape", 0.0, 20.0, "n"),
-                 Coordinate("beta", "shape", -20.0, 20.0, "n"), Coordinate("n", "exponent", 0.2, 1.5)),
-                ("alpha",), ("x0",), ({"gamma": 1.0, "beta": 1.0},)),
+                 Coordinate("beta", "shape_sum", 0.0, 40.0, "n", partner="gamma", sign=1.0),
+                 Coordinate("n", "exponent", 0.1, 1.5)),
+                ("alpha",), ("x0",)),
     "bouc_wen": ((Coordinate("k0", "stiffness", -3.0, 1.0), Coordinate("c0", "damping", -4.0, 2.0),
                   Coordinate("A", "gain", -4.0, 1.0), Coordinate("beta", "shape", 0.0, 20.0, "n"),
-                  Coordinate("gamma", "shape", -20.0, 20.0, "n"), Coordinate("n", "exponent", 0.2, 1.5)),
-                 ("alpha",), (), ({"beta": 1.0, "gamma": 1.0},)),
+                  Coordinate("gamma", "shape_sum", 0.0, 40.0, "n", partner="beta", sign=1.0),
+                  Coordinate("n", "exponent", 0.1, 1.5)),
+                 ("alpha",), ()),
 }
+_ORDER = ("stiffness", "gain", "damping", "exponent", "time_constant", "shape", "shape_sum")
+"""The order in which coordinates are mapped to parameters: each kind needs only earlier ones."""
 
 
 @dataclass(frozen=True)
 class SearchSpace:
-    k_ref: float   # N/mm
-    c_ref: float   # N*s/mm
-    F_ref: float   # N
-    normalise: bool = True
-    """False searches log10(alpha) in [-3, 1] too: only for measuring what the normalisation
-    is worth (benchmarks/bench_normalisation.py)."""
+    k_ref: float                  # N/mm
+    c_ref: float                  # N*s/mm
+    F_ref: float                  # N
+    sample_interval_s: float      # the shortest median sample interval of the tests
     model: str = "proposed"
 
     @classmethod
-    def from_measurements(cls, sines: Sequence[Measurement], normalise: bool = True,
-                          model: str = "proposed") -> "SearchSpace":
+    def from_measurements(cls, measurements: Sequence[Measurement], model: str = "proposed",
+                          steps: Sequence[bool] = ()) -> "SearchSpace":
+        """The space for these tests; ``steps`` marks which are step tests (left out of the
+        scales unless all are)."""
         if model not in MODEL_SPACES:
             raise ValueError(f"no search space for the {model!r} model; choose one of {', '.join(MODEL_SPACES)} "
                              "(kelvin_voigt is fitted by linear least squares)")
-        kelvin_voigt = KelvinVoigtFit.fit(sines)
-        peak = max(float(np.max(np.abs(m.force_N))) for m in sines)
-        amplitude = max(float(np.max(np.abs(m.displacement_mm))) for m in sines)
+        steps = list(steps) or [False] * len(measurements)
+        scaling = [m for m, is_step in zip(measurements, steps) if not is_step] or list(measurements)
+        kelvin_voigt = KelvinVoigtFit.fit(scaling)
+        peak = max(float(np.max(np.abs(m.force_N))) for m in scaling)
+        amplitude = max(float(np.max(np.abs(m.displacement_mm))) for m in scaling)
         # A hysteretic element can show a near-zero or negative Kelvin-Voigt damping or
-        # stiffness; fall back to the secant stiffness and a 1 s time scale then.
+        # stiffness; fall back to the secant stiffness and a 10 ms time scale then.
         k_ref = abs(kelvin_voigt.k) if kelvin_voigt.k > 0 else peak / amplitude
         c_ref = abs(kelvin_voigt.c) if kelvin_voigt.c > 0 else k_ref * 0.01
-        return cls(k_ref, c_ref, peak, normalise, model)
+        interval = min(float(np.median(np.diff(m.time_s))) for m in measurements)
+        return cls(k_ref, c_ref, peak, interval, model)
 
     @property
     def coordinates(self) -> tuple[Coordinate, ...]:
-        searched, alphas, _, _ = MODEL_SPACES[self.model]
-        if self.normalise:
-            return searched
-        return searched + tuple(Coordinate(name, "alpha", -3.0, 1.0) for name in alphas)
+        return MODEL_SPACES[self.model][0]
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return tuple(c.parameter for c in self.coordinates)
 
     @property
     def bushing(self):
         return get_model(self.model)
 
+    @property
+    def tau_ref(self) -> float:
+        return self.c_ref / self.k_ref
+
+    @property
+    def shortest_time_constant_s(self) -> float:
+        return TIME_CONSTANT_FLOOR * self.sample_interval_s
+
     def bounds(self) -> np.ndarray:
         """(d, 2) lower and upper bounds of the coordinates (d = 14 for the proposed model)."""
-        log_A_low = max(np.log10(1.0 / self.k_ref), -4.0)  # A >= 1 N/mm (paper)
-        return np.array([(max(c.low, log_A_low), c.high) if c.kind == "gain" else (c.low, c.high)
-                         for c in self.coordinates])
+        log_A_low = max(math.log10(1.0 / self.k_ref), -4.0)  # A >= 1 N/mm (paper)
+        log_tau_low = math.log10(self.shortest_time_constant_s / self.tau_ref)
+        rows = []
+        for c in self.coordinates:
+            if c.kind == "gain":
+                rows.append((max(c.low, log_A_low), c.high))
+            elif c.kind == "time_constant":
+                rows.append((max(c.low, log_tau_low), c.high))
+            else:
+                rows.append((c.low, c.high))
+        return np.array(rows)
 
     def to_model_parameters(self, coordinates: np.ndarray) -> np.ndarray:
         """(P, d) coordinates -> (P, m) parameters of the model, in its parameter order."""
-        theta = np.atleast_2d(coordinates)
+        theta = np.atleast_2d(np.asarray(coordinates, dtype=float))
         names = self.bushing.parameter_names
-        out = np.zeros((theta.shape[0], len(names)))   # fixed parameters (x0) stay 0
-        index = {name: i for i, name in enumerate(names)}
-        column = {c.parameter: i for i, c in enumerate(self.coordinates)}
+        value = {name: np.zeros(theta.shape[0]) for name in names}   # fixed parameters (x0) stay 0
         for name in MODEL_SPACES[self.model][1]:
-            out[:, index[name]] = 1.0
-        for i, c in enumerate(self.coordinates):
+            value[name] = np.ones(theta.shape[0])
+        column = {c.parameter: i for i, c in enumerate(self.coordinates)}
+        for c in sorted(self.coordinates, key=lambda c: _ORDER.index(c.kind)):
+            u = theta[:, column[c.parameter]]
             if c.kind == "stiffness":
-                out[:, index[c.parameter]] = self.k_ref * 10.0 ** theta[:, i]
-            elif c.kind == "damping":
-                out[:, index[c.parameter]] = self.c_ref * 10.0 ** theta[:, i]
+                value[c.parameter] = self.k_ref * 10.0 ** u
             elif c.kind == "gain":
                 # A >= 1 N/mm (paper); the clamp keeps rounding at the bound from crossing it.
-                out[:, index[c.parameter]] = np.maximum(self.k_ref * 10.0 ** theta[:, i], 1.0)
-            elif c.kind == "shape":
-                out[:, index[c.parameter]] = theta[:, i] * self.k_ref / self.F_ref ** theta[:, column[c.exponent]]
+                value[c.parameter] = np.maximum(self.k_ref * 10.0 ** u, 1.0)
+            elif c.kind == "damping":
+                value[c.parameter] = self.c_ref * 10.0 ** u
             elif c.kind == "exponent":
-                out[:, index[c.parameter]] = theta[:, i]
-            else:  # "alpha"
-                out[:, index[c.parameter]] = 10.0 ** theta[:, i]
-        return out
+                value[c.parameter] = u
+            elif c.kind == "time_constant":
+                value[c.parameter] = self.tau_ref * 10.0 ** u * sum(value[name] for name in c.over)
+            elif c.kind == "shape":
+                value[c.parameter] = u * self._shape_scale(value[c.exponent])
+            else:  # shape_sum: u = partner' + sign*parameter'
+                value[c.parameter] = c.sign * (u * self._shape_scale(value[c.exponent]) - value[c.partner])
+        return np.column_stack([value[name] for name in names])
 
     def to_parameters(self, coordinates: np.ndarray) -> np.ndarray:
         """(P, d) coordinates -> (P, 16) parameters of the core that simulate the model
@@ -161,43 +210,37 @@ class SearchSpace:
         return parameter_matrix([bushing.core_parameters(dict(zip(names, row))) for row in rows])
 
     def to_coordinates(self, params: Mapping[str, float]) -> np.ndarray:
-        """The inverse of :meth:`to_model_parameters` (after rescaling every alpha to 1 when
-        normalised)."""
+        """The inverse of :meth:`to_model_parameters` (after rescaling every alpha to 1)."""
         p = dict(params)
-        if self.normalise and self.model == "proposed":
-            p = rescale_hysteresis(p, p["alpha1"], p["alpha2"])
-        elif self.normalise:
-            p = _rescale_block(p, "", p["alpha"])
+        p = rescale_hysteresis(p, p["alpha1"], p["alpha2"]) if self.model == "proposed" else \
+            _rescale_block(p, "", p["alpha"])
         theta = []
         for c in self.coordinates:
             value = p[c.parameter]
-            if c.kind == "stiffness" or c.kind == "gain":
-                theta.append(np.log10(value / self.k_ref) if value > 0 else -np.inf)
+            if c.kind in ("stiffness", "gain"):
+                theta.append(math.log10(value / self.k_ref) if value > 0 else -math.inf)
             elif c.kind == "damping":
-                theta.append(np.log10(value / self.c_ref))
-            elif c.kind == "shape":
-                theta.append(value * self.F_ref ** p[c.exponent] / self.k_ref)
+                theta.append(math.log10(value / self.c_ref) if value > 0 else -math.inf)
             elif c.kind == "exponent":
                 theta.append(value)
+            elif c.kind == "time_constant":
+                stiffness = sum(p[name] for name in c.over)
+                theta.append(math.log10(value / stiffness / self.tau_ref) if value > 0 else -math.inf)
+            elif c.kind == "shape":
+                theta.append(value / self._shape_scale(p[c.exponent]))
             else:
-                theta.append(np.log10(value))
+                theta.append((p[c.partner] + c.sign * value) / self._shape_scale(p[c.exponent]))
         return np.array(theta)
 
-    def constraint_matrix(self) -> np.ndarray:
-        """(constraints, d): candidate theta is feasible where matrix @ theta > 0. The shape
-        coordinates share one positive scale per block, so the signs carry over."""
-        column = {c.parameter: i for i, c in enumerate(self.coordinates)}
-        constraints = MODEL_SPACES[self.model][3]
-        matrix = np.zeros((len(constraints), len(self.coordinates)))
-        for row, constraint in enumerate(constraints):
-            for name, coefficient in constraint.items():
-                matrix[row, column[name]] = coefficient
-        return matrix
-
-    def constraint_violation(self, coordinates: np.ndarray) -> np.ndarray:
-        """How far each candidate is from the constraints (0 if it meets them)."""
+    def inside(self, coordinates: np.ndarray) -> np.ndarray:
+        """Whether each row of coordinates lies in the box."""
         theta = np.atleast_2d(coordinates)
-        return np.maximum(0.0, -(theta @ self.constraint_matrix().T)).sum(axis=1)
+        bounds = self.bounds()
+        return np.all((theta >= bounds[:, 0]) & (theta <= bounds[:, 1]), axis=1)
+
+    def _shape_scale(self, n):
+        """beta = coordinate * k_ref / F_ref^n: the shape parameters' scale [N^(1-n)/mm]."""
+        return self.k_ref / self.F_ref ** n
 
 
 def rescale_hysteresis(params: Mapping[str, float], s1: float, s2: float) -> dict[str, float]:

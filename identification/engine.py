@@ -1,0 +1,157 @@
+"""Where the fit's tasks run: in this process, in local worker processes, or on a Dask cluster.
+
+One small interface: ``engine.map(function, items, shared)`` calls ``function(shared, item)``
+for every item and returns the results in the order of the items, whatever order they
+finish in. ``shared`` (the objective, a few hundred kB) travels once per chunk of items
+(processes) or once per worker (Dask), not once per item. ``function`` must be a module-level
+function. Tasks carry everything they need, seeds included, so every engine returns the
+same bits: each task runs with one BLAS thread (a multi-threaded BLAS may sum in another
+order) and, in worker processes, one numba thread (the cores are used by the processes).
+
+- :class:`SerialEngine`: this process (``--workers 1``).
+- :class:`ProcessEngine`: ``workers`` local processes (``--workers N``; processes, not
+  threads, because of the GIL), started with ``spawn`` (numba's thread pool is not safe
+  to fork).
+- :class:`DaskEngine`: a ``dask.distributed`` cluster (``--scheduler ADDRESS``), e.g.
+  ``dask scheduler`` on one machine and ``dask worker ADDRESS --nthreads 1`` on each core's
+  worth of the others. A scheduler that does not answer, or has no workers, is an
+  :class:`EngineError` after ``timeout_s``, not a hang.
+"""
+from __future__ import annotations
+
+import os
+from typing import Callable, Sequence
+
+CHUNKS_PER_WORKER = 4
+"""Items are sent in about this many chunks per worker: fewer copies of ``shared``, still
+enough chunks to balance starts of unequal cost."""
+DEFAULT_TIMEOUT_S = 20.0
+
+
+class EngineError(RuntimeError):
+    """The engine cannot run tasks (e.g. the Dask scheduler cannot be reached)."""
+
+
+def _run_chunk(function: Callable, shared, chunk: Sequence, single_threaded: bool) -> list:
+    from threadpoolctl import threadpool_limits
+    if single_threaded:
+        import numba
+        numba.set_num_threads(1)
+    with threadpool_limits(limits=1):
+        return [function(shared, item) for item in chunk]
+
+
+def _chunks(items: Sequence, count: int) -> list[list]:
+    count = max(1, min(count, len(items)))
+    size, extra = divmod(len(items), count)
+    out, start = [], 0
+    for i in range(count):
+        end = start + size + (1 if i < extra else 0)
+        out.append(list(items[start:end]))
+        start = end
+    return out
+
+
+class SerialEngine:
+    """Runs every task here, one after the other."""
+    workers = 1
+    description = "1 process"
+
+    def map(self, function: Callable, items: Sequence, shared=None, progress: Callable[[int], None] | None = None):
+        results = []
+        for chunk in _chunks(items, max(1, len(items) // 64)):
+            results += _run_chunk(function, shared, chunk, single_threaded=False)
+            if progress:
+                progress(len(chunk))
+        return results
+
+    def close(self):
+        pass
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+class ProcessEngine(SerialEngine):
+    """Runs tasks in ``workers`` local processes."""
+
+    def __init__(self, workers: int):
+        import multiprocessing
+        from concurrent.futures import ProcessPoolExecutor
+        if workers < 2:
+            raise ValueError(f"a process engine needs 2 or more workers, not {workers}")
+        self.workers = workers
+        self.description = f"{workers} local processes"
+        self._pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"))
+
+    def map(self, function, items, shared=None, progress=None):
+        from concurrent.futures import as_completed
+        chunks = _chunks(items, self.workers * CHUNKS_PER_WORKER)
+        futures = {self._pool.submit(_run_chunk, function, shared, chunk, True): i for i, chunk in enumerate(chunks)}
+        results: list = [None] * len(chunks)
+        for future in as_completed(futures):
+            index = futures[future]
+            results[index] = future.result()
+            if progress:
+                progress(len(chunks[index]))
+        return [result for chunk in results for result in chunk]
+
+    def close(self):
+        self._pool.shutdown(cancel_futures=True)
+
+
+class DaskEngine(SerialEngine):
+    """Runs tasks on a ``dask.distributed`` cluster: a scheduler address or a ``Client``."""
+
+    def __init__(self, scheduler, timeout_s: float = DEFAULT_TIMEOUT_S):
+        from dask.distributed import Client
+        self._own_client = not isinstance(scheduler, Client)
+        if self._own_client:
+            try:
+                self._client = Client(scheduler, timeout=f"{timeout_s}s", set_as_default=False)
+            except (OSError, TimeoutError) as exc:
+                raise EngineError(f"cannot reach the Dask scheduler at {scheduler!r} within {timeout_s:g} s ({exc}); "
+                                  "start one with `dask scheduler` and workers with "
+                                  "`dask worker ADDRESS --nthreads 1`") from None
+        else:
+            self._client = scheduler
+        try:
+            self._client.wait_for_workers(1, timeout=timeout_s)
+        except (OSError, TimeoutError):
+            self.close()
+            raise EngineError(f"the Dask scheduler at {self._client.scheduler.address} has no workers after "
+                              f"{timeout_s:g} s; start some with `dask worker ADDRESS --nthreads 1`") from None
+        self.workers = max(1, sum(self._client.nthreads().values()))
+        self.description = f"Dask cluster {self._client.scheduler.address} ({self.workers} worker threads)"
+
+    def map(self, function, items, shared=None, progress=None):
+        from dask.distributed import as_completed
+        shared_future = self._client.scatter(shared, broadcast=True, hash=False)
+        chunks = _chunks(items, self.workers * CHUNKS_PER_WORKER)
+        futures = [self._client.submit(_run_chunk, function, shared_future, chunk, True, pure=False)
+                   for chunk in chunks]
+        if progress:
+            index = {future.key: i for i, future in enumerate(futures)}
+            for future in as_completed(futures):
+                progress(len(chunks[index[future.key]]))
+        results = self._client.gather(futures)
+        return [result for chunk in results for result in chunk]
+
+    def close(self):
+        if self._own_client:
+            self._client.close()
+
+
+def make_engine(workers: int | None = None, scheduler=None, timeout_s: float = DEFAULT_TIMEOUT_S):
+    """The engine for ``--workers N`` (default: every core here) or ``--scheduler ADDRESS``."""
+    if scheduler is not None:
+        if workers is not None:
+            raise ValueError("give either a number of workers or a Dask scheduler, not both")
+        return DaskEngine(scheduler, timeout_s)
+    workers = workers if workers is not None else (os.cpu_count() or 1)
+    if workers < 1:
+        raise ValueError(f"workers = {workers}: give 1 or more")
+    return SerialEngine() if workers == 1 else ProcessEngine(workers)

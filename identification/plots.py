@@ -1,0 +1,81 @@
+"""Figures: measured and predicted forces (paper Figs. 9-19), the multi-start waterfall, the
+ensemble's prediction band. Every function writes a PNG and returns its path."""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+
+from fmu_src.bushing_models import get_model
+from identification.measurements import Measurement
+from identification.objectives import nrmse
+
+MODEL_STYLES = {"proposed": ("C0", "-"), "spencer": ("C2", "-."), "bouc_wen": ("C1", ":"),
+                "kelvin_voigt": ("C3", "--")}
+
+
+def _pyplot():
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    return plt
+
+
+def _save(figure, path) -> Path:
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    figure.savefig(path, dpi=90)
+    _pyplot().close(figure)
+    return path
+
+
+def plot_comparison(measurement: Measurement, predictions: dict, path: Path, band: tuple | None = None) -> Path:
+    """Measured and predicted force over time and against displacement (paper Figs. 15-17);
+    ``band``: (lower, upper) force [N] of an ensemble, shaded around the first prediction."""
+    plt = _pyplot()
+    m = measurement
+    figure, (in_time, loop) = plt.subplots(1, 2, figsize=(12, 4.4))
+    in_time.plot(m.time_s, m.force_N / 1e3, color="0.55", lw=1.4, label="measured")
+    loop.plot(m.displacement_mm, m.force_N / 1e3, color="0.55", lw=1.2)
+    if band is not None:
+        lower, upper = band
+        in_time.fill_between(m.time_s, lower / 1e3, upper / 1e3, color="C0", alpha=0.25, lw=0,
+                             label="ensemble band")
+    for model, predicted in predictions.items():
+        color, style = MODEL_STYLES.get(model, ("k", "-"))
+        label = f"{get_model(model).title} (NRMSE {nrmse(predicted, m.force_N):.1%})"
+        in_time.plot(m.time_s, predicted / 1e3, color=color, ls=style, lw=1.1, label=label)
+        loop.plot(m.displacement_mm, predicted / 1e3, color=color, ls=style, lw=1.0)
+    in_time.set(xlabel="time [s]", ylabel="force [kN]", title=Path(m.source).name)
+    loop.set(xlabel="displacement [mm]", ylabel="force [kN]", title="force-displacement")
+    in_time.legend(loc="best", fontsize=7)
+    for axes in (in_time, loop):
+        axes.grid(alpha=0.3)
+    figure.tight_layout()
+    return _save(figure, path)
+
+
+def plot_waterfall(misfits: Sequence[float], stages: Sequence[int], best: float, threshold: float,
+                   path: Path) -> Path:
+    """pyPESTO's waterfall: every start's final misfit, sorted, coloured by the last stage it
+    ran in; the band up to the agreement threshold shaded. Starts on the plateau at the left
+    found the same optimum."""
+    plt = _pyplot()
+    misfits = np.asarray(misfits, dtype=float)
+    stages = np.asarray(stages)
+    order = np.argsort(misfits, kind="stable")
+    figure, axes = plt.subplots(figsize=(7, 4.2))
+    finite = np.isfinite(misfits[order])
+    for stage in sorted(set(stages.tolist())):
+        chosen = (stages[order] == stage) & finite
+        axes.semilogy(np.flatnonzero(chosen) + 1, misfits[order][chosen], "o", ms=4,
+                      label=f"ended in stage {stage + 1}")
+    axes.axhspan(best, best + threshold, color="C2", alpha=0.25, label="within the ensemble threshold")
+    axes.axhline(1.0, color="0.3", ls="--", lw=1, label="noise floor (misfit 1)")
+    axes.set(xlabel="start, sorted by final misfit", ylabel="misfit chi^2/n",
+             title="multi-start waterfall")
+    axes.grid(alpha=0.3, which="both")
+    axes.legend(fontsize=8)
+    figure.tight_layout()
+    return _save(figure, path)
