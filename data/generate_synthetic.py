@@ -1,6 +1,8 @@
 """Generate the SYNTHETIC measurement files in data/ (not real test-rig data).
 
-    python data/generate_synthetic.py [--params FILE] [--prefix NAME] [--seed N]
+    python data/generate_synthetic.py [--params FILE] [--prefix NAME] [--seed N] [--force-noise F]
+                                      [--sine AMPLITUDE_MM,FREQUENCY_HZ ...] [--step AMPLITUDE_MM,RISE_S ...]
+                                      [--out-dir DIR]
 
 Truth: the continuous-time model (``identification.simulate`` on the analytic displacement and
 velocity of the protocol, 16 communication steps per sample of 1 ms, so that the
@@ -16,6 +18,8 @@ Protocols (the paper's identification tests and random verification input):
 - sine 2 mm, 10 Hz, 1 s
 - step 2 mm, rise time 0.4 s, held to 10 s
 - random, peak 2 mm, PSD ~ f^-2.5 over 0.5-30 Hz, 5 s
+or, with ``--sine``/``--step`` (repeatable), exactly the tests named, as ``identification
+design`` recommends them: a sine for max(1 s, 2 periods), a step held to 10 s like the paper's.
 """
 from __future__ import annotations
 
@@ -42,12 +46,23 @@ PROTOCOLS = {
 }
 
 
+def named_protocols(sines=(), steps=()) -> dict:
+    """File-name suffix -> protocol for sines (amplitude mm, frequency Hz) and steps
+    (amplitude mm, rise time s)."""
+    out = {}
+    for amplitude, frequency in sines:
+        out[f"sine_{amplitude:g}mm_{frequency:g}Hz"] = Sine(amplitude, frequency, max(1.0, 2.0 / frequency))
+    for amplitude, rise in steps:
+        out[f"step_{amplitude:g}mm_rise{rise:g}s"] = Step(amplitude, rise, 10.0)
+    return out
+
+
 def generate(params_file: Path, prefix: str, seed: int, out_dir: Path = HERE,
-             force_noise_fraction: float = FORCE_NOISE_FRACTION) -> list[Path]:
+             force_noise_fraction: float = FORCE_NOISE_FRACTION, protocols: dict | None = None) -> list[Path]:
     parameter_set = read_parameter_set(params_file)  # any model: the file names it
     rng = np.random.default_rng(seed)
     written = []
-    for name, protocol in PROTOCOLS.items():
+    for name, protocol in (protocols or PROTOCOLS).items():
         t = sample_times(protocol.duration_s, SAMPLE_RATE_HZ)
         x, v = protocol.signals(t)
         force = simulate(parameter_set, t, x, v, steps_per_sample=TRUTH_STEPS_PER_SAMPLE)
@@ -72,9 +87,25 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=2024)
     parser.add_argument("--force-noise", type=float, default=FORCE_NOISE_FRACTION,
                         help="force noise rms as a fraction of the rms force (default 0.005)")
+    parser.add_argument("--sine", action="append", type=_pair, default=[], metavar="AMPLITUDE_MM,FREQUENCY_HZ",
+                        help="generate this sine (instead of the default protocols); repeatable")
+    parser.add_argument("--step", action="append", type=_pair, default=[], metavar="AMPLITUDE_MM,RISE_S",
+                        help="generate this step, held to 10 s; repeatable")
+    parser.add_argument("--out-dir", type=Path, default=HERE)
     args = parser.parse_args()
-    for path in generate(args.params, args.prefix, args.seed, force_noise_fraction=args.force_noise):
+    protocols = named_protocols(args.sine, args.step) if (args.sine or args.step) else None
+    for path in generate(args.params, args.prefix, args.seed, args.out_dir, args.force_noise, protocols):
         print(f"wrote {path}")
+
+
+def _pair(text: str) -> tuple[float, float]:
+    try:
+        first, second = (float(part) for part in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: give two numbers separated by a comma, e.g. 3,30") from None
+    if not (first > 0 and second > 0):
+        raise argparse.ArgumentTypeError(f"{text!r}: both numbers must be > 0")
+    return first, second
 
 
 if __name__ == "__main__":

@@ -86,6 +86,9 @@ def read_ensemble(path: str | Path, model: str | None = None) -> ParameterEnsemb
             checked.append(best.model.check(member))
         except ParameterError as exc:
             raise ParameterError(f"{path}, ensemble member {number}: {exc}") from None
+    if checked[0] != best.parameters:
+        raise ParameterError(f"{path}: the first ensemble member differs from 'parameters' (the best fit, which "
+                             "build_fmu.py uses); an edited file? Make them the same")
     return ParameterEnsemble(best.model, checked, best.provenance)
 
 

@@ -7,11 +7,14 @@ import sys
 import warnings
 from pathlib import Path
 
+import numpy as np
+
 from fmu_src.bushing_models import MODEL_NAMES
 from fmu_src.bushing_params import ParameterError
 from fmu_src.parameter_files import read_parameter_set
 from identification.engine import EngineError
-from identification.measurements import MeasurementError, load_measurement
+from identification.errors import IdentificationError
+from identification.measurements import load_measurement
 from identification.rig_tests import load_manifest, training_tests
 
 
@@ -23,6 +26,13 @@ def positive_int(text: str) -> int:
     value = int(text)
     if value < 1:
         raise argparse.ArgumentTypeError(f"{value} is not allowed: give an integer >= 1")
+    return value
+
+
+def non_negative_int(text: str) -> int:
+    value = int(text)
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"{value} is not allowed: give an integer >= 0")
     return value
 
 
@@ -57,7 +67,8 @@ def main(argv: list[str] | None = None) -> int:
     sensitivity_parser.add_argument("--csv", type=Path, help="also write the table as CSV")
 
     report_parser = commands.add_parser("report", help="verification report: error tables and plots (paper §5)")
-    report_parser.add_argument("--params", type=Path, required=True, help="parameter file (.json or .ssv)")
+    report_parser.add_argument("--params", type=Path, required=True,
+                               help="parameter file (.json or .ssv) or ensemble (then with its band)")
     report_parser.add_argument("--data", action="append", type=Path, default=[], metavar="FILE",
                                help="measured test CSV to compare with; repeatable")
     report_parser.add_argument("--truth", type=Path,
@@ -77,16 +88,34 @@ def main(argv: list[str] | None = None) -> int:
     compare_parser.add_argument("--out", type=Path, required=True,
                                 help="directory for the fitted parameter files, the table (CSV) and the plots")
 
+    predict_parser = commands.add_parser(
+        "predict", help="simulate a parameter file or an ensemble on a test's displacement")
+    predict_parser.add_argument("--params", type=Path, required=True,
+                                help="parameter file (.json, .ssv) or ensemble file (fit --ensemble)")
+    predict_parser.add_argument("--data", type=Path, required=True,
+                                help="CSV with time_s and displacement_* columns (a force column is not needed)")
+    predict_parser.add_argument("--out", type=Path, required=True,
+                                help="CSV to write: time_s,displacement_mm,force_N[,force_min_N,force_max_N]")
+    predict_parser.add_argument("--plot", type=Path, help="also plot the prediction (PNG)")
+
+    design_parser = commands.add_parser("design", help="rank candidate next tests by how much the ensemble disagrees")
+    design_parser.add_argument("--ensemble", type=Path, required=True, help="ensemble file (fit --ensemble)")
+    design_parser.add_argument("--noise", type=positive_float, metavar="N",
+                               help="noise level [N] to compare with (default: the training tests')")
+    design_parser.add_argument("--top", type=positive_int, default=3, help="how many to recommend (default 3)")
+    design_parser.add_argument("--json", action="store_true", help="print the ranking as JSON")
+
+    fleet_parser = commands.add_parser("fit-many", help="fit a fleet: every sub-folder of DIR with a tests.json")
+    fleet_parser.add_argument("folder", type=Path, metavar="DIR")
+    fleet_parser.add_argument("--out", type=Path, required=True, help="directory for <name>.json and summary.csv")
+    _add_search_arguments(fleet_parser)
+
     args = parser.parse_args(argv)
     try:
-        if args.command == "sensitivity":
-            return _sensitivity(args)
-        if args.command == "report":
-            return _report(args)
-        if args.command == "compare":
-            return _compare(args)
-        return _fit(args)
-    except (MeasurementError, ParameterError, EngineError, UsageError) as exc:
+        handler = {"sensitivity": _sensitivity, "report": _report, "compare": _compare, "predict": _predict,
+                   "design": _design, "fit-many": _fit_many}.get(args.command, _fit)
+        return handler(args)
+    except (IdentificationError, ParameterError, EngineError, UsageError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
 
@@ -111,15 +140,17 @@ def _add_search_arguments(parser) -> None:
     group.add_argument("--preset", default="default", choices=["default", "paper"],
                        help="default: screened Sobol starts + successive halving of trust-region least squares; "
                             "paper: the paper's GA (300 x 200) instead of the screening")
-    group.add_argument("--seed", type=int, default=0, help="root seed of the search (default 0)")
+    group.add_argument("--seed", type=non_negative_int, default=0, help="root seed of the search (default 0)")
     group.add_argument("--screening", type=positive_int, metavar="N",
                        help="Sobol points screened (default preset: 8192)")
     group.add_argument("--starts", type=positive_int, metavar="N",
                        help="least-squares starts of the first stage (default 128; later stages shrink in proportion)")
-    group.add_argument("--workers", type=positive_int, metavar="N",
+    where = group.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=positive_int, metavar="N",
                        help=f"local worker processes (default: all {os.cpu_count()} cores)")
-    group.add_argument("--scheduler", metavar="ADDRESS",
-                       help="run the starts on a Dask cluster instead, e.g. tcp://10.0.0.5:8786")
+    where.add_argument("--scheduler", metavar="ADDRESS",
+                       help="run on a Dask cluster instead, e.g. tcp://10.0.0.5:8786 (workers started with "
+                            "`dask worker ADDRESS --nthreads 1`)")
     group.add_argument("--quiet", action="store_true", help="no progress bars")
 
 
@@ -134,10 +165,12 @@ def _training_tests(args):
     return training_tests(args.sine, args.step, args.rise_time, args.random), None
 
 
-def check_output(path: Path | None, option: str, directory: bool = False) -> None:
+def check_output(path: Path | None, option: str, directory: bool = False, suffixes: tuple[str, ...] = ()) -> None:
     """Refuse, before any work, an output that cannot be written (exit 2, nothing lost)."""
     if path is None:
         return
+    if suffixes and path.suffix.lower() not in suffixes:
+        raise UsageError(f"{option} {path}: give a file name ending in {' or '.join(suffixes)}")
     folder = path if directory and path.exists() else path.parent
     if path.exists() and directory != path.is_dir():
         raise UsageError(f"{option} {path}: is {'a file' if directory else 'a directory'}, "
@@ -150,12 +183,14 @@ def check_output(path: Path | None, option: str, directory: bool = False) -> Non
 
 
 def _fit(args) -> int:
-    from identification.fit import FitNotConvergedWarning, fit
+    from identification.fitting import FitNotConvergedWarning, fit
     from identification.plots import plot_comparison, plot_waterfall
     from identification.simulate import simulate
 
-    for path, option in ((args.out, "--out"), (args.ssv, "--ssv"), (args.ensemble, "--ensemble")):
-        check_output(path, option)
+    # the parameter file and the ensemble carry the fit's provenance: JSON; SSP holds values only
+    for path, option, suffix in ((args.out, "--out", ".json"), (args.ssv, "--ssv", ".ssv"),
+                                 (args.ensemble, "--ensemble", ".json")):
+        check_output(path, option, suffixes=(suffix,))
     check_output(args.plots, "--plots", directory=True)
     tests, manifest_model = _training_tests(args)
     model = args.model or manifest_model or "proposed"
@@ -199,8 +234,9 @@ def _sensitivity(args) -> int:
 def _report(args) -> int:
     from identification.report import data_errors, format_data_errors, format_errors, grid_errors, plot_measurement
     from identification.search_space import KelvinVoigtFit
-    parameter_set = read_parameter_set(args.params)
-    params, model = parameter_set.parameters, parameter_set.model.name
+    from fmu_src.parameter_files import read_ensemble
+    params = read_ensemble(args.params)
+    model = params.model.name
     if not (args.data or args.truth):
         raise UsageError("give --data files and/or --truth to report on")
     kelvin_voigt = None
@@ -218,6 +254,54 @@ def _report(args) -> int:
             for m in measurements:
                 path = plot_measurement(params, m, args.plots / (Path(m.source).stem + ".png"), kelvin_voigt, model)
                 print(f"wrote {path}")
+    return 0
+
+
+def _predict(args) -> int:
+    from fmu_src.parameter_files import read_ensemble
+    from identification.predict import predict
+    check_output(args.out, "--out", suffixes=(".csv",))
+    check_output(args.plot, "--plot", suffixes=(".png",))
+    ensemble = read_ensemble(args.params)
+    m = load_measurement(args.data, force_optional=True)
+    prediction = predict(ensemble, m.time_s, m.displacement_mm, m.measured_velocity_mm_s)
+    prediction.write_csv(args.out)
+    written = [args.out]
+    if args.plot:
+        from identification.plots import plot_comparison
+        band = (prediction.lower_N, prediction.upper_N) if prediction.members > 1 else None
+        written.append(plot_comparison(m, {ensemble.model.name: prediction.force_N}, args.plot, band,
+                                       measured=m.has_force))
+    width = prediction.band_width_N
+    print(f"{prediction.members} parameter set(s); rms force {np.sqrt(np.mean(prediction.force_N ** 2)):.1f} N"
+          + (f"; band width: mean {np.mean(width):.1f} N, largest {np.max(width):.1f} N" if prediction.members > 1
+             else ""))
+    print("wrote " + ", ".join(map(str, written)))
+    return 0
+
+
+def _design(args) -> int:
+    import json
+    from fmu_src.parameter_files import read_ensemble
+    from identification.design import design
+    result = design(read_ensemble(args.ensemble), noise_N=args.noise, progress=not args.json)
+    print(json.dumps(result.as_json(args.top), indent=2) if args.json else result.format(args.top))
+    return 0
+
+
+def _fit_many(args) -> int:
+    from identification.fleet import fit_many
+    check_output(args.out, "--out", directory=True)
+    rows = fit_many(args.folder, args.out, workers=args.workers, scheduler=args.scheduler, preset=args.preset,
+                    seed=args.seed, screening=args.screening, starts=args.starts, progress=not args.quiet)
+    for row in rows:
+        state = f"error: {row.error}" if row.error else (f"misfit {row.misfit:.4f}, "
+                                                          + ("converged" if row.converged else "NOT converged"))
+        print(f"{row.name:30s} {state}")
+    print(f"wrote {args.out}/summary.csv and {sum(not r.error for r in rows)} parameter file(s)")
+    failed = [r.name for r in rows if r.error or not r.converged]
+    if failed:
+        print(f"WARNING: not converged or failed: {', '.join(failed)}", file=sys.stderr)
     return 0
 
 

@@ -16,7 +16,7 @@ from typing import Sequence
 
 from fmu_src.bushing_models import get_model
 from identification.engine import make_engine
-from identification.fit import FitNotConvergedWarning, fit
+from identification.fitting import FitNotConvergedWarning, fit
 from identification.measurements import load_measurement
 from identification.objectives import nrmse, rms_error
 from identification.rig_tests import RigTest

@@ -2,7 +2,8 @@
 
 One small interface: ``engine.map(function, items, shared)`` calls ``function(shared, item)``
 for every item and returns the results in the order of the items, whatever order they
-finish in. ``shared`` (the objective, a few hundred kB) travels once per chunk of items
+finish in; ``progress(count)`` hears of finished items and ``each(index, result)`` gets each
+result as it arrives; ``chunk_size`` fixes the items per task (default: a few chunks per worker). ``shared`` (the objective, a few hundred kB) travels once per chunk of items
 (processes) or once per worker (Dask), not once per item. ``function`` must be a module-level
 function. Tasks carry everything they need, seeds included, so every engine returns the
 same bits: each task runs with one BLAS thread (a multi-threaded BLAS may sum in another
@@ -22,10 +23,13 @@ from __future__ import annotations
 import os
 from typing import Callable, Sequence
 
+import numpy as np
+
 CHUNKS_PER_WORKER = 4
 """Items are sent in about this many chunks per worker: fewer copies of ``shared``, still
 enough chunks to balance starts of unequal cost."""
-DEFAULT_TIMEOUT_S = 20.0
+DEFAULT_TIMEOUT_S = 10.0
+POLL_S = 0.05
 
 
 class EngineError(RuntimeError):
@@ -39,6 +43,14 @@ def _run_chunk(function: Callable, shared, chunk: Sequence, single_threaded: boo
         numba.set_num_threads(1)
     with threadpool_limits(limits=1):
         return [function(shared, item) for item in chunk]
+
+
+def _report(results: list, first: int, progress, each) -> None:
+    if progress:
+        progress(len(results))
+    if each:
+        for offset, result in enumerate(results):
+            each(first + offset, result)
 
 
 def _chunks(items: Sequence, count: int) -> list[list]:
@@ -57,12 +69,13 @@ class SerialEngine:
     workers = 1
     description = "1 process"
 
-    def map(self, function: Callable, items: Sequence, shared=None, progress: Callable[[int], None] | None = None):
+    def map(self, function: Callable, items: Sequence, shared=None, progress: Callable[[int], None] | None = None,
+            each: Callable[[int, object], None] | None = None, chunk_size: int | None = None):
         results = []
-        for chunk in _chunks(items, max(1, len(items) // 64)):
-            results += _run_chunk(function, shared, chunk, single_threaded=False)
-            if progress:
-                progress(len(chunk))
+        for chunk in _chunks(items, -(-len(items) // chunk_size) if chunk_size else max(1, len(items) // 64)):
+            done = _run_chunk(function, shared, chunk, single_threaded=False)
+            _report(done, len(results), progress, each)
+            results += done
         return results
 
     def close(self):
@@ -87,16 +100,16 @@ class ProcessEngine(SerialEngine):
         self.description = f"{workers} local processes"
         self._pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"))
 
-    def map(self, function, items, shared=None, progress=None):
+    def map(self, function, items, shared=None, progress=None, each=None, chunk_size=None):
         from concurrent.futures import as_completed
-        chunks = _chunks(items, self.workers * CHUNKS_PER_WORKER)
+        chunks = _chunks(items, -(-len(items) // chunk_size) if chunk_size else self.workers * CHUNKS_PER_WORKER)
+        starts = np.cumsum([0] + [len(c) for c in chunks])
         futures = {self._pool.submit(_run_chunk, function, shared, chunk, True): i for i, chunk in enumerate(chunks)}
         results: list = [None] * len(chunks)
         for future in as_completed(futures):
             index = futures[future]
             results[index] = future.result()
-            if progress:
-                progress(len(chunks[index]))
+            _report(results[index], int(starts[index]), progress, each)
         return [result for chunk in results for result in chunk]
 
     def close(self):
@@ -124,21 +137,48 @@ class DaskEngine(SerialEngine):
             self.close()
             raise EngineError(f"the Dask scheduler at {self._client.scheduler.address} has no workers after "
                               f"{timeout_s:g} s; start some with `dask worker ADDRESS --nthreads 1`") from None
-        self.workers = max(1, sum(self._client.nthreads().values()))
-        self.description = f"Dask cluster {self._client.scheduler.address} ({self.workers} worker threads)"
+        threads = self._client.nthreads()
+        if any(count > 1 for count in threads.values()):
+            self.close()
+            raise EngineError(f"the Dask workers of {scheduler!r} run {max(threads.values())} threads each; the fit "
+                              "needs single-threaded workers (each task sets its BLAS and numba threads, which is "
+                              "not safe between threads): start them with `dask worker ADDRESS --nthreads 1 "
+                              "--nworkers N`")
+        self.workers = len(threads)
+        self.timeout_s = timeout_s
+        self.description = f"Dask cluster {self._client.scheduler.address} ({self.workers} workers)"
 
-    def map(self, function, items, shared=None, progress=None):
+    def map(self, function, items, shared=None, progress=None, each=None, chunk_size=None):
         from dask.distributed import as_completed
         shared_future = self._client.scatter(shared, broadcast=True, hash=False)
-        chunks = _chunks(items, self.workers * CHUNKS_PER_WORKER)
+        chunks = _chunks(items, -(-len(items) // chunk_size) if chunk_size else self.workers * CHUNKS_PER_WORKER)
+        starts = np.cumsum([0] + [len(c) for c in chunks])
         futures = [self._client.submit(_run_chunk, function, shared_future, chunk, True, pure=False)
                    for chunk in chunks]
-        if progress:
-            index = {future.key: i for i, future in enumerate(futures)}
-            for future in as_completed(futures):
-                progress(len(chunks[index[future.key]]))
+        index = {future.key: i for i, future in enumerate(futures)}
+        for future in self._completed(futures):
+            _report(future.result(), int(starts[index[future.key]]), progress, each)
         results = self._client.gather(futures)
         return [result for chunk in results for result in chunk]
+
+    def _completed(self, futures):
+        """The futures as they finish; an EngineError when the cluster has had no worker for
+        ``timeout_s`` (a lost cluster is an error, not a hang)."""
+        import time
+        from dask.distributed import as_completed
+        finished = as_completed(futures, loop=self._client.loop)
+        last_worker_seen = time.monotonic()
+        while not finished.is_empty():
+            batch = finished.next_batch(block=False)
+            yield from batch
+            if batch:
+                continue
+            time.sleep(POLL_S)
+            if self._client.nthreads():
+                last_worker_seen = time.monotonic()
+            elif time.monotonic() - last_worker_seen >= self.timeout_s:
+                raise EngineError(f"the Dask cluster at {self._client.scheduler.address} has had no workers "
+                                  f"for {self.timeout_s:g} s while {finished.count()} task(s) wait")
 
     def close(self):
         if self._own_client:

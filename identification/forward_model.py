@@ -40,8 +40,8 @@ MAX_PHASE_PER_STEP_RAD = 0.07
 MAX_STEPS_PER_SAMPLE = 8
 HOLD_DECIMATION = 10
 HOLD_SETTLE_SAMPLES = 10
-"""Samples after a change of the displacement before a hold is decimated: a cubic spline
-through a ramp's corner rings into the hold by a factor 0.27 per sample."""
+"""Samples next to a change of the displacement (after it and before it) that a decimated hold
+keeps: a cubic spline through a ramp's corner rings into the hold by a factor 0.27 per sample."""
 
 
 @dataclass(frozen=True)
@@ -122,8 +122,8 @@ def prepare_input(time_s, displacement_mm, velocity_mm_s=None, decimate_holds: b
 
 def _held_samples_to_skip(x: np.ndarray) -> np.ndarray:
     """True for the samples whose force a decimated hold does not compute: inside runs of
-    exactly equal displacement, from HOLD_SETTLE_SAMPLES after the run starts, all but every
-    HOLD_DECIMATION-th and the run's last two."""
+    exactly equal displacement, more than HOLD_SETTLE_SAMPLES from either end of the run, all
+    but every HOLD_DECIMATION-th."""
     skip = np.zeros(x.size, dtype=bool)
     same = np.append(False, x[1:] == x[:-1])   # x_k equals x_(k-1)
     k = 0
@@ -135,7 +135,7 @@ def _held_samples_to_skip(x: np.ndarray) -> np.ndarray:
         while end + 1 < x.size and same[end + 1]:
             end += 1
         # samples k-1 .. end hold the same displacement
-        first, last = k - 1 + HOLD_SETTLE_SAMPLES, end - 2
+        first, last = k - 1 + HOLD_SETTLE_SAMPLES, end - HOLD_SETTLE_SAMPLES
         if last > first:
             inner = np.arange(first, last + 1)
             skip[inner[(inner - first) % HOLD_DECIMATION != 0]] = True

@@ -20,13 +20,15 @@ from pathlib import Path
 
 import numpy as np
 
+from identification.errors import IdentificationError
+
 LENGTH_TO_MM = {"mm": 1.0, "m": 1000.0, "in": 25.4}
 FORCE_TO_N = {"N": 1.0, "kN": 1000.0, "lbf": 4.4482216152605, "kip": 4448.2216152605}
 VELOCITY_TO_MM_S = {"mm_s": 1.0, "m_s": 1000.0, "in_s": 25.4}
 MIN_SAMPLES = 10
 
 
-class MeasurementError(ValueError):
+class MeasurementError(IdentificationError):
     """A measurement file that cannot be used; the message names the file, column and row."""
 
 
@@ -39,6 +41,7 @@ class Measurement:
     velocity_derived: bool = False
     source: str = ""
     comments: list[str] = field(default_factory=list)
+    has_force: bool = True      # False: an input file without a force column (force_N is zeros)
 
     def __len__(self) -> int:
         return self.time_s.size
@@ -63,8 +66,9 @@ def _column_factor(path: Path, header: str, quantity: str, table: dict[str, floa
     return table[unit]
 
 
-def load_measurement(path: str | Path) -> Measurement:
-    """Load a measurement CSV; raise MeasurementError naming what is wrong and where."""
+def load_measurement(path: str | Path, force_optional: bool = False) -> Measurement:
+    """Load a measurement CSV; raise MeasurementError naming what is wrong and where.
+    ``force_optional``: accept a file without a force column (an input to predict)."""
     path = Path(path)
     try:
         lines = path.read_text(encoding="utf-8").splitlines()
@@ -86,7 +90,8 @@ def load_measurement(path: str | Path) -> Measurement:
             raise MeasurementError(f"{path}: more than one {quantity} column in header {header!r}")
         if matches:
             columns[quantity] = (matches[0], _column_factor(path, names[matches[0]], quantity, table))
-    missing = [q for q in ("time", "displacement", "force") if q not in columns]
+    missing = [q for q in ("time", "displacement", "force") if q not in columns
+               and not (q == "force" and force_optional)]
     if missing:
         raise MeasurementError(
             f"{path}: header {header!r} (line {header_line}) lacks column(s) {', '.join(missing)}; "
@@ -122,7 +127,9 @@ def load_measurement(path: str | Path) -> Measurement:
     displacement = column("displacement")
     derived = "velocity" not in columns
     velocity = derive_velocity(time_s, displacement) if derived else column("velocity")
-    return Measurement(time_s, displacement, column("force"), velocity, derived, str(path), comments)
+    has_force = "force" in columns
+    force = column("force") if has_force else np.zeros_like(time_s)
+    return Measurement(time_s, displacement, force, velocity, derived, str(path), comments, has_force)
 
 
 def write_measurement(path: str | Path, time_s, displacement_mm, force_N, comments: list[str] = ()) -> None:

@@ -7,7 +7,7 @@ trust-region least squares.
    least squares (``least_squares(method="trf")``) for a few evaluations; the best fraction
    continue from where they stopped with a larger budget, and so on (``stages``). The last
    stage's starts run to convergence; they are the independent starts whose agreement is
-   the convergence evidence (``identification.fit``).
+   the convergence evidence (``identification.fitting``).
 
 Why this and not a population method alone: the misfit landscape of the proposed model has
 a wide bad basin around the optimum (a local search from most random points stalls at

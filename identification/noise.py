@@ -54,6 +54,8 @@ def estimate_noise(force_N) -> NoiseEstimate:
                          f"got shape {force.shape}")
     differences = np.convolve(force, _EIGHTH_DIFFERENCE, mode="valid")
     robust = float(np.median(np.abs(differences)) / _NORMAL_MAD)
+    if robust == 0.0:   # a force constant over most samples (quantised, clipped): no robust scale
+        return NoiseEstimate(float(np.sqrt(np.mean(differences ** 2))), float(np.sqrt(np.mean(force ** 2))))
     kept = differences[np.abs(differences) <= _TRIM * robust]
-    sigma = float(np.sqrt(np.mean(kept ** 2) / _TRIMMED_VARIANCE)) if kept.size else robust
+    sigma = float(np.sqrt(np.mean(kept ** 2) / _TRIMMED_VARIANCE))
     return NoiseEstimate(sigma, float(np.sqrt(np.mean(force ** 2))))

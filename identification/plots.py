@@ -30,21 +30,24 @@ def _save(figure, path) -> Path:
     return path
 
 
-def plot_comparison(measurement: Measurement, predictions: dict, path: Path, band: tuple | None = None) -> Path:
+def plot_comparison(measurement: Measurement, predictions: dict, path: Path, band: tuple | None = None,
+                    measured: bool = True) -> Path:
     """Measured and predicted force over time and against displacement (paper Figs. 15-17);
-    ``band``: (lower, upper) force [N] of an ensemble, shaded around the first prediction."""
+    ``band``: (lower, upper) force [N] of an ensemble, shaded around the first prediction;
+    ``measured``: whether to draw the measurement's force (False for a displacement-only input)."""
     plt = _pyplot()
     m = measurement
     figure, (in_time, loop) = plt.subplots(1, 2, figsize=(12, 4.4))
-    in_time.plot(m.time_s, m.force_N / 1e3, color="0.55", lw=1.4, label="measured")
-    loop.plot(m.displacement_mm, m.force_N / 1e3, color="0.55", lw=1.2)
+    if measured:
+        in_time.plot(m.time_s, m.force_N / 1e3, color="0.55", lw=1.4, label="measured")
+        loop.plot(m.displacement_mm, m.force_N / 1e3, color="0.55", lw=1.2)
     if band is not None:
         lower, upper = band
         in_time.fill_between(m.time_s, lower / 1e3, upper / 1e3, color="C0", alpha=0.25, lw=0,
                              label="ensemble band")
     for model, predicted in predictions.items():
         color, style = MODEL_STYLES.get(model, ("k", "-"))
-        label = f"{get_model(model).title} (NRMSE {nrmse(predicted, m.force_N):.1%})"
+        label = get_model(model).title + (f" (NRMSE {nrmse(predicted, m.force_N):.1%})" if measured else "")
         in_time.plot(m.time_s, predicted / 1e3, color=color, ls=style, lw=1.1, label=label)
         loop.plot(m.displacement_mm, predicted / 1e3, color=color, ls=style, lw=1.0)
     in_time.set(xlabel="time [s]", ylabel="force [kN]", title=Path(m.source).name)

@@ -91,8 +91,10 @@ def load_manifest(path: str | Path) -> Manifest:
         document = json.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
         raise ManifestError(f"tests manifest {path} does not exist") from None
-    except json.JSONDecodeError as exc:
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
         raise ManifestError(f"{path}: not valid JSON ({exc})") from None
+    except OSError as exc:
+        raise ManifestError(f"{path}: cannot be read ({exc.strerror})") from None
     if not isinstance(document, dict):
         raise ManifestError(f"{path}: expected a JSON object with keys {', '.join(KINDS)} and optional model")
     unknown = sorted(set(document) - {*KINDS, "model"})
@@ -105,7 +107,7 @@ def load_manifest(path: str | Path) -> Manifest:
             raise ManifestError(f"{path}: {kind!r} must be a list")
     steps, rise_times = [], []
     for entry in files["step"]:
-        if not (isinstance(entry, dict) and set(entry) == {"file", "rise_time_s"}):
+        if not (isinstance(entry, dict) and set(entry) == {"file", "rise_time_s"} and isinstance(entry["file"], str)):
             raise ManifestError(f"{path}: each step must be {{\"file\": ..., \"rise_time_s\": ...}}, got {entry!r}")
         steps.append(folder / entry["file"])
         rise_times.append(entry["rise_time_s"])

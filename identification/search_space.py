@@ -40,6 +40,7 @@ import numpy as np
 
 from fmu_src.bushing_models import get_model
 from identification.compiled_core import parameter_matrix
+from identification.errors import IdentificationError
 from identification.measurements import Measurement
 
 TIME_CONSTANT_FLOOR = 0.01
@@ -132,6 +133,10 @@ class SearchSpace:
         kelvin_voigt = KelvinVoigtFit.fit(scaling)
         peak = max(float(np.max(np.abs(m.force_N))) for m in scaling)
         amplitude = max(float(np.max(np.abs(m.displacement_mm))) for m in scaling)
+        if not (peak > 0 and amplitude > 0):
+            raise IdentificationError(f"the tests {', '.join(m.source for m in scaling)} have a peak force of "
+                                      f"{peak:g} N and a peak displacement of {amplitude:g} mm: both must be > 0 "
+                                      "to scale the search")
         # A hysteretic element can show a near-zero or negative Kelvin-Voigt damping or
         # stiffness; fall back to the secant stiffness and a 10 ms time scale then.
         k_ref = abs(kelvin_voigt.k) if kelvin_voigt.k > 0 else peak / amplitude

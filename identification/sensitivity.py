@@ -19,6 +19,7 @@ from typing import Mapping
 import numpy as np
 
 from fmu_src.bushing_params import PARAMETER_NAMES, PARAMETER_UNITS
+from identification.errors import IdentificationError
 from identification.forward_model import prepare_input
 from identification.protocols import Sine, Step, sample_times
 from identification.simulate import simulate_driven
@@ -71,7 +72,7 @@ class SensitivityTable:
 def sensitivity(params: Mapping[str, float], delta: float = 0.1, sine: Sine = Sine(2.0, 10.0, 1.0),
                 step: Step = Step(2.0, 0.4, 10.0), rate_hz: float = 1000.0) -> SensitivityTable:
     if not 0.0 < delta < 1.0:
-        raise ValueError(f"delta = {delta} must be between 0 and 1 (a relative change)")
+        raise IdentificationError(f"delta = {delta} must be between 0 and 1 (a relative change)")
     base = np.array([params[name] for name in PARAMETER_NAMES], dtype=float)
     candidates = [base]
     for i in range(len(PARAMETER_NAMES)):

@@ -12,7 +12,8 @@
    noise floor (NRMSE <= FLOOR_FACTOR x its noise level). A fit that is not both is
    ``converged = False`` and says why (``FitResult.warning``);
 4. how sure (``identification.ensemble``): the singular values of the residual Jacobian and
-   the parameter sets within the 95 % confidence threshold.
+   the ensemble: distinct start end points and posterior draws (emcee) pushed to the edge of
+   the 95 % confidence region.
 
 The ``paper`` preset replaces the Sobol screening by the paper's genetic algorithm (pymoo:
 population 300, 200 generations, uniform crossover 0.8, mutation probability 0.05 per
@@ -34,12 +35,14 @@ from fmu_src.bushing_models import get_model
 from fmu_src.parameter_files import ParameterSet, save_ensemble, save_parameters
 from identification.compiled_core import parameter_matrix
 from identification.engine import make_engine
-from identification.ensemble import (Identifiability, ensemble_candidates, identifiability, misfit_threshold,
-                                     select_members)
+from identification.errors import IdentificationError
+from identification.ensemble import (PUSH, STEPS, WALKERS, Identifiability, SamplerReport, identifiability,
+                                     misfit_threshold, posterior_samples, push_to_boundary, select_members,
+                                     threshold_scale)
 from identification.measurements import Measurement
 from identification.multistart import Problem, SearchSettings, StartRecord, jacobian, screen, successive_halving
 from identification.noise import NoiseEstimate, estimate_noise
-from identification.objectives import Objective, nrmse
+from identification.objectives import MIN_NOISE_FRACTION, Objective, nrmse
 from identification.rig_tests import Manifest, RigTest
 from identification.search_space import KelvinVoigtFit, SearchSpace
 from identification.simulate import simulate
@@ -71,13 +74,23 @@ class TestFit:
     nrmse: float
 
     @property
+    def noise_fraction(self) -> float:
+        """The noise level the fit works with: the estimate, at least MIN_NOISE_FRACTION of
+        the rms force (what the objective divides by)."""
+        return max(self.noise.relative, MIN_NOISE_FRACTION)
+
+    @property
+    def ratio(self) -> float:
+        return self.nrmse / self.noise_fraction
+
+    @property
     def at_floor(self) -> bool:
-        return bool(self.nrmse <= FLOOR_FACTOR * self.noise.relative)
+        return bool(self.ratio <= FLOOR_FACTOR)
 
     def as_dict(self) -> dict:
-        return {"file": self.name, "kind": self.kind, "noise_N": _round(self.noise.sigma_N),
-                "noise_fraction": _round(self.noise.relative), "nrmse": _round(self.nrmse),
-                "nrmse_over_noise": _round(self.nrmse / self.noise.relative), "at_floor": self.at_floor}
+        return {"file": self.name, "kind": self.kind, "noise_N": _round(self.noise_fraction * self.noise.rms_force_N),
+                "noise_fraction": _round(self.noise_fraction), "nrmse": _round(self.nrmse),
+                "nrmse_over_noise": _round(self.ratio), "at_floor": self.at_floor}
 
 
 @dataclass
@@ -96,6 +109,7 @@ class FitResult:
     engine: str = "1 process"
     space: SearchSpace | None = None
     final_starts: int = 1
+    sampler: SamplerReport | None = None
     notes: list[str] = field(default_factory=list)
 
     @property
@@ -122,11 +136,11 @@ class FitResult:
         """The ``not converged`` message with its figures, or None."""
         if self.converged:
             return None
-        worst = max(self.tests, key=lambda t: t.nrmse / t.noise.relative)
+        worst = max(self.tests, key=lambda t: t.ratio)
         reasons = []
         if not self.at_floor:
-            reasons.append(f"training NRMSE {worst.nrmse:.2%} on {worst.name} is {worst.nrmse / worst.noise.relative:.2f}x "
-                           f"its noise level {worst.noise.relative:.2%} (the floor is {FLOOR_FACTOR}x)")
+            reasons.append(f"training NRMSE {worst.nrmse:.2%} on {worst.name} is {worst.ratio:.2f}x "
+                           f"its noise level {worst.noise_fraction:.2%} (the floor is {FLOOR_FACTOR}x)")
         if self.space is not None and self.agreeing < MIN_AGREEING:
             reasons.append(f"only {self.agreeing} of {self.final_starts} final starts reach the best misfit")
         hint = ("more starts (--starts, --screening) may find a better optimum"
@@ -151,6 +165,10 @@ class FitResult:
                                          "shortest_time_constant_s": _round(self.space.shortest_time_constant_s)},
                         "note": "alpha = 1 in every Bouc-Wen block: the (alpha, A, beta, gamma) redundancy "
                                 "(search_space.rescale_hysteresis gives the equivalent sets)"})
+        if self.sampler is not None:
+            out["posterior_sampling"] = {"acceptance": _round(self.sampler.acceptance),
+                                         "autocorrelation_steps": _round(self.sampler.autocorrelation_steps),
+                                         "kept_steps": self.sampler.kept_steps}
         if self.identifiability is not None:
             out["weak_directions"] = [{k: (_round(v) if not isinstance(v, dict) else {n: _round(x) for n, x in v.items()})
                                        for k, v in entry.items()} for entry in self.identifiability.weakest()]
@@ -172,14 +190,16 @@ class FitResult:
                  f"misfit chi^2/n = {self.misfit:.4f} (1 = the noise floor)"]
         lines.append(f"{'test':44s} {'kind':7s} {'noise':>8s} {'NRMSE':>8s} {'ratio':>6s}  floor")
         for t in self.tests:
-            lines.append(f"{t.name:44s} {t.kind:7s} {t.noise.relative:8.2%} {t.nrmse:8.2%} "
-                         f"{t.nrmse / t.noise.relative:6.2f}  {'yes' if t.at_floor else 'NO'}")
+            lines.append(f"{t.name:44s} {t.kind:7s} {t.noise_fraction:8.2%} {t.nrmse:8.2%} "
+                         f"{t.ratio:6.2f}  {'yes' if t.at_floor else 'NO'}")
         if self.space is not None:
             lines.append(f"starts: {self.agreeing} of {self.final_starts} final starts agree (misfit within "
                          f"{self.threshold:.2e} of the best: delta chi^2 at 95 % for {len(self.space.names)} parameters); "
                          f"ensemble: {len(self.ensemble)} parameter sets")
         if self.identifiability is not None:
             lines.append(self.identifiability.format())
+        if self.sampler is not None:
+            lines.append(self.sampler.format())
         lines += self.notes
         lines.append("converged: yes" if self.converged else f"converged: no ({self.warning})")
         return "\n".join(lines)
@@ -212,7 +232,7 @@ def as_tests(measurements) -> list[RigTest]:
         else:
             tests.append(RigTest(load_measurement(item)))
     if not tests:
-        raise ValueError("no training tests given")
+        raise IdentificationError("no training tests given")
     return tests
 
 
@@ -227,32 +247,45 @@ def fit(measurements, model: str = "proposed", preset: str = "default", seed: in
     Sobol points and of first-stage starts (later stages shrink in proportion, at least
     MIN_FINAL_STARTS remain). Emits a ``FitNotConvergedWarning`` when the fit is not converged.
     """
+    from threadpoolctl import threadpool_limits
     started = time.perf_counter()
     tests = as_tests(measurements)
     bushing = get_model(model)
-    noise = [estimate_noise(t.measurement.force_N) for t in tests]
-    if bushing.name == "kelvin_voigt":
-        result = _fit_kelvin_voigt(tests, noise, started)
-    else:
-        if preset not in PRESETS:
-            raise ValueError(f"unknown preset {preset!r}; choose one of {', '.join(PRESETS)}")
-        settings = _settings(PRESETS[preset], screening, starts)
-        owned = engine is None
-        engine = engine or make_engine(workers, scheduler)
-        try:
-            result = _search(tests, noise, bushing.name, preset, settings, seed, engine, progress, started)
-        finally:
-            if owned:
-                engine.close()
+    if seed < 0:
+        raise IdentificationError(f"seed = {seed}: give an integer >= 0")
+    noise = [_noise_of(t) for t in tests]
+    # One BLAS thread here as in every task: a multi-threaded BLAS may sum in another order,
+    # and the scales and the Jacobian's SVD computed here must not depend on the engine.
+    with threadpool_limits(limits=1):
+        if bushing.name == "kelvin_voigt":
+            result = _fit_kelvin_voigt(tests, noise, started)
+        else:
+            if preset not in PRESETS:
+                raise IdentificationError(f"unknown preset {preset!r}; choose one of {', '.join(PRESETS)}")
+            settings = _settings(PRESETS[preset], screening, starts)
+            owned = engine is None
+            engine = engine or make_engine(workers, scheduler)
+            try:
+                result = _search(tests, noise, bushing.name, preset, settings, seed, engine, progress, started)
+            finally:
+                if owned:
+                    engine.close()
     if not result.converged:
         warnings.warn(result.warning, FitNotConvergedWarning, stacklevel=2)
     return result
 
 
+def _noise_of(test: RigTest) -> NoiseEstimate:
+    try:
+        return estimate_noise(test.measurement.force_N)
+    except ValueError as exc:
+        raise IdentificationError(f"{test.measurement.source}: {exc}") from None
+
+
 def _settings(base: SearchSettings, screening: int | None, starts: int | None) -> SearchSettings:
     if starts is not None:
         if starts < 1:
-            raise ValueError(f"starts = {starts}: give 1 or more")
+            raise IdentificationError(f"starts = {starts}: give 1 or more")
         first = base.stages[0][0]
         stages = tuple((max(min(MIN_FINAL_STARTS, starts), round(count * starts / first)) if i else starts, evaluations)
                        for i, (count, evaluations) in enumerate(base.stages))
@@ -279,14 +312,14 @@ def _search(tests, noise, model, preset, settings, seed, engine, progress, start
     evaluations += sum(r.evaluations - 1 for r in records)
 
     best = min(records, key=lambda r: (r.misfit, r.start))
-    residuals, n, d = problem.objective.size, problem.objective.size, len(space.names)
-    threshold = misfit_threshold(best.misfit, residuals, d)
+    n, d = problem.objective.size, len(space.names)
+    threshold = misfit_threshold(best.misfit, n, d)
     scaled_jacobian, _ = jacobian(problem, best.theta)
     ident = identifiability(scaled_jacobian * np.sqrt(n), space.names, threshold * n)
-    candidates = ensemble_candidates(best.theta, ident, space.bounds())
-    candidate_misfits = problem.misfit(candidates)
-    evaluations += 2 * d + 1 + len(candidates)
-    members = select_members(best.theta, [(r.theta, r.misfit) for r in records], candidates, candidate_misfits,
+    draws, _, sampler = posterior_samples(problem, best.theta, seed, threshold_scale(best.misfit, n, d))
+    samples, sample_misfits = push_to_boundary(problem, best.theta, draws, best.misfit + threshold)
+    evaluations += d + 1 + WALKERS * STEPS + len(draws) * len(PUSH)
+    members = select_members(best.theta, [(r.theta, r.misfit) for r in records], samples, sample_misfits,
                              best.misfit + threshold, space.bounds())
     rows = space.to_model_parameters(np.array(members))
     names = space.bushing.parameter_names
@@ -294,7 +327,8 @@ def _search(tests, noise, model, preset, settings, seed, engine, progress, start
     parameters = ParameterSet(space.bushing, ensemble[0])
     result = FitResult(parameters, float(best.misfit), _test_fits(tests, noise, parameters), records, threshold,
                        ensemble, ident, preset, seed, evaluations, time.perf_counter() - started, engine.description,
-                       space, final_starts=settings.stages[-1][0])
+                       space, final_starts=sum(r.stage == records[0].stage for r in records),
+                       sampler=sampler)
     result.parameters.provenance = result.provenance()
     return result
 
