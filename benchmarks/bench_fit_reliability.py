@@ -92,7 +92,10 @@ def truths(count: int, seed: int = 1) -> list[tuple[str, dict]]:
         tried += 1
         theta = bounds[:, 0] + rng.random(len(bounds)) * (bounds[:, 1] - bounds[:, 0])
         params = dict(zip(PARAMETER_NAMES, map(float, nominal.to_parameters(theta)[0])))
-        if plausible(params) is None or not own_space(params).inside(own_space(params).to_coordinates(params))[0]:
+        if plausible(params) is None:
+            continue
+        space = own_space(params)
+        if not space.inside(space.to_coordinates(params))[0]:
             continue
         out.append((f"random {len(out) - 2}", params))
     print(f"truths: {len(out)} ({max(0, len(out) - 3)} random ones kept of {tried} drawn)", file=sys.stderr)
@@ -201,12 +204,20 @@ def main() -> None:
     parser.add_argument("--workers", type=int, default=None)
     parser.add_argument("--first-truth", type=int, default=0, help="skip the truths before this index")
     parser.add_argument("--json", type=Path)
+    parser.add_argument("--truths-file", type=Path,
+                        help="read the truths from this JSON file if it exists, else draw them and write it")
     args = parser.parse_args()
 
     print(f"machine: {platform.machine()}, Python {platform.python_version()}, {time.strftime('%Y-%m-%d')}",
           file=sys.stderr)
     rows = []
-    for index, (name, truth) in enumerate(truths(args.truths)):
+    if args.truths_file and args.truths_file.exists():
+        drawn = [tuple(pair) for pair in json.loads(args.truths_file.read_text())][:args.truths]
+    else:
+        drawn = truths(args.truths)
+        if args.truths_file:
+            args.truths_file.write_text(json.dumps(drawn, indent=1))
+    for index, (name, truth) in enumerate(drawn):
         if index < args.first_truth:
             continue
         tests, noise_levels = training_data(truth, 100 + index)
