@@ -36,8 +36,9 @@ from fmu_src.parameter_files import ParameterSet, save_ensemble, save_parameters
 from identification.compiled_core import parameter_matrix
 from identification.engine import make_engine
 from identification.errors import IdentificationError
-from identification.ensemble import (PUSH, STEPS, WALKERS, Identifiability, SamplerReport, identifiability,
-                                     misfit_threshold, posterior_samples, push_to_boundary, select_members,
+from identification.ensemble import (PROBES, PROFILE_EVALUATIONS, PROFILE_ROUNDS, PUSH, STEPS, WALKERS,
+                                     Identifiability, SamplerReport, identifiability, misfit_threshold,
+                                     posterior_samples, profile_extremes, push_to_boundary, select_members,
                                      threshold_scale)
 from identification.measurements import Measurement
 from identification.multistart import Problem, SearchSettings, StartRecord, jacobian, screen, successive_halving
@@ -316,11 +317,15 @@ def _search(tests, noise, model, preset, settings, seed, engine, progress, start
     threshold = misfit_threshold(best.misfit, n, d)
     scaled_jacobian, _ = jacobian(problem, best.theta)
     ident = identifiability(scaled_jacobian * np.sqrt(n), space.names, threshold * n)
+    limit = best.misfit + threshold
+    extremes, extreme_misfits = profile_extremes(problem, best.theta, best.misfit, ident, limit, engine)
     draws, _, sampler = posterior_samples(problem, best.theta, seed, threshold_scale(best.misfit, n, d))
-    samples, sample_misfits = push_to_boundary(problem, best.theta, draws, best.misfit + threshold)
-    evaluations += d + 1 + WALKERS * STEPS + len(draws) * len(PUSH)
-    members = select_members(best.theta, [(r.theta, r.misfit) for r in records], samples, sample_misfits,
-                             best.misfit + threshold, space.bounds())
+    pushed, pushed_misfits = push_to_boundary(problem, best.theta, draws, limit)
+    evaluations += d + 1 + WALKERS * STEPS + len(draws) * len(PUSH) \
+        + len(PROBES) * 2 * (d + 1) * (1 + PROFILE_ROUNDS * PROFILE_EVALUATIONS)
+    members = select_members(best.theta, [(r.theta, r.misfit) for r in records],
+                             np.vstack([extremes, pushed]), np.concatenate([extreme_misfits, pushed_misfits]),
+                             limit, space.bounds())
     rows = space.to_model_parameters(np.array(members))
     names = space.bushing.parameter_names
     ensemble = [dict(zip(names, map(float, row))) for row in rows]
