@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import argparse
 import hashlib
+import importlib.resources
 import json
 import shutil
 import sys
@@ -34,12 +35,12 @@ from xml.dom.minidom import parseString
 from xml.etree import ElementTree as ET
 
 REPO = Path(__file__).resolve().parent
-SOURCE_DIR = REPO / "fmu_src"
 LIBRARY_MODULES = ("bushing_core.py", "bushing_params.py", "bushing_models.py", "parameter_files.py")
 SLAVE_MODULE = "bushing_slave.py"
 
 sys.path.insert(0, str(REPO))
-from fmu_src import bushing_params  # noqa: E402
+import fmu_src  # noqa: E402
+from fmu_src import __version__, bushing_params  # noqa: E402
 from fmu_src.bushing_models import MODEL_NAMES, get_model  # noqa: E402
 from fmu_src.parameter_files import parameter_document, read_parameter_set  # noqa: E402
 
@@ -55,16 +56,28 @@ DEFAULT_PARAMETERS = _DEFAULTS.parameters
 PORT_UNITS = {"x": "m", "v": "m/s", "F": "N"}
 
 
+SOURCE_DIR = Path(fmu_src.__file__).resolve().parent
+
+
 class BuildError(RuntimeError):
     pass
 
 
 def default_parameter_file(model: str = "proposed") -> Path:
-    """The parameter set an FMU of ``model`` gets when no ``--params`` is given."""
-    return REPO / "data" / get_model(model).default_file
+    """The parameter set an FMU of ``model`` gets when no ``--params`` is given: in the
+    checkout's data/, or in the installed package ``bushing_data`` (the same files)."""
+    name = get_model(model).default_file
+    checkout = REPO / "data" / name
+    if checkout.is_file():
+        return checkout
+    try:
+        return Path(str(importlib.resources.files("bushing_data") / name))
+    except ModuleNotFoundError:
+        raise BuildError(f"the default parameter set {name} is neither in {REPO / 'data'} nor installed "
+                         "(package bushing_data); reinstall the project or give --params FILE") from None
 
 
-def build_fmu(params_file: str | Path | None = None, out_dir: str | Path = REPO / "dist",
+def build_fmu(params_file: str | Path | None = None, out_dir: str | Path = "dist",
               model: str = "proposed") -> Path:
     """Build the FMU of ``model`` with the parameter set in ``params_file`` as start values
     (default: :func:`default_parameter_file`); return its path."""
@@ -78,7 +91,8 @@ def build_fmu(params_file: str | Path | None = None, out_dir: str | Path = REPO 
     defaults_text = json.dumps(defaults_json, indent=2) + "\n"
     slave_text = ((SOURCE_DIR / SLAVE_MODULE).read_text()
                   + f"\n\nclass {bushing.identifier}(BushingSlave):\n"
-                    f"    \"\"\"The {bushing.title} model (written by build_fmu.py).\"\"\"\n")
+                    f"    \"\"\"The {bushing.title} model (written by build_fmu.py).\"\"\"\n"
+                    f"    version = {__version__!r}\n")
 
     digest = hashlib.sha256(slave_text.encode())
     for name in LIBRARY_MODULES:
@@ -121,6 +135,7 @@ def _rewrite_model_description(fmu_path: Path, parameters: dict[str, float], bus
     with zipfile.ZipFile(fmu_path) as archive:
         entries = {info.filename: archive.read(info.filename) for info in archive.infolist()}
     root = ET.fromstring(entries["modelDescription.xml"])
+    root.set("generationTool", f"boucwen-bushing {__version__} (build_fmu.py) with {root.get('generationTool')}")
     _add_units(root, {**PORT_UNITS, **bushing.units, **{s.name: s.unit for s in bushing.states}})
     _set_parameter_starts(root, parameters)
     _add_model_structure(root)
@@ -173,13 +188,14 @@ def _add_model_structure(root: ET.Element) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="bushing-build-fmu", description=__doc__.splitlines()[0])
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     parser.add_argument("--model", default="proposed", choices=MODEL_NAMES,
                         help="which bushing model (default: proposed, the paper's eqs. 1-5)")
     parser.add_argument("--params", help="parameter set of the model, project JSON or SSP 1.0 .ssv "
                                          "(paper N-mm-s units); default: the paper's Table 5 for the "
                                          "proposed model, data/params_<model>_fit_synthetic_table5.json otherwise")
-    parser.add_argument("--out", default=str(REPO / "dist"), help="output directory (default: dist/)")
+    parser.add_argument("--out", default="dist", help="output directory (default: dist/ in the working directory)")
     args = parser.parse_args(argv)
     try:
         path = build_fmu(args.params, args.out, args.model)

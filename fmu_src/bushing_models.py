@@ -33,9 +33,11 @@ from dataclasses import dataclass
 from typing import Callable, Mapping
 
 from . import bushing_params as proposed
-from .bushing_params import ParameterError, ParameterSpec, number_errors
+from .bushing_params import DAMPING, EXPONENT, GAIN, SPRING, WEIGHT, ParameterError, ParameterSpec, number_errors, range_errors
 
 RIGID = 1e12
+PLAUSIBLE_TRAVEL_MM = 100.0
+PLAUSIBLE_VELOCITY_MM_S = 1000.0
 """How much stiffer (or more viscous) than the rest a limit element is made (see above)."""
 
 
@@ -75,7 +77,9 @@ class BushingModel:
         errors = number_errors(params, self.units, f" of the {self.name} model")
         if errors:
             return errors, []
-        return self._check({name: float(params[name]) for name in self.parameter_names})
+        values = {name: float(params[name]) for name in self.parameter_names}
+        errors, warnings = self._check(values)
+        return range_errors(values, self.specs) + errors, warnings
 
     def check(self, params: Mapping[str, float]) -> dict[str, float]:
         """The parameters as floats in spec order, or ParameterError listing every problem
@@ -92,6 +96,18 @@ class BushingModel:
     def core_parameters(self, params: Mapping[str, float]) -> dict[str, float]:
         """The proposed model's 16 parameters that simulate this model (see module docstring)."""
         return self._to_core(params)
+
+    def plausible_force_bound(self, params: Mapping[str, float]) -> float:
+        """A force [N] no bushing with these parameters should reach in service: every spring
+        and Bouc-Wen gain of the model (A weighted by its alpha) and every dashpot in parallel,
+        at PLAUSIBLE_TRAVEL_MM and PLAUSIBLE_VELOCITY_MM_S, plus the constant force. Above it
+        the inputs are most likely in the wrong units (millimetres in the metre port)."""
+        stiffness = sum(abs(params[s.name]) * abs(params.get("alpha" + s.name[1:], 1.0) if s.name.startswith("A")
+                                                  else 1.0)
+                        for s in self.specs if s.unit == "N/mm")
+        damping = sum(abs(params[s.name]) for s in self.specs if s.unit == "N.s/mm")
+        return (stiffness * PLAUSIBLE_TRAVEL_MM + damping * PLAUSIBLE_VELOCITY_MM_S
+                + abs(self.force_offset(params)))
 
     def force_offset(self, params: Mapping[str, float]) -> float:
         """Constant force [N] added to the core's force (Spencer's -k1*x0, Kelvin-Voigt's preload)."""
@@ -111,16 +127,18 @@ def _wall(c2: float, k2: float, A2: float) -> float:
 
 # ---------------------------------------------------------------- Spencer
 SPENCER_SPECS = (
-    ParameterSpec("c0", "N.s/mm", "viscous damping in parallel with the Bouc-Wen element (large velocities)"),
-    ParameterSpec("k0", "N/mm", "stiffness in parallel with the Bouc-Wen element (large velocities)"),
-    ParameterSpec("c1", "N.s/mm", "dashpot from the internal displacement y to ground (roll-off at low velocity)"),
-    ParameterSpec("k1", "N/mm", "accumulator spring from x to ground"),
+    ParameterSpec("c0", "N.s/mm", "viscous damping in parallel with the Bouc-Wen element (large velocities)",
+                  **DAMPING),
+    ParameterSpec("k0", "N/mm", "stiffness in parallel with the Bouc-Wen element (large velocities)", **SPRING),
+    ParameterSpec("c1", "N.s/mm", "dashpot from the internal displacement y to ground (roll-off at low velocity)",
+                  minimum=0.0, exclusive=True, why="it divides dy/dt"),
+    ParameterSpec("k1", "N/mm", "accumulator spring from x to ground", **SPRING),
     ParameterSpec("x0", "mm", "initial displacement of the accumulator spring k1 (preload -k1*x0)"),
-    ParameterSpec("alpha", "1", "weight of the hysteretic force z"),
-    ParameterSpec("A", "N/mm", "Bouc-Wen initial stiffness"),
+    ParameterSpec("alpha", "1", "weight of the hysteretic force z", **WEIGHT),
+    ParameterSpec("A", "N/mm", "Bouc-Wen initial stiffness", **GAIN),
     ParameterSpec("beta", "N^(1-n)/mm", "Spencer's beta: on u*|z|^n (the paper's gamma)"),
     ParameterSpec("gamma", "N^(1-n)/mm", "Spencer's gamma: on |u|*z*|z|^(n-1) (the paper's beta)"),
-    ParameterSpec("n", "1", "Bouc-Wen exponent"),
+    ParameterSpec("n", "1", "Bouc-Wen exponent", **EXPONENT),
 )
 
 
@@ -131,38 +149,24 @@ def _spencer_to_core(p):
     return core
 
 
-def _single_block_checks(p, springs):
-    """Checks shared by Spencer and the single Bouc-Wen (both name their element c0, n, beta, gamma)."""
-    errors, warnings = [], []
-    if not p["n"] > 0:
-        errors.append(f"n = {p['n']} must be > 0 (exponent of |z|)")
-    errors += [f"{name} = {p[name]} N/mm must be >= 0 (a negative spring is unstable)"
-               for name in springs if p[name] < 0]
-    if p["c0"] < 0:
-        warnings.append(f"c0 = {p['c0']} N.s/mm is a negative damping (unphysical)")
+def _single_block_check(p):
+    """Beyond the ranges of the specs, shared by Spencer and the single Bouc-Wen (both name
+    their element's shape parameters beta, gamma)."""
+    warnings = []
     if not p["beta"] + p["gamma"] > 0:
         warnings.append(f"beta + gamma = {p['beta'] + p['gamma']} should be > 0 (bounded hysteresis)")
-    return errors, warnings
-
-
-def _spencer_check(p):
-    errors, warnings = _single_block_checks(p, ("k0", "k1"))
-    if not p["c0"] + p["c1"] > 0:
-        errors.append(f"c0 + c1 = {p['c0'] + p['c1']} N.s/mm must be > 0 (it divides dy/dt)")
-    if not p["c1"] > 0:
-        errors.append(f"c1 = {p['c1']} N.s/mm must be > 0 (the dashpot to ground)")
-    return errors, warnings
+    return [], warnings
 
 
 # ---------------------------------------------------------------- single Bouc-Wen
 BOUC_WEN_SPECS = (
-    ParameterSpec("c0", "N.s/mm", "viscous damping in parallel"),
-    ParameterSpec("k0", "N/mm", "linear stiffness in parallel"),
-    ParameterSpec("alpha", "1", "weight of the hysteretic force z"),
-    ParameterSpec("A", "N/mm", "Bouc-Wen initial stiffness"),
+    ParameterSpec("c0", "N.s/mm", "viscous damping in parallel", **DAMPING),
+    ParameterSpec("k0", "N/mm", "linear stiffness in parallel", **SPRING),
+    ParameterSpec("alpha", "1", "weight of the hysteretic force z", **WEIGHT),
+    ParameterSpec("A", "N/mm", "Bouc-Wen initial stiffness", **GAIN),
     ParameterSpec("beta", "N^(1-n)/mm", "Bouc-Wen shape parameter on |u|*z*|z|^(n-1) (as in eq. 1)"),
     ParameterSpec("gamma", "N^(1-n)/mm", "Bouc-Wen shape parameter on u*|z|^n (as in eq. 1)"),
-    ParameterSpec("n", "1", "Bouc-Wen exponent"),
+    ParameterSpec("n", "1", "Bouc-Wen exponent", **EXPONENT),
 )
 
 
@@ -173,14 +177,10 @@ def _bouc_wen_to_core(p):
     return core
 
 
-def _bouc_wen_check(p):
-    return _single_block_checks(p, ("k0",))
-
-
 # ---------------------------------------------------------------- Kelvin-Voigt
 KELVIN_VOIGT_SPECS = (
-    ParameterSpec("k", "N/mm", "stiffness"),
-    ParameterSpec("c", "N.s/mm", "viscous damping"),
+    ParameterSpec("k", "N/mm", "stiffness", **SPRING),
+    ParameterSpec("c", "N.s/mm", "viscous damping", **DAMPING),
     ParameterSpec("preload", "N", "force at x = 0"),
 )
 
@@ -192,10 +192,8 @@ def _kelvin_voigt_to_core(p):
     return core
 
 
-def _kelvin_voigt_check(p):
-    warnings = [f"{name} = {p[name]} {unit} is negative (unphysical)"
-                for name, unit in (("k", "N/mm"), ("c", "N.s/mm")) if p[name] < 0]
-    return [], warnings
+def _no_further_check(p):
+    return [], []
 
 
 _Z1 = StateSpec("z1", "z1", "N", "hysteretic force of the left block (eq. 1)")
@@ -206,20 +204,20 @@ _W = StateSpec("w", "w", "m", "displacement of the right plate (eq. 4)")
 MODELS: dict[str, BushingModel] = {
     "proposed": BushingModel(
         "proposed", proposed.MODEL_NAME, "proposed (paper eqs. 1-5)", proposed.PARAMETER_SPECS,
-        (_Z1, _Z2, _Y, _W), "params_table5_combined.json", dict, proposed.range_checks),
+        (_Z1, _Z2, _Y, _W), "params_table5_combined.json", dict, proposed.constraint_checks),
     "spencer": BushingModel(
         "spencer", "SpencerBushing", "Spencer (1997)", SPENCER_SPECS,
         (StateSpec("z", "z2", "N", "hysteretic force"),
          StateSpec("y", "w", "m", "internal displacement (between the Bouc-Wen element and c1)")),
-        "params_spencer_fit_synthetic_table5.json", _spencer_to_core, _spencer_check,
+        "params_spencer_fit_synthetic_table5.json", _spencer_to_core, _single_block_check,
         lambda p: -p["k1"] * p["x0"]),
     "bouc_wen": BushingModel(
         "bouc_wen", "SingleBoucWenBushing", "single Bouc-Wen", BOUC_WEN_SPECS,
         (StateSpec("z", "z2", "N", "hysteretic force"),), "params_bouc_wen_fit_synthetic_table5.json",
-        _bouc_wen_to_core, _bouc_wen_check),
+        _bouc_wen_to_core, _single_block_check),
     "kelvin_voigt": BushingModel(
         "kelvin_voigt", "KelvinVoigtBushing", "Kelvin-Voigt (linear)", KELVIN_VOIGT_SPECS, (),
-        "params_kelvin_voigt_fit_synthetic_table5.json", _kelvin_voigt_to_core, _kelvin_voigt_check,
+        "params_kelvin_voigt_fit_synthetic_table5.json", _kelvin_voigt_to_core, _no_further_check,
         lambda p: p["preload"]),
 }
 MODEL_NAMES = tuple(MODELS)

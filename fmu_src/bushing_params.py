@@ -20,28 +20,55 @@ UNIT_SYSTEM = "N-mm-s"
 
 @dataclass(frozen=True)
 class ParameterSpec:
+    """A parameter's name, unit, meaning and allowed range: ``minimum`` (inclusive unless
+    ``exclusive``; None: any finite value), with ``why`` the range is what it is. Values outside
+    are refused everywhere: by the FMU, by parameter files and by the identification."""
     name: str
     unit: str
     description: str
+    minimum: float | None = None
+    exclusive: bool = False
+    why: str = ""
+
+    @property
+    def allowed(self) -> str:
+        """The allowed range in words: '> 0', '>= 0' or 'any finite value'."""
+        if self.minimum is None:
+            return "any finite value"
+        return f"{'>' if self.exclusive else '>='} {self.minimum:g}"
+
+    def range_error(self, value: float) -> str | None:
+        """What is wrong with a finite ``value``, or None if it is in range."""
+        if self.minimum is None or (value > self.minimum if self.exclusive else value >= self.minimum):
+            return None
+        return f"{self.name} = {value} [{self.unit}] must be {self.allowed}" + (f" ({self.why})" if self.why else "")
+
+
+SPRING = dict(minimum=0.0, why="a negative spring is unstable")
+DAMPING = dict(minimum=0.0, why="a negative dashpot adds energy")
+WEIGHT = dict(minimum=0.0, why="a negative weight turns the hysteresis loop inside out")
+GAIN = dict(minimum=0.0, why="a negative initial stiffness of the hysteresis is unstable")
+EXPONENT = dict(minimum=0.0, exclusive=True, why="exponent of |z|")
 
 
 PARAMETER_SPECS: tuple[ParameterSpec, ...] = (
-    ParameterSpec("c0", "N.s/mm", "dashpot in series with the right block; roll-off at low velocity"),
-    ParameterSpec("k0", "N/mm", "spring from the left plate y to ground; main static stiffness"),
-    ParameterSpec("c1", "N.s/mm", "dashpot between x and y; relaxation of the impact force"),
-    ParameterSpec("k1", "N/mm", "spring between x and y (standard solid)"),
-    ParameterSpec("c2", "N.s/mm", "dashpot between x and w; viscous damping at large velocity"),
-    ParameterSpec("k2", "N/mm", "spring between x and w; stiffness at large velocity"),
-    ParameterSpec("alpha1", "1", "weight of the hysteretic force z1 on the left plate"),
-    ParameterSpec("alpha2", "1", "weight of the hysteretic force z2 on the right plate"),
+    ParameterSpec("c0", "N.s/mm", "dashpot in series with the right block; roll-off at low velocity", **DAMPING),
+    ParameterSpec("k0", "N/mm", "spring from the left plate y to ground; main static stiffness", **SPRING),
+    ParameterSpec("c1", "N.s/mm", "dashpot between x and y; relaxation of the impact force",
+                  minimum=0.0, exclusive=True, why="it divides eq. 3"),
+    ParameterSpec("k1", "N/mm", "spring between x and y (standard solid)", **SPRING),
+    ParameterSpec("c2", "N.s/mm", "dashpot between x and w; viscous damping at large velocity", **DAMPING),
+    ParameterSpec("k2", "N/mm", "spring between x and w; stiffness at large velocity", **SPRING),
+    ParameterSpec("alpha1", "1", "weight of the hysteretic force z1 on the left plate", **WEIGHT),
+    ParameterSpec("alpha2", "1", "weight of the hysteretic force z2 on the right plate", **WEIGHT),
     ParameterSpec("beta1", "N^(1-n1)/mm", "Bouc-Wen shape parameter of z1 (eq. 1)"),
     ParameterSpec("beta2", "N^(1-n2)/mm", "Bouc-Wen shape parameter of z2 (eq. 2)"),
     ParameterSpec("gamma1", "N^(1-n1)/mm", "Bouc-Wen shape parameter of z1 (eq. 1)"),
     ParameterSpec("gamma2", "N^(1-n2)/mm", "Bouc-Wen shape parameter of z2 (eq. 2)"),
-    ParameterSpec("n1", "1", "Bouc-Wen exponent of z1 (smoothness of the transition)"),
-    ParameterSpec("n2", "1", "Bouc-Wen exponent of z2"),
-    ParameterSpec("A1", "N/mm", "Bouc-Wen initial stiffness of z1"),
-    ParameterSpec("A2", "N/mm", "Bouc-Wen initial stiffness of z2"),
+    ParameterSpec("n1", "1", "Bouc-Wen exponent of z1 (smoothness of the transition)", **EXPONENT),
+    ParameterSpec("n2", "1", "Bouc-Wen exponent of z2", **EXPONENT),
+    ParameterSpec("A1", "N/mm", "Bouc-Wen initial stiffness of z1", **GAIN),
+    ParameterSpec("A2", "N/mm", "Bouc-Wen initial stiffness of z2", **GAIN),
 )
 PARAMETER_NAMES: tuple[str, ...] = tuple(spec.name for spec in PARAMETER_SPECS)
 PARAMETER_UNITS: dict[str, str] = {spec.name: spec.unit for spec in PARAMETER_SPECS}
@@ -85,34 +112,23 @@ def number_errors(params: Mapping[str, float], units: Mapping[str, str], model_l
     return errors
 
 
-def validate_parameters(params: Mapping[str, float]) -> tuple[list[str], list[str]]:
-    """Check a parameter set (paper units).
+def range_errors(p: Mapping[str, float], specs: tuple[ParameterSpec, ...]) -> list[str]:
+    """Every value of ``p`` (finite floats) outside its spec's allowed range."""
+    return [error for spec in specs if (error := spec.range_error(p[spec.name])) is not None]
 
-    Returns ``(errors, warnings)``. Errors make the model unusable (NaN/Inf, c1 <= 0,
-    c0 + c2 <= 0, n <= 0, negative stiffness); warnings are the paper's identification
-    constraints (A >= 1, beta >= 0, beta1 + gamma1 > 0, beta2 - gamma2 > 0), which the
-    equations do not need but a fitted bushing should satisfy.
+
+def constraint_checks(p: Mapping[str, float]) -> tuple[list[str], list[str]]:
+    """(errors, warnings) of the proposed model beyond each value's range (``PARAMETER_SPECS``,
+    checked by ``bushing_models``), for a complete set of finite floats.
+
+    Error: c0 + c2 = 0 (it divides eq. 4). Warnings: the paper's identification constraints
+    (A >= 1, beta >= 0, beta1 + gamma1 > 0, beta2 - gamma2 > 0), which the equations do not
+    need but a fitted bushing should satisfy.
     """
-    errors = number_errors(params, PARAMETER_UNITS)
-    if errors:
-        return errors, []
-    return range_checks({name: float(params[name]) for name in PARAMETER_NAMES})
-
-
-def range_checks(p: Mapping[str, float]) -> tuple[list[str], list[str]]:
-    """(errors, warnings) of :func:`validate_parameters` for a complete set of finite floats."""
     errors: list[str] = []
     warnings: list[str] = []
-    if not p["c1"] > 0:
-        errors.append(f"c1 = {p['c1']} N.s/mm must be > 0 (it divides eq. 3)")
     if not p["c0"] + p["c2"] > 0:
         errors.append(f"c0 + c2 = {p['c0'] + p['c2']} N.s/mm must be > 0 (it divides eq. 4)")
-    for name in ("n1", "n2"):
-        if not p[name] > 0:
-            errors.append(f"{name} = {p[name]} must be > 0 (exponent of |z| in eqs. 1-2)")
-    for name in ("k0", "k1", "k2"):
-        if p[name] < 0:
-            errors.append(f"{name} = {p[name]} N/mm must be >= 0 (a negative spring is unstable)")
 
     for name in ("A1", "A2"):
         if p[name] < 1:
@@ -126,7 +142,4 @@ def range_checks(p: Mapping[str, float]) -> tuple[list[str], list[str]]:
     if not p["beta2"] - p["gamma2"] > 0:
         warnings.append(f"beta2 - gamma2 = {p['beta2'] - p['gamma2']} violates the paper's constraint "
                         "beta2 - gamma2 > 0")
-    for name in ("c0", "c2"):
-        if p[name] < 0:
-            warnings.append(f"{name} = {p[name]} N.s/mm is a negative damping (unphysical)")
     return errors, warnings

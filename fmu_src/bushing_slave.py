@@ -8,11 +8,18 @@ The FMU's class is a subclass of :class:`BushingSlave` named after the model's F
 identifier, which build_fmu.py appends to the packed copy of this module (pythonfmu takes
 the class with the longest hierarchy), so every model has its own modelIdentifier.
 
-Error policy. pythonfmu turns a Python exception into fmi2Fatal (the instance is lost), so
-nothing here raises. A setter stores the value and logs a problem at once; a doStep that
-cannot succeed (invalid parameter or input, overflow, too many substeps) logs the reason
-with category ``logStatusError`` and returns False, which pythonfmu reports as fmi2Discard;
-the committed state stays untouched, so the master can fix the value and step again.
+Error policy. pythonfmu 0.7 knows three outcomes of a call: fmi2OK, fmi2Discard (do_step
+returns False) and fmi2Fatal (any Python exception); it cannot return fmi2Error.
+- Start values with which the simulation cannot start (a parameter outside its range) are
+  logged at exitInitializationMode with category ``logStatusError``; if they are still invalid
+  at the first doStep, it fails with fmi2Fatal (an exception) and the reasons also go to stderr
+  (pythonfmu passes log messages only with debug logging on), so that every master stops
+  visibly: fmpy raises, libcosim reports a failed step. (exitInitializationMode itself does not
+  fail: libcosim aborts the process on that.)
+- During the run, a setter stores the value and logs a problem at once; a doStep that cannot
+  succeed (a parameter made invalid, a non-finite input, overflow, too many substeps) logs the
+  reason and returns False: fmi2Discard, with the committed state untouched, so the master can
+  fix the value and step again.
 The output F is never NaN or Inf: it falls back to the last finite force.
 
 Packaging. Inside an FMU this module is renamed to a name unique to the build, and its
@@ -20,8 +27,10 @@ siblings live in the package ``<that name>_lib``, so several FMUs of this projec
 with different code or defaults) can share one Python interpreter without running each
 other's modules.
 """
+import ctypes
 import importlib
 import math
+import sys
 
 from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Real
 from pythonfmu.default_experiment import DefaultExperiment
@@ -45,7 +54,10 @@ MM_PER_M = 1000.0
 PLAUSIBLE_TRAVEL_M = 0.1
 """|x| beyond this is far outside any rubber bushing's travel: most likely millimetres
 entered where metres are expected. It is warned about, not refused."""
-FMU_VERSION = "0.1.0"
+
+
+class InitializationError(RuntimeError):
+    """Start values with which the simulation cannot start (fmi2Fatal at the first doStep)."""
 
 
 def _description(model) -> str:
@@ -60,7 +72,7 @@ def _description(model) -> str:
 class BushingSlave(Fmi2Slave):
     author = "Bouc-Wen bushing project"
     description = _description(MODEL)
-    version = FMU_VERSION
+    version = None  # the project's version, written into each FMU's class by build_fmu.py
     license = "MIT"
     default_experiment = DefaultExperiment(start_time=0.0, stop_time=1.0, step_size=1e-3)
 
@@ -83,6 +95,10 @@ class BushingSlave(Fmi2Slave):
         self._force_is_current = False  # _last_force belongs to the current inputs and state
         self._initial_state_pending = True  # set at exit of initialization, or first valid step
         self._travel_warned = False    # the implausible-travel warning is given once
+        self._force_bound = math.inf   # N, above it the force is implausible (warned once)
+        self._force_warned = False
+        self._stale_force_logged = False   # the stale-force error is given once per episode
+        self._last_errors = []         # the parameter errors of the last validation
 
         for spec in MODEL.specs:
             self.register_variable(Real(
@@ -155,12 +171,41 @@ class BushingSlave(Fmi2Slave):
             if math.isfinite(force):
                 self._last_force = force
                 self._force_is_current = True
+                self._stale_force_logged = False
+                return force
+            reason = f"the force at x = {self.x} m, v = {self.v} m/s is not finite ({force})"
+        else:
+            reason = "the parameters are invalid (see the errors above)"
+        if not self._stale_force_logged:   # once until a current force can be computed again
+            self._stale_force_logged = True
+            self._error(f"F cannot be computed: {reason}; F keeps its last finite value {self._last_force} N")
         return self._last_force
 
     # ---------------------------------------------------------------- FMI life cycle
     def exit_initialization_mode(self):
+        # Never raise here: libcosim aborts the whole process on a failed exitInitializationMode,
+        # while it reports a failed step. Invalid start values are logged now and fail the first step.
         if self._refresh_parameters() and math.isfinite(self._x_now_mm):
             self._set_initial_state()
+
+    def _fail_to_start(self):
+        """The first doStep with start values that cannot run: fail visibly in every master.
+        pythonfmu 0.7 can return no fmi2Error: a Python exception is its only way to fail a call
+        other than fmi2Discard, and it makes fmi2Fatal (fmpy raises, libcosim reports a failed
+        step). fmi2Discard would not do: fmpy ends the run silently on it. pythonfmu passes log
+        messages to the host only with debug logging on, so the reasons also go to stderr."""
+        reasons = self._last_errors or ["the parameters are invalid"]
+        for message in reasons:
+            print(f"{self.instance_name}: {message}", file=sys.stderr)
+        self._error("the simulation cannot start: " + "; ".join(reasons))
+        # pythonfmu 0.7 releases the instance, its class and its log queue once when an
+        # exception is raised and once more when the instance is freed (PySlaveInstance's
+        # cleanPyObject, twice): freeing a failed instance then corrupts memory and crashes the
+        # host (libcosim at its exit; tests/test_fmu_bad_values.py). One extra reference each,
+        # never given back, absorbs the second release: a few kB leaked per failed instance.
+        for kept in (self, type(self), self._get_log_queue()):
+            ctypes.pythonapi.Py_IncRef(ctypes.py_object(kept))
+        raise InitializationError("; ".join(reasons))
 
     def _set_initial_state(self):
         """Relaxed equilibrium at the current displacement (see bushing_core.initial_state)."""
@@ -173,6 +218,8 @@ class BushingSlave(Fmi2Slave):
         if not 0.0 < step_size < math.inf:
             return self._refuse(f"communication step size {step_size} s must be a finite number > 0")
         if not self._refresh_parameters():
+            if self._initial_state_pending:   # never started: nothing a master can do in the run
+                self._fail_to_start()
             return self._refuse("doStep refused: the parameters are invalid (see the errors above)")
         if not (math.isfinite(self.x) and math.isfinite(self.v)):
             name, value, unit = ("x", self.x, "m") if not math.isfinite(self.x) else ("v", self.v, "m/s")
@@ -190,6 +237,12 @@ class BushingSlave(Fmi2Slave):
         if not math.isfinite(force):
             return self._refuse(f"doStep at t = {current_time} s refused: the force would be {force} N "
                                 f"(x = {self.x} m, v = {self.v} m/s); check the units of the inputs")
+        if abs(force) > self._force_bound and not self._force_warned:
+            self._force_warned = True
+            self.log(f"F = {force:.4g} N at t = {current_time + step_size} s exceeds {self._force_bound:.3g} N, the "
+                     "force of all the bushing's springs and dashpots at 0.1 m and 1 m/s: check the units of "
+                     f"the inputs (x = {self.x} m, v = {self.v} m/s; the FMU takes metres)",
+                     Fmi2Status.warning, "logStatusWarning")
         self._state = state
         self._state_x_mm = self._x_now_mm = x_end
         self._last_force = force
@@ -203,6 +256,7 @@ class BushingSlave(Fmi2Slave):
             self._parameters_changed = False
             values = {name: getattr(self, name) for name in MODEL.parameter_names}
             errors, warnings = MODEL.validate(values)
+            self._last_errors = errors
             for message in errors:
                 self._error(message)
             if errors:
@@ -213,6 +267,7 @@ class BushingSlave(Fmi2Slave):
                     self.log(f"accepted, but {message}", Fmi2Status.warning, "logStatusWarning")
                 self._parameters = MODEL.core_parameters(values)
                 self._force_offset = MODEL.force_offset(values)
+                self._force_bound = MODEL.plausible_force_bound(values)
                 self._compiled = core.compile_model(self._parameters)
         return self._compiled is not None
 

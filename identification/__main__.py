@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from fmu_src import __version__
 from fmu_src.bushing_models import MODEL_NAMES
 from fmu_src.bushing_params import ParameterError
 from fmu_src.parameter_files import read_parameter_set
@@ -43,9 +44,18 @@ def positive_float(text: str) -> float:
     return value
 
 
+def fraction(text: str) -> float:
+    value = float(text)
+    if not 0.0 < value < 1.0:
+        raise argparse.ArgumentTypeError(f"{value} is not allowed: give a number between 0 and 1")
+    return value
+
+
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m identification",
+    program = "bushing-identify" if Path(sys.argv[0]).name.startswith("bushing-identify") else "python -m identification"
+    parser = argparse.ArgumentParser(prog=program,
                                      description="Identify the bushing model's parameters from measured tests.")
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     commands = parser.add_subparsers(dest="command", required=True)
 
     fit_parser = commands.add_parser("fit", help="fit a model's parameters to rig tests, with convergence evidence")
@@ -63,7 +73,8 @@ def main(argv: list[str] | None = None) -> int:
     sensitivity_parser = commands.add_parser(
         "sensitivity", help="rank the 16 parameters by local sensitivity (paper Tables 1 and 3)")
     sensitivity_parser.add_argument("--params", type=Path, required=True, help="parameter file (.json or .ssv)")
-    sensitivity_parser.add_argument("--delta", type=float, default=0.1, help="relative change (default 0.1)")
+    sensitivity_parser.add_argument("--delta", type=fraction, default=0.1,
+                                    help="relative change, 0 < delta < 1 (default 0.1)")
     sensitivity_parser.add_argument("--csv", type=Path, help="also write the table as CSV")
 
     report_parser = commands.add_parser("report", help="verification report: error tables and plots (paper §5)")
@@ -111,13 +122,17 @@ def main(argv: list[str] | None = None) -> int:
     _add_search_arguments(fleet_parser)
 
     args = parser.parse_args(argv)
-    try:
-        handler = {"sensitivity": _sensitivity, "report": _report, "compare": _compare, "predict": _predict,
-                   "design": _design, "fit-many": _fit_many}.get(args.command, _fit)
-        return handler(args)
-    except (IdentificationError, ParameterError, EngineError, UsageError) as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+    with warnings.catch_warnings():
+        # A user reads the warning, not where in our code it was raised.
+        warnings.showwarning = lambda message, category, *rest, **keywords: print(f"WARNING: {message}",
+                                                                                  file=sys.stderr)
+        try:
+            handler = {"sensitivity": _sensitivity, "report": _report, "compare": _compare, "predict": _predict,
+                       "design": _design, "fit-many": _fit_many}.get(args.command, _fit)
+            return handler(args)
+        except (IdentificationError, ParameterError, EngineError, UsageError) as exc:
+            print(f"error: {exc}", file=sys.stderr)
+            return 2
 
 
 def _add_training_arguments(parser) -> None:
@@ -204,7 +219,7 @@ def _fit(args) -> int:
         result = fit(tests, model=model, preset=args.preset, seed=args.seed, workers=args.workers,
                      scheduler=args.scheduler, progress=not args.quiet, screening=args.screening,
                      starts=args.starts)
-    written = result.save(args.out, args.ssv, args.ensemble, data=[t.measurement.source for t in tests])
+    written = _save_or_rescue(result, args, [t.measurement.source for t in tests])
     print(result.summary())
     if args.plots:
         if result.records:
@@ -220,9 +235,34 @@ def _fit(args) -> int:
     return 0
 
 
+def _save_or_rescue(result, args, data) -> list[Path]:
+    """Write the fit's files; if that fails after all (a disk filled up, a folder removed during
+    the fit), write them into the working directory, or the temporary one, and say where: a
+    finished fit is never lost."""
+    import tempfile
+    import time
+    try:
+        return result.save(args.out, args.ssv, args.ensemble, data=data)
+    except OSError as exc:
+        stamp = time.strftime("%Y%m%d-%H%M%S")
+        for folder in (Path.cwd(), Path(tempfile.gettempdir())):
+            rescue = {"out": folder / f"rescued_fit_{stamp}.json",
+                      "ssv": folder / f"rescued_fit_{stamp}.ssv" if args.ssv else None,
+                      "ensemble": folder / f"rescued_fit_{stamp}_ensemble.json" if args.ensemble else None}
+            try:
+                written = result.save(rescue["out"], rescue["ssv"], rescue["ensemble"], data=data)
+            except OSError:
+                continue
+            print(f"WARNING: could not write the fit's files ({exc}); wrote them instead to "
+                  + ", ".join(map(str, written)), file=sys.stderr)
+            return written
+        raise
+
+
 def _sensitivity(args) -> int:
     from fmu_src.parameter_files import load_parameters
     from identification.sensitivity import sensitivity
+    check_output(args.csv, "--csv", suffixes=(".csv",))
     table = sensitivity(load_parameters(args.params, model="proposed"), delta=args.delta)
     print(table.format())
     if args.csv:
@@ -239,6 +279,7 @@ def _report(args) -> int:
     model = params.model.name
     if not (args.data or args.truth):
         raise UsageError("give --data files and/or --truth to report on")
+    check_output(args.plots, "--plots", directory=True)
     kelvin_voigt = None
     if args.kelvin_voigt_train:
         kelvin_voigt = KelvinVoigtFit.fit([load_measurement(path) for path in args.kelvin_voigt_train])

@@ -339,11 +339,11 @@ def _search(tests, noise, model, preset, settings, seed, engine, progress, start
 
 
 def _fit_kelvin_voigt(tests, noise, started) -> FitResult:
-    """F = k*x + c*v by linear least squares on the tests other than steps (a linear spring
-    cannot show the step's relaxation; all tests if there are only steps)."""
+    """F = k*x + c*v by linear least squares with k, c >= 0 on the tests other than steps (a
+    linear spring cannot show the step's relaxation; all tests if there are only steps)."""
     bushing = get_model("kelvin_voigt")
     linear = KelvinVoigtFit.fit([t.measurement for t in tests if t.kind != "step"]
-                                or [t.measurement for t in tests])
+                                or [t.measurement for t in tests], nonnegative=True)
     values = {"k": linear.k, "c": linear.c, "preload": 0.0}
     parameters = ParameterSet(bushing, values)
     objective = Objective(tests, noise)

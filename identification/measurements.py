@@ -11,10 +11,20 @@ velocity in m_s, mm_s, in_s (per second). Internal units: s, mm, N, mm/s.
 When the velocity is absent it is derived from the displacement with second-order finite
 differences (``numpy.gradient``: central in the interior, one-sided at both ends), which
 amplifies displacement noise by about 1/(sqrt(2)*dt).
+
+Plausibility. A file in the wrong units loads without error, so :func:`plausibility_warnings`
+checks what a rubber-bushing test can look like and warns (``MeasurementWarning``), naming the
+column, what it found and the likely mistake: peak displacement outside PLAUSIBLE_TRAVEL_MM
+(metres or micrometres in a millimetre column), peak force below MIN_PLAUSIBLE_FORCE_N (kN in
+a newton column), a secant stiffness (force range over displacement range) outside
+PLAUSIBLE_STIFFNESS_N_PER_MM, a sample rate outside PLAUSIBLE_SAMPLE_RATE_HZ (time in ms), and a
+displacement that moves more than half its rms between samples (sampled too slowly for its
+content, or a wrong time unit).
 """
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -26,6 +36,15 @@ LENGTH_TO_MM = {"mm": 1.0, "m": 1000.0, "in": 25.4}
 FORCE_TO_N = {"N": 1.0, "kN": 1000.0, "lbf": 4.4482216152605, "kip": 4448.2216152605}
 VELOCITY_TO_MM_S = {"mm_s": 1.0, "m_s": 1000.0, "in_s": 25.4}
 MIN_SAMPLES = 10
+PLAUSIBLE_TRAVEL_MM = (0.01, 200.0)
+MIN_PLAUSIBLE_FORCE_N = 10.0
+PLAUSIBLE_STIFFNESS_N_PER_MM = (1.0, 1e6)
+PLAUSIBLE_SAMPLE_RATE_HZ = (10.0, 1e6)
+MAX_STEP_OVER_RMS = 0.5
+
+
+class MeasurementWarning(UserWarning):
+    """A measurement that loads but looks implausible for a bushing test (likely wrong units)."""
 
 
 class MeasurementError(IdentificationError):
@@ -129,7 +148,51 @@ def load_measurement(path: str | Path, force_optional: bool = False) -> Measurem
     velocity = derive_velocity(time_s, displacement) if derived else column("velocity")
     has_force = "force" in columns
     force = column("force") if has_force else np.zeros_like(time_s)
+    headers = {quantity: names[index] for quantity, (index, _) in columns.items()}
+    for message in plausibility_warnings(time_s, displacement, force if has_force else None, headers):
+        warnings.warn(f"{path}: {message}", MeasurementWarning, stacklevel=2)
     return Measurement(time_s, displacement, force, velocity, derived, str(path), comments, has_force)
+
+
+def plausibility_warnings(time_s, displacement_mm, force_N=None, headers=None) -> list[str]:
+    """What looks wrong for a rubber-bushing test (see the module docstring), each naming the
+    column, what was found and the likely mistake; [] if nothing does."""
+    headers = {"time": "time_s", "displacement": "displacement_mm", "force": "force_N", **(headers or {})}
+    found = []
+    peak = float(np.max(np.abs(displacement_mm)))
+    low, high = PLAUSIBLE_TRAVEL_MM
+    if peak < low:
+        found.append(f"column {headers['displacement']}: peak displacement {peak:.3g} mm is below {low} mm; "
+                     "metres in a millimetre column? (2 mm is 2, not 0.002)")
+    elif peak > high:
+        found.append(f"column {headers['displacement']}: peak displacement {peak:.3g} mm is above {high:g} mm, "
+                     "beyond a bushing's travel; micrometres in a millimetre column?")
+    if force_N is not None:
+        peak_force = float(np.max(np.abs(force_N)))
+        if peak_force < MIN_PLAUSIBLE_FORCE_N:
+            found.append(f"column {headers['force']}: peak force {peak_force:.3g} N is below "
+                         f"{MIN_PLAUSIBLE_FORCE_N:g} N; kilonewtons in a newton column?")
+        travel = float(np.ptp(displacement_mm))
+        if travel > 0 and peak_force > 0:
+            stiffness = float(np.ptp(force_N)) / travel
+            low, high = PLAUSIBLE_STIFFNESS_N_PER_MM
+            if not low <= stiffness <= high:
+                found.append(f"columns {headers['force']}/{headers['displacement']}: secant stiffness "
+                             f"{stiffness:.3g} N/mm is outside {low:g}-{high:g} N/mm; check the units of both")
+    interval = float(np.median(np.diff(time_s)))
+    rate = 1.0 / interval
+    low, high = PLAUSIBLE_SAMPLE_RATE_HZ
+    if not low <= rate <= high:
+        found.append(f"column {headers['time']}: sample interval {interval:.3g} s ({rate:.3g} Hz) is outside a "
+                     f"rig's {low:g} Hz-{high:g} Hz; milliseconds in a seconds column?")
+    moving = displacement_mm - np.mean(displacement_mm)
+    spread = float(np.sqrt(np.mean(moving ** 2)))
+    if spread > 0:
+        step = float(np.sqrt(np.mean(np.diff(displacement_mm) ** 2)))
+        if step > MAX_STEP_OVER_RMS * spread:
+            found.append(f"column {headers['displacement']}: moves {step / spread:.2f} of its rms between samples "
+                         f"({rate:.3g} Hz); sampled too slowly for its content, or a wrong time unit?")
+    return found
 
 
 def write_measurement(path: str | Path, time_s, displacement_mm, force_N, comments: list[str] = ()) -> None:

@@ -37,6 +37,7 @@ from dataclasses import dataclass
 from typing import Mapping, Sequence
 
 import numpy as np
+from scipy.optimize import lsq_linear
 
 from fmu_src.bushing_models import get_model
 from identification.compiled_core import parameter_matrix
@@ -54,11 +55,17 @@ class KelvinVoigtFit:
     c: float
 
     @classmethod
-    def fit(cls, measurements: Sequence[Measurement]) -> "KelvinVoigtFit":
+    def fit(cls, measurements: Sequence[Measurement], nonnegative: bool = False) -> "KelvinVoigtFit":
+        """Unconstrained (a scale for the search: a hysteretic force may show a negative c),
+        or with k, c >= 0 (``nonnegative``: a Kelvin-Voigt bushing's parameters)."""
         x = np.concatenate([m.displacement_mm for m in measurements])
         v = np.concatenate([m.velocity_mm_s for m in measurements])
         force = np.concatenate([m.force_N for m in measurements])
-        (k, c), *_ = np.linalg.lstsq(np.column_stack([x, v]), force, rcond=None)
+        design = np.column_stack([x, v])
+        if nonnegative:
+            k, c = lsq_linear(design, force, bounds=(0.0, np.inf)).x
+        else:
+            (k, c), *_ = np.linalg.lstsq(design, force, rcond=None)
         return cls(float(k), float(c))
 
     def force(self, displacement_mm, velocity_mm_s):

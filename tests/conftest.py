@@ -5,7 +5,6 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import build_fmu
-from fmu_src import bushing_core as core
 from fmu_src.parameter_files import load_parameters
 
 REPO = Path(__file__).resolve().parents[1]
@@ -17,39 +16,6 @@ def paper_parameters(table: str) -> dict[str, float]:
     files = {"table2": "params_table2_sine.json", "table4": "params_table4_step.json",
              "table5": "params_table5_combined.json"}
     return load_parameters(DATA / files[table])
-
-
-def reference_jump(params, state, jump_mm):
-    """Independent reference for a displacement jump (an impulse in dx/dt): y moves with x,
-    w by c2/(c0 + c2) of it, and z2 follows dz2/dxi = g2 over xi = c0/(c0 + c2)*jump,
-    integrated by scipy's solve_ivp on the gain of eq. 2."""
-    y, z1, w, z2 = state
-    if jump_mm == 0.0:
-        return np.array(state, dtype=float)
-    damping = params["c0"] + params["c2"]
-    xi = params["c0"] / damping * jump_mm
-    gain = lambda _, z: [core.hysteretic_gain(z[0], xi, params["A2"], params["beta2"], params["gamma2"], params["n2"])]
-    z2_end = solve_ivp(gain, (0.0, xi), [z2], rtol=1e-12, atol=1e-12).y[0, -1]
-    return np.array([y + jump_mm, z1, w + params["c2"] / damping * jump_mm, z2_end])
-
-
-def reference_force(params, time_s, x_mm, v_mm_s, rtol=1e-10, atol=1e-9):
-    """Independent reference: scipy's Radau on eqs. 1-4 (``bushing_core.rhs``), restarted at
-    every sample with the same piecewise-linear input as the FMU (x_k + v_k*t, with a
-    displacement jump where x_k differs from the previous step's end)."""
-    state = np.array(core.initial_state(params, x_mm[0]))
-    state_x = x_mm[0]
-    forces = [core.force(state, x_mm[0], v_mm_s[0], params)]
-    for k in range(len(time_s) - 1):
-        h = time_s[k + 1] - time_s[k]
-        state = reference_jump(params, state, x_mm[k] - state_x)
-        solution = solve_ivp(core.rhs, (0.0, h), state, method="Radau", args=(x_mm[k], v_mm_s[k], params),
-                             rtol=rtol, atol=atol)
-        assert solution.success, solution.message
-        state = solution.y[:, -1]
-        state_x = x_mm[k] + v_mm_s[k] * h
-        forces.append(core.force(state, state_x, v_mm_s[k], params))
-    return np.array(forces)
 
 
 def paper_equations(t, state, p, displacement, velocity):
@@ -80,6 +46,51 @@ def paper_force(p, time_s, displacement, velocity, rtol=1e-10, atol=1e-10):
     x, xd = displacement(time_s), velocity(time_s)
     wd = (p["c2"] * xd + p["k2"] * (x - w) + p["alpha2"] * z2) / (p["c0"] + p["c2"])
     return p["k0"] * y + p["c0"] * wd
+
+
+JUMP_RAMP_S = 1e-9
+"""A displacement jump, for the references below: the limit of a ramp this short."""
+
+
+def paper_ramp(p, state, x_start, dx, duration_s, rtol=1e-10, atol=1e-12):
+    """The state (y, z1, w, z2) after the displacement moves from ``x_start`` by ``dx`` [mm] at
+    constant speed over ``duration_s``: scipy's Radau on :func:`paper_equations`."""
+    speed = dx / duration_s
+    solution = solve_ivp(paper_equations, (0.0, duration_s), np.asarray(state, dtype=float), method="Radau",
+                         args=(p, lambda t: x_start + speed * t, lambda t: speed), rtol=rtol, atol=atol)
+    assert solution.success, solution.message
+    return solution.y[:, -1]
+
+
+def paper_eq5(p, state, x, v):
+    """Eq. 5 with eq. 4, F = k0*y + c0*dw/dt [N], typed from the paper once more."""
+    y, _, w, z2 = state
+    return p["k0"] * y + p["c0"] * (p["c2"] * v + p["k2"] * (x - w) + p["alpha2"] * z2) / (p["c0"] + p["c2"])
+
+
+def reference_jump(p, state, x_start, jump_mm):
+    """Independent reference for a displacement jump: the paper's equations over a ramp of
+    JUMP_RAMP_S (its limit differs by about JUMP_RAMP_S times the relaxation rates, < 1e-5)."""
+    return paper_ramp(p, state, x_start, jump_mm, JUMP_RAMP_S)
+
+
+def reference_force(params, time_s, x_mm, v_mm_s, rtol=1e-10, atol=1e-9):
+    """Independent reference with the FMU's input convention: scipy's Radau on the paper's
+    eqs. 1-4 (:func:`paper_equations`) over each sample with the input x_k + v_k*(t - t_k), a
+    displacement jump (:func:`reference_jump`) where x_k differs from the previous step's end,
+    and eq. 5 at each sample with the velocity of the step that ends there."""
+    p = params
+    state = [p["k1"] * x_mm[0] / (p["k0"] + p["k1"]), 0.0, x_mm[0], 0.0]   # relaxed equilibrium
+    state_x = x_mm[0]
+    forces = [paper_eq5(p, state, x_mm[0], v_mm_s[0])]
+    for k in range(len(time_s) - 1):
+        h = time_s[k + 1] - time_s[k]
+        if x_mm[k] != state_x:
+            state = reference_jump(p, state, state_x, x_mm[k] - state_x)
+        state = paper_ramp(p, state, x_mm[k], v_mm_s[k] * h, h, rtol=rtol, atol=atol)
+        state_x = x_mm[k] + v_mm_s[k] * h
+        forces.append(paper_eq5(p, state, state_x, v_mm_s[k]))
+    return np.array(forces)
 
 
 @pytest.fixture(scope="session")

@@ -52,7 +52,7 @@ def test_libcosim_applies_each_components_parameter_set(rig_runs, component):
         assert np.max(np.abs(force - wrong)) > 0.01 * np.max(np.abs(force))
 
 
-def test_a_refused_step_reaches_libcosims_log_with_its_category(rig_runs, tmp_path):
+def test_an_invalid_parameter_fails_libcosims_run_and_reaches_its_log(rig_runs, tmp_path):
     import re
     import shutil
     import subprocess
@@ -72,4 +72,5 @@ def test_a_refused_step_reaches_libcosims_log_with_its_category(rig_runs, tmp_pa
     result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
     assert "step False" in result.stdout, result.stdout + result.stderr[-2000:]
     log = result.stdout + result.stderr  # libcosim's console sink writes to stdout
-    assert "category=logStatusError" in log and "c1 = 0.0 N.s/mm must be > 0" in log
+    assert "category=logStatusError" in log and "c1 = 0.0 [N.s/mm] must be > 0" in log
+    assert result.returncode == 0    # a failed step, not an aborted process

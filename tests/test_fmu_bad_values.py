@@ -1,9 +1,14 @@
 """Bad values: refused with a logged reason, no NaN force, nothing lost, no crash or hang."""
 import math
+import subprocess
+import sys
 import time
 
 import numpy as np
 import pytest
+
+from fmpy import simulate_fmu
+from fmpy.fmi1 import FMICallException
 
 from fmu_harness import BushingFmu
 
@@ -29,7 +34,8 @@ def undisturbed_force(fmu_path, count):
 @pytest.mark.parametrize("name, value, fragments", [
     ("c1", 0.0, ["c1 = 0.0", "must be > 0"]),
     ("c1", -1.0, ["c1 = -1.0", "must be > 0"]),
-    ("c0", -300.0, ["c0 + c2", "must be > 0"]),
+    ("c0", -300.0, ["c0 = -300.0 [N.s/mm]", "must be >= 0"]),
+    ("c2", -1.0, ["c2 = -1.0 [N.s/mm]", "must be >= 0"]),
     ("n1", 0.0, ["n1 = 0.0", "must be > 0"]),
     ("k2", -5.0, ["k2 = -5.0", "must be >= 0"]),
     ("A2", math.nan, ["A2 = nan", "finite"]),
@@ -59,7 +65,10 @@ def test_non_finite_input_refuses_the_step_with_its_name(fmu_path, name, value):
     fmu.set(name, value)
     assert fmu.do_step(STEP) == "discard"
     assert any(f"input {name} = {value}" in message for message in fmu.messages_with("error"))
-    assert fmu.get("F") == force
+    assert fmu.get("F") == force and fmu.get("F") == force
+    # The last finite force is returned, and said so once, not silently.
+    stale = [m for m in fmu.messages_with("error") if m.startswith("F cannot be computed")]
+    assert len(stale) == 1 and f"keeps its last finite value {force} N" in stale[0]
     fmu.free()
 
 
@@ -109,6 +118,26 @@ def test_implausible_travel_is_warned_once(fmu_path):
     fmu.free()
 
 
+def test_a_millimetre_ramp_into_the_metre_port_warns_about_the_force_once(fmu_path):
+    # 2 (mm meant) ramped in over 0.5 s as metres: a finite but absurd force of order 1e7 N.
+    fmu = BushingFmu(fmu_path)
+    for k in range(500):
+        assert fmu.step(k * 4e-3, 4.0, STEP) == "ok"
+    force_warnings = [m for m in fmu.messages_with("warning") if "exceeds" in m and "N, the force of" in m]
+    assert len(force_warnings) == 1 and "the FMU takes metres" in force_warnings[0]
+    assert abs(fmu.get("F")) > 1e6
+    fmu.free()
+
+
+def test_the_papers_tests_raise_no_force_warning(fmu_path):
+    fmu = BushingFmu(fmu_path)
+    run_steps(fmu, 200)
+    for k in range(400):   # the step test's ramp: 2 mm in 0.4 s
+        assert fmu.step(2 * MM * min(1.0, k / 400), 2 * MM / 0.4, STEP) == "ok"
+    assert fmu.messages_with("warning") == []
+    fmu.free()
+
+
 @pytest.mark.parametrize("name, value, fragment", [
     ("A1", 0.5, "A1 >= 1"), ("beta2", -0.1, "beta2 >= 0"), ("gamma2", 1.0, "beta2 - gamma2 > 0")])
 def test_paper_constraint_violation_is_accepted_with_a_warning(fmu_path, name, value, fragment):
@@ -128,11 +157,33 @@ def test_messages_carry_a_category_the_model_description_declares(fmu_path):
     fmu.free()
 
 
-def test_parameters_fixed_after_initialization_start_from_the_equilibrium(fmu_path):
-    # Invalid at exitInitializationMode: no initial state can be computed then. Once fixed,
-    # the first step starts from the relaxed equilibrium at x0, as if they had been valid.
+@pytest.mark.parametrize("name, value, fragment", [
+    ("c1", -1.0, "c1 = -1.0 [N.s/mm] must be > 0"),
+    ("k0", -1.0, "k0 = -1.0 [N/mm] must be >= 0"),
+    ("n1", math.nan, "n1 = nan [1] must be a finite number"),
+    ("c2", -1.0, "c2 = -1.0 [N.s/mm] must be >= 0"),
+])
+def test_invalid_start_values_make_simulate_fmu_raise_and_name_the_parameter(fmu_path, name, value, fragment,
+                                                                             capfd):
+    # Before: a 2-row result with F = 0 and no error. Now the first step fails (fmi2Fatal:
+    # pythonfmu's only failing status) and the reason reaches stderr without any logging set up.
+    with pytest.raises(FMICallException, match="fmi2DoStep failed with status 4"):
+        simulate_fmu(str(fmu_path), stop_time=0.01, step_size=STEP, start_values={name: value})
+    assert fragment in capfd.readouterr().err
+    messages = []
+    with pytest.raises(FMICallException):
+        simulate_fmu(str(fmu_path), stop_time=0.01, step_size=STEP, start_values={name: value}, debug_logging=True,
+                     logger=lambda component, instance, status, category, message: messages.append(
+                         (status, (category or b"").decode(), message.decode())))
+    assert any(status == 3 and category == "logStatusError" and fragment in message   # 3: fmi2Error
+               for status, category, message in messages), messages
+
+
+def test_start_values_fixed_before_the_first_step_start_from_the_equilibrium(fmu_path):
+    # Invalid at exitInitializationMode (logged), corrected before the first step: the run starts
+    # from the relaxed equilibrium at x0, as if they had been valid.
     fmu = BushingFmu(fmu_path, start_values={"c1": -1.0}, x0_m=1.0 * MM)
-    assert fmu.do_step(STEP) == "discard"
+    assert any("c1 = -1.0 [N.s/mm] must be > 0" in m for m in fmu.messages_with("error"))
     fmu.set("c1", 1.485)
     assert fmu.do_step(STEP) == "ok"
     reference = BushingFmu(fmu_path, x0_m=1.0 * MM)
@@ -140,3 +191,54 @@ def test_parameters_fixed_after_initialization_start_from_the_equilibrium(fmu_pa
     assert fmu.states() == reference.states() and fmu.get("F") == reference.get("F")
     for instance in (fmu, reference):
         instance.free()
+
+
+def test_invalid_start_value_makes_fmpys_command_line_fail(fmu_path):
+    command = [sys.executable, "-c", "from fmpy.cli import main; main()", "simulate", str(fmu_path),
+               "--stop-time", "0.01", "--start-values", "c1", "-1"]
+    result = subprocess.run(command, capture_output=True, text=True, timeout=120)
+    assert result.returncode != 0
+    assert "c1 = -1.0 [N.s/mm] must be > 0" in result.stderr, result.stderr[-2000:]
+
+
+FAIL_FREE_AND_RUN_AGAIN = """
+import sys
+from fmpy import extract, read_model_description
+from fmpy.fmi1 import FMICallException
+from fmpy.fmi2 import FMU2Slave
+path = sys.argv[1]
+description, folder = read_model_description(path), extract(path)
+refs = {v.name: v.valueReference for v in description.modelVariables}
+
+def instance(name, c1):
+    fmu = FMU2Slave(guid=description.guid, unzipDirectory=folder,
+                    modelIdentifier=description.coSimulation.modelIdentifier, instanceName=name)
+    fmu.instantiate()
+    fmu.setupExperiment(startTime=0.0)
+    fmu.enterInitializationMode()
+    fmu.setReal([refs["c1"]], [c1])
+    fmu.exitInitializationMode()
+    return fmu
+
+for attempt in range(3):
+    fmu = instance(f"bad{attempt}", -1.0)
+    try:
+        fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=1e-3)
+    except FMICallException as exc:
+        print("failed with status", exc.status)
+    fmu.freeInstance()
+good = instance("good", 1.485)
+good.doStep(currentCommunicationPoint=0.0, communicationStepSize=1e-3)
+print("then ran", good.getReal([refs["F"]])[0])
+good.terminate()
+good.freeInstance()
+"""
+
+
+def test_instances_that_failed_to_start_can_be_freed_and_the_host_runs_on(fmu_path):
+    # pythonfmu 0.7 releases an instance twice after an exception (once when raised, once when
+    # freed): the host crashed when it freed the failed instance, or at its exit (libcosim).
+    result = subprocess.run([sys.executable, "-c", FAIL_FREE_AND_RUN_AGAIN, str(fmu_path)], capture_output=True,
+                            text=True, timeout=300)
+    assert result.returncode == 0, (result.returncode, result.stderr[-2000:])
+    assert result.stdout.count("failed with status 4") == 3 and "then ran 0.0" in result.stdout

@@ -15,8 +15,8 @@ from test_fmu_numerics import simulate_with_fmpy
 
 BASELINES = ("spencer", "bouc_wen", "kelvin_voigt")
 MM = 1e-3
-BAD_VALUES = {"spencer": ("c1", 0.0, "c1 = 0.0 N.s/mm must be > 0"),
-              "bouc_wen": ("n", -1.0, "n = -1.0 must be > 0"),
+BAD_VALUES = {"spencer": ("c1", 0.0, "c1 = 0.0 [N.s/mm] must be > 0"),
+              "bouc_wen": ("n", -1.0, "n = -1.0 [1] must be > 0"),
               "kelvin_voigt": ("k", float("nan"), "k = nan [N/mm] is not a finite number")}
 
 

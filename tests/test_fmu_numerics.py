@@ -2,11 +2,9 @@
 import numpy as np
 import pytest
 from fmpy import simulate_fmu
-from scipy.integrate import solve_ivp
 
-from conftest import DATA, paper_parameters, reference_force
+from conftest import DATA, paper_force, paper_parameters, reference_force
 from fmu_harness import BushingFmu
-from fmu_src import bushing_core as core
 from identification.measurements import load_measurement
 from identification.objectives import nrmse
 from identification.forward_model import prepare_input
@@ -74,14 +72,9 @@ def test_force_converges_as_the_communication_step_shrinks(fmu_path):
     sine = Sine(2.0, 10.0)
     check_times = sample_times(0.2, 250.0)  # every 4 ms
 
-    def continuous_rhs(t, state):
-        x, v = sine.signals(np.array([t]))
-        return core.rhs(0.0, state, x[0], v[0], params)
-
-    solution = solve_ivp(continuous_rhs, (0.0, 0.2), np.zeros(4), method="Radau", t_eval=check_times,
-                         rtol=1e-10, atol=1e-9)
+    reference = paper_force(params, check_times, lambda t: sine.signals(t)[0], lambda t: sine.signals(t)[1],
+                            rtol=1e-10, atol=1e-9)
     x_ref, v_ref = sine.signals(check_times)
-    reference = np.array([core.force(s, x, v, params) for s, x, v in zip(solution.y.T, x_ref, v_ref)])
 
     errors = []
     for step in (4e-3, 2e-3, 1e-3, 5e-4):

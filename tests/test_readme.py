@@ -20,6 +20,13 @@ def test_interface_table_matches_the_model_description(fmu_path):
             assert default == "—", name
 
 
+def test_interface_table_states_each_parameters_allowed_range():
+    from fmu_src.bushing_params import PARAMETER_SPECS
+    rows = re.findall(r"^\| `(\w+)` \| parameter \| [^|]+ \| [^|]+ \| ([^|]+) \|", (REPO / "README.md").read_text(), re.M)
+    allowed = {name: value.strip() for name, value in rows}
+    assert allowed == {spec.name: spec.allowed.replace("any finite value", "any") for spec in PARAMETER_SPECS}
+
+
 def test_ci_runs_the_readme_test_command():
     readme = (REPO / "README.md").read_text()
     ci = (REPO / ".ci" / "run").read_text()

@@ -1,10 +1,12 @@
 """Training tests from the command line and from a tests.json manifest."""
 import json
 import re
+import time
 
 import pytest
 
 from conftest import DATA
+from fmu_src.parameter_files import load_parameters
 from identification.__main__ import main
 from identification.measurements import MeasurementError
 from identification.rig_tests import ManifestError, load_manifest, training_tests
@@ -80,3 +82,50 @@ def test_numeric_options_out_of_range_are_refused(tmp_path, capsys, option, valu
         main(["fit", "--sine", str(SINE), option, value, "--out", str(tmp_path / "p.json")])
     assert exit_info.value.code == 2
     assert f"argument {option}" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("command, fragment", [
+    (["sensitivity", "--params", str(DATA / "params_table5_combined.json"), "--csv", "/nonexistent/dir/s.csv"],
+     "--csv /nonexistent/dir/s.csv: the directory"),
+    (["report", "--params", str(DATA / "params_table5_combined.json"), "--data", str(SINE),
+      "--plots", "/nonexistent/dir/plots"], "--plots /nonexistent/dir/plots: the directory"),
+    (["predict", "--params", str(DATA / "params_table5_combined.json"), "--data", str(SINE),
+      "--out", "/nonexistent/dir/p.csv"], "--out /nonexistent/dir/p.csv: the directory"),
+    (["compare", "--sine", str(SINE), "--out", "/nonexistent/dir/cmp"], "--out /nonexistent/dir/cmp: the directory"),
+    (["fit-many", str(DATA), "--out", "/nonexistent/dir/fleet"], "--out /nonexistent/dir/fleet: the directory"),
+])
+def test_every_command_checks_its_outputs_before_any_work(capsys, command, fragment):
+    started = time.monotonic()
+    assert main(command) == 2
+    assert fragment in capsys.readouterr().err
+    assert time.monotonic() - started < 5      # refused at once, not after the work
+
+
+def test_sensitivity_delta_must_be_a_fraction(capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        main(["sensitivity", "--params", str(DATA / "params_table5_combined.json"), "--delta", "0"])
+    assert exit_info.value.code == 2 and "argument --delta" in capsys.readouterr().err
+
+
+def test_a_fit_whose_files_cannot_be_written_after_all_is_rescued_into_the_working_directory(
+        tmp_path, monkeypatch, capsys):
+    # The check before the work passes; then the folder disappears during the fit.
+    import shutil
+    import fmu_src.parameter_files as parameter_files
+    out_dir = tmp_path / "results"
+    out_dir.mkdir()
+    work = tmp_path / "work"
+    work.mkdir()
+    monkeypatch.chdir(work)
+    real_save = parameter_files.save_parameters
+
+    def vanishing_folder(path, *args, **kwargs):
+        shutil.rmtree(out_dir, ignore_errors=True)
+        return real_save(path, *args, **kwargs)
+    monkeypatch.setattr("identification.fitting.save_parameters", vanishing_folder)
+    assert main(["fit", "--model", "kelvin_voigt", "--sine", str(SINE), "--out", str(out_dir / "p.json"),
+                 "--quiet"]) == 0
+    rescued, = work.glob("rescued_fit_*.json")
+    err = capsys.readouterr().err
+    assert "could not write the fit's files" in err and str(rescued) in err
+    assert load_parameters(rescued, model="kelvin_voigt")["k"] > 0

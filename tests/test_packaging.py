@@ -1,0 +1,93 @@
+"""Installable like the tools users know: console scripts, package data, one version."""
+import os
+import shutil
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+import pytest
+from fmpy import read_model_description
+
+from conftest import REPO
+from fmu_src import __version__
+
+BIN = Path(sys.executable).parent
+
+
+@pytest.fixture(scope="module")
+def installed_wheel(tmp_path_factory) -> Path:
+    """The project's wheel, unpacked into a folder of its own (a pure-Python wheel unpacked is
+    installed): what `pip install` puts on a user's machine, with no checkout behind it."""
+    folder = tmp_path_factory.mktemp("wheel")
+    # Built from a copy: setuptools leaves build/ behind, whose stale files a later build would pack.
+    source = folder / "source"
+    shutil.copytree(REPO, source, ignore=shutil.ignore_patterns(".git", ".venv", "build", "dist", "out", "*.egg-info",
+                                                                 "__pycache__", ".pytest_cache"))
+    result = subprocess.run([sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", str(source), "-w", str(folder)],
+                            capture_output=True, text=True, timeout=600)
+    assert result.returncode == 0, result.stderr[-3000:]
+    wheel, = folder.glob("*.whl")
+    site = folder / "site"
+    with zipfile.ZipFile(wheel) as archive:
+        archive.extractall(site)
+    return site
+
+
+def run_outside_the_checkout(site: Path, cwd: Path, code: str) -> subprocess.CompletedProcess:
+    # PYTHONPATH comes before the editable install's finder, so the unpacked wheel is what runs.
+    environment = dict(os.environ, PYTHONPATH=str(site))
+    return subprocess.run([sys.executable, "-c", code], cwd=cwd, env=environment, capture_output=True, text=True,
+                          timeout=300)
+
+
+def test_the_wheel_declares_both_console_scripts(installed_wheel):
+    entry_points, = installed_wheel.glob("*.dist-info/entry_points.txt")
+    text = entry_points.read_text()
+    assert "bushing-identify = identification.__main__:main" in text
+    assert "bushing-build-fmu = build_fmu:main" in text
+
+
+def test_the_installed_build_finds_its_default_parameters_outside_the_checkout(installed_wheel, tmp_path):
+    code = ("import sys, build_fmu\n"
+            "print(build_fmu.__file__)\n"
+            "sys.exit(build_fmu.main(['--model', 'kelvin_voigt']))\n")
+    result = run_outside_the_checkout(installed_wheel, tmp_path, code)
+    assert result.returncode == 0, result.stderr[-3000:]
+    assert str(installed_wheel) in result.stdout          # the wheel's copy ran, not the checkout's
+    fmu = tmp_path / "dist" / "KelvinVoigtBushing.fmu"    # in the working directory, not site-packages
+    assert fmu.is_file()
+    assert read_model_description(str(fmu)).version == __version__
+
+
+@pytest.mark.parametrize("script", ["bushing-identify", "bushing-build-fmu"])
+def test_console_scripts_print_the_projects_version_from_any_directory(script, tmp_path):
+    path = BIN / script
+    if not path.exists():
+        pytest.skip(f"{script} is not installed in this environment (pip install -e . makes it)")
+    result = subprocess.run([str(path), "--version"], cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0
+    assert result.stdout.strip() == f"{script} {__version__}"
+
+
+def test_version_lives_in_one_place():
+    pyproject = (REPO / "pyproject.toml").read_text()
+    assert 'dynamic = ["version"]' in pyproject and 'version = { attr = "fmu_src.__version__" }' in pyproject
+    from importlib.metadata import PackageNotFoundError, version
+    try:
+        assert version("boucwen-bushing") == __version__
+    except PackageNotFoundError:
+        pytest.skip("the project is not installed")
+    assert f"## {__version__}" in (REPO / "CHANGELOG.md").read_text()
+
+
+def test_fmu_carries_the_version_and_the_generation_tool(fmu_path):
+    description = read_model_description(str(fmu_path))
+    assert description.version == __version__
+    assert description.generationTool.startswith(f"boucwen-bushing {__version__} (build_fmu.py) with PythonFMU")
+
+
+def test_license_is_the_one_the_package_and_the_fmu_declare(fmu_path):
+    assert (REPO / "LICENSE").read_text().startswith("MIT License")
+    assert 'license = { text = "MIT" }' in (REPO / "pyproject.toml").read_text()
+    assert read_model_description(str(fmu_path)).license == "MIT"
