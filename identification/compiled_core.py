@@ -1,16 +1,25 @@
 """The model core compiled with numba, for simulating whole populations of parameter sets.
 
-One definition: the source of ``fmu_src/bushing_core.py`` is executed into a private
-namespace and its kernels (plain float arithmetic, errors as status codes) are replaced by
+One definition: the source of ``fmu_src/bushing_core.py`` is written, with the population
+loop below appended, into a generated module in the cache folder (:func:`cache_directory`),
+where its kernels (plain float arithmetic, errors as status codes) are replaced by
 numba-compiled versions of themselves, so that they call each other compiled. The FMU runs
 the same functions as plain Python; ``tests/test_compiled_core.py`` checks the two agree to
-1e-9 (they are bitwise equal in practice). Compilation takes a few seconds on first use.
+1e-9 (they are bitwise equal in practice). Compilation takes a few seconds on first use; numba
+caches the machine code on disk, so later processes load it.
 
 Units as in the core: mm, mm/s, N, s; parameters in the paper's N-mm-s units.
 """
 from __future__ import annotations
 
+import hashlib
+import importlib.util
 import inspect
+import os
+import sys
+import types
+import warnings
+from pathlib import Path
 from typing import Mapping
 
 import numba
@@ -22,34 +31,19 @@ from fmu_src.bushing_params import PARAMETER_NAMES
 
 _KERNELS = ("_decay_factors", "_rk4_in_xi", "_segment", "_block_step", "_gain_variation",
             "_substeps_needed", "_jump_kernel", "_integrate")
-
-
-def _compile_core():
-    namespace = {"__name__": "bushing_core_compiled"}
-    exec(compile(inspect.getsource(_core), _core.__file__, "exec"), namespace)
-    for name in _KERNELS:
-        # error_model="numpy": a division by zero gives inf/nan (caught as NOT_FINITE)
-        # instead of an exception that would abort the whole population.
-        namespace[name] = numba.njit(error_model="numpy")(namespace[name])
-    return namespace
-
-
-_compiled = _compile_core()
-_jump_kernel = _compiled["_jump_kernel"]
-_integrate = _compiled["_integrate"]
-_OK = _core.OK
 _I = {name: i for i, name in enumerate(PARAMETER_NAMES)}
-_C0, _K0, _C1, _K1, _C2, _K2 = _I["c0"], _I["k0"], _I["c1"], _I["k1"], _I["c2"], _I["k2"]
-_ALPHA1, _ALPHA2, _BETA1, _BETA2 = _I["alpha1"], _I["alpha2"], _I["beta1"], _I["beta2"]
-_GAMMA1, _GAMMA2, _N1, _N2, _A1, _A2 = _I["gamma1"], _I["gamma2"], _I["n1"], _I["n2"], _I["A1"], _I["A2"]
+CACHE_ENVIRONMENT = "BUSHING_CACHE_DIR"
 
 
-@numba.njit(error_model="numpy", parallel=True)
-def _simulate_population(matrix, t, x, v, out_index, out_velocity, max_substeps):
+def _population_forces(matrix, t, x, v, out_index, out_velocity, max_substeps):
     """Forces of every parameter set (rows of ``matrix``) at the communication points
     ``t[out_index]``; the input over [t_k, t_k+1] is x_k + v_k*(t - t_k), as in the FMU, and the
     force at an output point is eq. 5 with the velocity ``out_velocity`` (the FMU's direct
-    feedthrough of the velocity set at that instant)."""
+    feedthrough of the velocity set at that instant).
+
+    Written here, never called here: its source is compiled in the generated module (see
+    :func:`_load_compiled_module`), where ``_jump_kernel`` and ``_integrate`` are the core's
+    compiled kernels and the parameter indices are constants."""
     count, samples, outputs = matrix.shape[0], t.size, out_index.size
     forces = np.full((count, outputs), np.nan)
     for i in numba.prange(count):
@@ -86,6 +80,68 @@ def _simulate_population(matrix, t, x, v, out_index, out_velocity, max_substeps)
                                                         + p[_ALPHA2] * z2) / C)
                 j += 1
     return forces
+
+
+def _compiled_source() -> str:
+    """One module: the core's source, its kernels compiled, and the population loop. Generated
+    as a file so that numba can cache the machine code on disk, and named after a hash of its
+    content, so that a change to the core or to the loop compiles afresh (numba's cache checks
+    only the file's own time stamp, not the sources of the functions a kernel calls)."""
+    indices = "\n".join(f"_{name.upper()} = {index}" for name, index in _I.items())
+    return (inspect.getsource(_core)
+            + "\n\n# ---- appended by identification/compiled_core.py ----\n"
+            + "import numba\nimport numpy as np\n\n"
+            + "_OK = OK\n" + indices + "\n"
+            # error_model="numpy": a division by zero gives inf/nan (caught as NOT_FINITE)
+            # instead of an exception that would abort the whole population.
+            + f"for _name in {_KERNELS!r}:\n"
+            + "    globals()[_name] = numba.njit(error_model='numpy', cache=True)(globals()[_name])\n\n\n"
+            + inspect.getsource(_population_forces)
+            + "\n\n_simulate_population = numba.njit(error_model='numpy', parallel=True, cache=True)"
+              "(_population_forces)\n")
+
+
+def cache_directory() -> Path:
+    """Where the generated module and numba's cache live: $BUSHING_CACHE_DIR, else
+    $XDG_CACHE_HOME/boucwen-bushing, else ~/.cache/boucwen-bushing."""
+    if os.environ.get(CACHE_ENVIRONMENT):
+        return Path(os.environ[CACHE_ENVIRONMENT])
+    return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "boucwen-bushing"
+
+
+def _load_compiled_module():
+    source = _compiled_source()
+    name = f"bushing_compiled_{hashlib.sha256(source.encode()).hexdigest()[:16]}"
+    try:
+        folder = cache_directory()
+        folder.mkdir(parents=True, exist_ok=True)
+        path = folder / f"{name}.py"
+        if not path.is_file() or path.read_text() != source:
+            # Written whole and renamed: worker processes start at once and must never read half a file.
+            partial = path.with_suffix(f".{os.getpid()}.tmp")
+            partial.write_text(source)
+            os.replace(partial, path)
+    except OSError as exc:
+        warnings.warn(f"cannot write the compiled model's cache in {cache_directory()} ({exc}); compiling "
+                      f"in memory at every start (set {CACHE_ENVIRONMENT} to a writable folder)", stacklevel=3)
+        module = types.ModuleType(name)
+        exec(compile(source.replace(", cache=True", ""), f"<{name}>", "exec"), module.__dict__)
+        return module
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+_compiled = _load_compiled_module()
+_jump_kernel = _compiled._jump_kernel
+_integrate = _compiled._integrate
+_simulate_population = _compiled._simulate_population
+_OK = _core.OK
+_C0, _K0, _C1, _K1, _C2, _K2 = _I["c0"], _I["k0"], _I["c1"], _I["k1"], _I["c2"], _I["k2"]
+_ALPHA1, _ALPHA2, _BETA1, _BETA2 = _I["alpha1"], _I["alpha2"], _I["beta1"], _I["beta2"]
+_GAMMA1, _GAMMA2, _N1, _N2, _A1, _A2 = _I["gamma1"], _I["gamma2"], _I["n1"], _I["n2"], _I["A1"], _I["A2"]
 
 
 def simulate_population_held(parameter_sets, time_s, displacement_mm, velocity_mm_s,

@@ -59,3 +59,47 @@ def test_compiled_forces_equal_the_python_core_on_a_random_population():
     for row, forces in zip(matrix, compiled):
         python = simulate_python_core(dict(zip(PARAMETER_NAMES, row)), t, x, v)
         np.testing.assert_allclose(forces, python, rtol=1e-9, atol=1e-9 * np.max(np.abs(python)))
+
+
+CACHE_PROBE = """
+import numpy as np
+from identification import compiled_core
+t = np.linspace(0.0, 0.02, 21)
+compiled_core.simulate_population_held([dict(zip(compiled_core.PARAMETER_NAMES, [1.0] * 16))], t, t, np.ones_like(t))
+stats = compiled_core._simulate_population.stats
+print(compiled_core._compiled.__file__, len(stats.cache_hits), len(stats.cache_misses))
+"""
+
+
+def run_cache_probe(cache_dir):
+    import os
+    import subprocess
+    import sys
+    from conftest import REPO
+    environment = dict(os.environ, BUSHING_CACHE_DIR=str(cache_dir), PYTHONPATH=str(REPO))
+    result = subprocess.run([sys.executable, "-c", CACHE_PROBE], env=environment, capture_output=True, text=True,
+                            timeout=600, cwd=REPO)
+    assert result.returncode == 0, result.stderr[-3000:]
+    path, hits, misses = result.stdout.split()
+    return path, int(hits), int(misses)
+
+
+def test_the_compiled_model_is_cached_on_disk_for_the_next_process(tmp_path):
+    path, hits, misses = run_cache_probe(tmp_path)
+    assert (hits, misses) == (0, 1)            # the first process compiles ...
+    assert path.startswith(str(tmp_path))
+    assert any(tmp_path.glob("__pycache__/*_population_forces*.nbi"))
+    assert run_cache_probe(tmp_path) == (path, 1, 0)   # ... the next one loads the machine code
+
+
+def test_the_cached_module_is_named_after_its_content_so_a_changed_core_compiles_afresh():
+    # numba checks only the time stamp of a kernel's own file: the name must change with the
+    # source of everything compiled into it (the core and the population loop).
+    import hashlib
+    import inspect
+    from fmu_src import bushing_core
+    from identification import compiled_core
+    source = open(compiled_core._compiled.__file__).read()
+    assert inspect.getsource(bushing_core) in source
+    assert inspect.getsource(compiled_core._population_forces) in source
+    assert compiled_core._compiled.__name__ == f"bushing_compiled_{hashlib.sha256(source.encode()).hexdigest()[:16]}"
