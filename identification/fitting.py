@@ -144,11 +144,31 @@ class FitResult:
                            f"its noise level {worst.noise_fraction:.2%} (the floor is {FLOOR_FACTOR}x)")
         if self.space is not None and self.agreeing < MIN_AGREEING:
             reasons.append(f"only {self.agreeing} of {self.final_starts} final starts reach the best misfit")
-        hint = ("more starts (--starts, --screening) may find a better optimum"
-                if self.space is not None and self.agreeing < MIN_AGREEING else
-                "the starts agree, so the model may not describe these data to their noise level "
-                "(or the noise estimate is low: correlated noise reads low)")
+        edges = self.at_box_edge()
+        if edges:
+            hint = (f"the best fit lies on the search box's bound in {', '.join(edges)}: the parameters that "
+                    "describe these data may lie outside the box (see identification/search_space.py)")
+        elif self.space is not None and self.agreeing < MIN_AGREEING:
+            hint = "more starts (--starts, --screening) may find a better optimum"
+        else:
+            hint = ("the starts agree, so the model may not describe these data to their noise level "
+                    "(or the noise estimate is low: correlated noise reads low)")
         return f"not converged: {'; '.join(reasons)}; {hint}"
+
+    def at_box_edge(self, tolerance: float = 1e-3) -> list[str]:
+        """The searched coordinates of the best fit within ``tolerance`` of the box's size from
+        an upper bound, or from a lower bound that is a limit of the search (the time constants'
+        floor, n >= 0.1). Other lower bounds stand for a physical limit a fit may rightly sit on:
+        no spring or dashpot (1e-3 k_ref, 1e-4 c_ref), A >= 1, beta >= 0 and the shape sums >= 0."""
+        if self.space is None:
+            return []
+        theta = self.space.to_coordinates(self.parameters.parameters)
+        edges = []
+        for c, value, (low, high) in zip(self.space.coordinates, theta, self.space.bounds()):
+            margin = tolerance * (high - low)
+            if value >= high - margin or (value <= low + margin and c.kind in ("time_constant", "exponent")):
+                edges.append(c.parameter)
+        return edges
 
     def provenance(self) -> dict:
         """What the parameter file records of the fit: everything but timings and engine, so
