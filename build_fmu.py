@@ -47,7 +47,7 @@ from fmu_src.parameter_files import parameter_document, read_parameter_set  # no
 PACKED_LIBRARY_INIT = '''"""Packed library of the bushing FMU (written by build_fmu.py)."""
 from pathlib import Path
 
-from . import bushing_core, parameter_files
+from . import bushing_core, bushing_models, parameter_files
 
 _DEFAULTS = parameter_files.read_parameter_set(Path(__file__).with_name("default_parameters.json"))
 MODEL = _DEFAULTS.model

@@ -33,12 +33,16 @@ from dataclasses import dataclass
 from typing import Callable, Mapping
 
 from . import bushing_params as proposed
-from .bushing_params import DAMPING, EXPONENT, GAIN, SPRING, WEIGHT, ParameterError, ParameterSpec, number_errors, range_errors
+from .bushing_params import (DAMPING, EXPONENT, GAIN, SPRING, WEIGHT, ParameterError, ParameterSpec, number_errors,
+                             range_errors)
 
 RIGID = 1e12
+"""How much stiffer (or more viscous) than the rest a limit element is made (see above)."""
 PLAUSIBLE_TRAVEL_MM = 100.0
 PLAUSIBLE_VELOCITY_MM_S = 1000.0
-"""How much stiffer (or more viscous) than the rest a limit element is made (see above)."""
+"""Beyond a rubber bushing's travel and speed in service: the FMU warns above them (most likely
+millimetres entered where metres are expected), and :meth:`BushingModel.plausible_force_bound`
+is the force there."""
 
 
 @dataclass(frozen=True)
@@ -102,9 +106,9 @@ class BushingModel:
         and Bouc-Wen gain of the model (A weighted by its alpha) and every dashpot in parallel,
         at PLAUSIBLE_TRAVEL_MM and PLAUSIBLE_VELOCITY_MM_S, plus the constant force. Above it
         the inputs are most likely in the wrong units (millimetres in the metre port)."""
-        stiffness = sum(abs(params[s.name]) * abs(params.get("alpha" + s.name[1:], 1.0) if s.name.startswith("A")
-                                                  else 1.0)
-                        for s in self.specs if s.unit == "N/mm")
+        def weight(name):   # a Bouc-Wen gain A<i> counts with its alpha<i>
+            return abs(params.get("alpha" + name[1:], 1.0)) if name.startswith("A") else 1.0
+        stiffness = sum(abs(params[s.name]) * weight(s.name) for s in self.specs if s.unit == "N/mm")
         damping = sum(abs(params[s.name]) for s in self.specs if s.unit == "N.s/mm")
         return (stiffness * PLAUSIBLE_TRAVEL_MM + damping * PLAUSIBLE_VELOCITY_MM_S
                 + abs(self.force_offset(params)))

@@ -41,17 +41,18 @@ from pythonfmu.enums import Fmi2Status
 # (fmpy's simulate_fmu does). So module-level code here must touch no files: the packed
 # library, imported once and then cached, reads the default parameters.
 if __package__:
-    from . import bushing_core as core
+    from . import bushing_core as core, bushing_models as models
     MODEL = None  # only an FMU built by build_fmu.py has a model and defaults
     DEFAULT_PARAMETERS = None
 else:
     _library = importlib.import_module(__name__ + "_lib")
     core = _library.bushing_core
+    models = _library.bushing_models
     MODEL = _library.MODEL
     DEFAULT_PARAMETERS = _library.DEFAULT_PARAMETERS
 
 MM_PER_M = 1000.0
-PLAUSIBLE_TRAVEL_M = 0.1
+PLAUSIBLE_TRAVEL_M = models.PLAUSIBLE_TRAVEL_MM / MM_PER_M
 """|x| beyond this is far outside any rubber bushing's travel: most likely millimetres
 entered where metres are expected. It is warned about, not refused."""
 
@@ -240,7 +241,8 @@ class BushingSlave(Fmi2Slave):
         if abs(force) > self._force_bound and not self._force_warned:
             self._force_warned = True
             self.log(f"F = {force:.4g} N at t = {current_time + step_size} s exceeds {self._force_bound:.3g} N, the "
-                     "force of all the bushing's springs and dashpots at 0.1 m and 1 m/s: check the units of "
+                     f"force of all the bushing's springs and dashpots at {PLAUSIBLE_TRAVEL_M:g} m and "
+                     f"{models.PLAUSIBLE_VELOCITY_MM_S / MM_PER_M:g} m/s: check the units of "
                      f"the inputs (x = {self.x} m, v = {self.v} m/s; the FMU takes metres)",
                      Fmi2Status.warning, "logStatusWarning")
         self._state = state

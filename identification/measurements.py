@@ -14,7 +14,7 @@ amplifies displacement noise by about 1/(sqrt(2)*dt).
 
 Plausibility. A file in the wrong units loads without error, so :func:`plausibility_warnings`
 checks what a rubber-bushing test can look like and warns (``MeasurementWarning``), naming the
-column, what it found and the likely mistake: peak displacement outside PLAUSIBLE_TRAVEL_MM
+column, what it found and the likely mistake: peak displacement outside PLAUSIBLE_PEAK_DISPLACEMENT_MM
 (metres or micrometres in a millimetre column), peak force below MIN_PLAUSIBLE_FORCE_N (kN in
 a newton column), a secant stiffness (force range over displacement range) outside
 PLAUSIBLE_STIFFNESS_N_PER_MM, a sample rate outside PLAUSIBLE_SAMPLE_RATE_HZ (time in ms), and a
@@ -36,7 +36,7 @@ LENGTH_TO_MM = {"mm": 1.0, "m": 1000.0, "in": 25.4}
 FORCE_TO_N = {"N": 1.0, "kN": 1000.0, "lbf": 4.4482216152605, "kip": 4448.2216152605}
 VELOCITY_TO_MM_S = {"mm_s": 1.0, "m_s": 1000.0, "in_s": 25.4}
 MIN_SAMPLES = 10
-PLAUSIBLE_TRAVEL_MM = (0.01, 200.0)
+PLAUSIBLE_PEAK_DISPLACEMENT_MM = (0.01, 200.0)
 MIN_PLAUSIBLE_FORCE_N = 10.0
 PLAUSIBLE_STIFFNESS_N_PER_MM = (1.0, 1e6)
 PLAUSIBLE_SAMPLE_RATE_HZ = (10.0, 1e6)
@@ -160,7 +160,7 @@ def plausibility_warnings(time_s, displacement_mm, force_N=None, headers=None) -
     headers = {"time": "time_s", "displacement": "displacement_mm", "force": "force_N", **(headers or {})}
     found = []
     peak = float(np.max(np.abs(displacement_mm)))
-    low, high = PLAUSIBLE_TRAVEL_MM
+    low, high = PLAUSIBLE_PEAK_DISPLACEMENT_MM
     if peak < low:
         found.append(f"column {headers['displacement']}: peak displacement {peak:.3g} mm is below {low} mm; "
                      "metres in a millimetre column? (2 mm is 2, not 0.002)")
