@@ -21,20 +21,14 @@ Coordinates, each with bounds (the box):
   model). Its lower bound is TIME_CONSTANT_FLOOR times the sample interval: faster modes are
   invisible in the samples and made fits drift to stiff corners (c1 -> 0.002 N*s/mm, a time
   constant near 1e-7 s at 1 kHz) that no data support and that make every solver stiff;
-- shape: log10(beta'), beta' = beta*F_ref^n/k_ref (so beta > 0: the paper's beta >= 0);
-- shape sum: log10(beta' + sign*gamma') of a block (gamma' = gamma*F_ref^n/k_ref), so the sum
-  is > 0: the paper's constraint beta1 + gamma1 > 0 (sign +1) and beta2 - gamma2 > 0 (sign -1);
+- shape: beta*F_ref^n/k_ref (beta >= 0, the paper's constraint);
+- shape sum: beta' + sign*gamma' of a block (gamma' = gamma*F_ref^n/k_ref), >= 0, which is the
+  paper's constraint beta1 + gamma1 > 0 (sign +1) and beta2 - gamma2 > 0 (sign -1) as a bound;
 - exponent: n.
-
-Why the shapes are logarithmic: with alpha = 1 the sum sets the force z_sat at which the block
-saturates, sum' = (A/k_ref)*(F_ref/z_sat)^n, which spans decades, and more of them the larger n
-is. A linear coordinate bounded at 20 or 40 (the box until version 0.2) left out plausible
-bushings with n > 1 (Table 5 with n2 x 1.19 has sum' = 130), and a wider linear box would spend
-almost all its volume on near-saturated blocks. A log10 bound of -3 is, for the force, zero.
 
 Every constraint is a bound, so bounded least squares and any box optimizer can search
 the space as it is. ``tests/test_search_space.py`` checks that the paper's Tables 2, 4, 5,
-each parameter moved by +-50 %, and moved Table 5 sets with n2 > 1, lie inside with a margin.
+each parameter moved by +-50 %, lie inside with a margin.
 """
 from __future__ import annotations
 
@@ -52,9 +46,6 @@ from identification.measurements import Measurement
 
 TIME_CONSTANT_FLOOR = 0.01
 """The smallest time constant searched, as a fraction of the (shortest) sample interval."""
-
-SHAPE_DECADES = (-3.0, 3.0)
-"""Bounds of the shape coordinates log10(beta') and log10(beta' +- gamma')."""
 
 
 @dataclass(frozen=True)
@@ -100,9 +91,9 @@ def _proposed_coordinates():
             Coordinate("c1", "time_constant", -math.inf, 4.0, over=("k0", "k1", "A1")),
             Coordinate("c2", "damping", -4.0, 2.0),
             Coordinate("A1", "gain", -4.0, 1.0), Coordinate("A2", "gain", -4.0, 1.0),
-            Coordinate("beta1", "shape", *SHAPE_DECADES, "n1"), Coordinate("beta2", "shape", *SHAPE_DECADES, "n2"),
-            Coordinate("gamma1", "shape_sum", *SHAPE_DECADES, "n1", partner="beta1", sign=1.0),
-            Coordinate("gamma2", "shape_sum", *SHAPE_DECADES, "n2", partner="beta2", sign=-1.0),
+            Coordinate("beta1", "shape", 0.0, 20.0, "n1"), Coordinate("beta2", "shape", 0.0, 20.0, "n2"),
+            Coordinate("gamma1", "shape_sum", 0.0, 40.0, "n1", partner="beta1", sign=1.0),
+            Coordinate("gamma2", "shape_sum", 0.0, 40.0, "n2", partner="beta2", sign=-1.0),
             Coordinate("n1", "exponent", 0.1, 1.5), Coordinate("n2", "exponent", 0.1, 1.5))
 
 
@@ -114,13 +105,13 @@ MODEL_SPACES = {
     "spencer": ((Coordinate("k0", "stiffness", -5.0, 1.0), Coordinate("k1", "stiffness", -3.0, 1.0),
                  Coordinate("c0", "damping", -4.0, 2.0),
                  Coordinate("c1", "time_constant", -math.inf, 6.0, over=("k0", "A")),
-                 Coordinate("A", "gain", -4.0, 1.0), Coordinate("gamma", "shape", *SHAPE_DECADES, "n"),
-                 Coordinate("beta", "shape_sum", *SHAPE_DECADES, "n", partner="gamma", sign=1.0),
+                 Coordinate("A", "gain", -4.0, 1.0), Coordinate("gamma", "shape", 0.0, 20.0, "n"),
+                 Coordinate("beta", "shape_sum", 0.0, 40.0, "n", partner="gamma", sign=1.0),
                  Coordinate("n", "exponent", 0.1, 1.5)),
                 ("alpha",), ("x0",)),
     "bouc_wen": ((Coordinate("k0", "stiffness", -3.0, 1.0), Coordinate("c0", "damping", -4.0, 2.0),
-                  Coordinate("A", "gain", -4.0, 1.0), Coordinate("beta", "shape", *SHAPE_DECADES, "n"),
-                  Coordinate("gamma", "shape_sum", *SHAPE_DECADES, "n", partner="beta", sign=1.0),
+                  Coordinate("A", "gain", -4.0, 1.0), Coordinate("beta", "shape", 0.0, 20.0, "n"),
+                  Coordinate("gamma", "shape_sum", 0.0, 40.0, "n", partner="beta", sign=1.0),
                   Coordinate("n", "exponent", 0.1, 1.5)),
                  ("alpha",), ()),
 }
@@ -216,9 +207,9 @@ class SearchSpace:
             elif c.kind == "time_constant":
                 value[c.parameter] = self.tau_ref * 10.0 ** u * sum(value[name] for name in c.over)
             elif c.kind == "shape":
-                value[c.parameter] = 10.0 ** u * self._shape_scale(value[c.exponent])
-            else:  # shape_sum: 10^u = partner' + sign*parameter'
-                value[c.parameter] = c.sign * (10.0 ** u * self._shape_scale(value[c.exponent]) - value[c.partner])
+                value[c.parameter] = u * self._shape_scale(value[c.exponent])
+            else:  # shape_sum: u = partner' + sign*parameter'
+                value[c.parameter] = c.sign * (u * self._shape_scale(value[c.exponent]) - value[c.partner])
         return np.column_stack([value[name] for name in names])
 
     def to_parameters(self, coordinates: np.ndarray) -> np.ndarray:
@@ -248,9 +239,9 @@ class SearchSpace:
                 stiffness = sum(p[name] for name in c.over)
                 theta.append(math.log10(value / stiffness / self.tau_ref) if value > 0 else -math.inf)
             elif c.kind == "shape":
-                theta.append(_log10_or_minus_inf(value / self._shape_scale(p[c.exponent])))
+                theta.append(value / self._shape_scale(p[c.exponent]))
             else:
-                theta.append(_log10_or_minus_inf((p[c.partner] + c.sign * value) / self._shape_scale(p[c.exponent])))
+                theta.append((p[c.partner] + c.sign * value) / self._shape_scale(p[c.exponent]))
         return np.array(theta)
 
     def inside(self, coordinates: np.ndarray) -> np.ndarray:
@@ -262,11 +253,6 @@ class SearchSpace:
     def _shape_scale(self, n):
         """beta = coordinate * k_ref / F_ref^n: the shape parameters' scale [N^(1-n)/mm]."""
         return self.k_ref / self.F_ref ** n
-
-
-def _log10_or_minus_inf(value: float) -> float:
-    """log10 of a shape coordinate; -inf (outside every box) for the paper's limits 0 and below."""
-    return math.log10(value) if value > 0 else -math.inf
 
 
 def rescale_hysteresis(params: Mapping[str, float], s1: float, s2: float) -> dict[str, float]:
