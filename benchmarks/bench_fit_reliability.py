@@ -102,6 +102,17 @@ def truths(count: int, seed: int = 1) -> list[tuple[str, dict]]:
     return out
 
 
+def load_or_draw_truths(count: int, path: Path | None = None) -> list[tuple[str, dict]]:
+    """The first ``count`` truths of the JSON file ``path`` if it exists, else :func:`truths`
+    (then written to ``path``, if given, so that later runs use the same ones)."""
+    if path and path.exists():
+        return [tuple(pair) for pair in json.loads(path.read_text())][:count]
+    drawn = truths(count)
+    if path:
+        path.write_text(json.dumps(drawn, indent=1))
+    return drawn
+
+
 def training_data(params, noise_seed: int):
     rng = np.random.default_rng(noise_seed)
     tests, noise_levels = [], []
@@ -211,12 +222,7 @@ def main() -> None:
     print(f"machine: {platform.machine()}, Python {platform.python_version()}, {time.strftime('%Y-%m-%d')}",
           file=sys.stderr)
     rows = []
-    if args.truths_file and args.truths_file.exists():
-        drawn = [tuple(pair) for pair in json.loads(args.truths_file.read_text())][:args.truths]
-    else:
-        drawn = truths(args.truths)
-        if args.truths_file:
-            args.truths_file.write_text(json.dumps(drawn, indent=1))
+    drawn = load_or_draw_truths(args.truths, args.truths_file)
     for index, (name, truth) in enumerate(drawn):
         if index < args.first_truth:
             continue

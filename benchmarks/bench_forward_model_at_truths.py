@@ -16,7 +16,6 @@ sees it as worse than any candidate that runs).
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from pathlib import Path
 
@@ -26,17 +25,18 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 sys.path.insert(0, str(REPO / "benchmarks"))
 
-from bench_fit_reliability import NOISE, TRAINING, truth_forces, truths  # noqa: E402
+from bench_fit_reliability import NOISE, TRAINING, load_or_draw_truths, truth_forces  # noqa: E402
 from identification.compiled_core import parameter_matrix  # noqa: E402
 from identification.ensemble import misfit_threshold  # noqa: E402
 from identification.measurements import Measurement  # noqa: E402
 from identification.noise import NoiseEstimate  # noqa: E402
-from identification.objectives import FIT_MAX_SUBSTEPS, Objective  # noqa: E402
+from identification.objectives import FAILED_RESIDUAL, FIT_MAX_SUBSTEPS, Objective  # noqa: E402
 from identification.rig_tests import RigTest  # noqa: E402
 
 
-def chi2_at_truth(truth: dict) -> tuple[float, float, float]:
-    """(sine rms residual / noise, chi^2 of the sine, chi^2 of the step) on noise-free data."""
+def chi2_at_truth(truth: dict) -> tuple[float, float, float, bool]:
+    """(sine rms residual / noise, chi^2 of the sine, chi^2 of the step, whether the simulation
+    failed: the objective's FAILED_RESIDUAL noise levels from there on) on noise-free data."""
     tests, levels = [], []
     for kind, protocol, rise in TRAINING:
         t, x, _, force = truth_forces(truth, protocol)
@@ -48,24 +48,22 @@ def chi2_at_truth(truth: dict) -> tuple[float, float, float]:
     residuals = objective.residual_matrix(parameter_matrix([truth]))[0] * np.sqrt(objective.size)  # noise units
     sine_size = objective.tests[0].measured_N.size
     sine, step = residuals[:sine_size], residuals[sine_size:]
-    return float(np.sqrt(np.mean(sine ** 2))), float(np.sum(sine ** 2)), float(np.sum(step ** 2))
+    failed = bool(np.any(np.isclose(np.abs(residuals), FAILED_RESIDUAL)))
+    return float(np.sqrt(np.mean(sine ** 2))), float(np.sum(sine ** 2)), float(np.sum(step ** 2)), failed
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--truths", type=int, default=12)
-    parser.add_argument("--truths-file", type=Path, help="the reliability benchmark's truths file (else drawn)")
+    parser.add_argument("--truths-file", type=Path,
+                        help="the reliability benchmark's truths file (if it does not exist: drawn and written)")
     args = parser.parse_args()
-    if args.truths_file and args.truths_file.exists():
-        drawn = [tuple(pair) for pair in json.loads(args.truths_file.read_text())][:args.truths]
-    else:
-        drawn = truths(args.truths)
+    drawn = load_or_draw_truths(args.truths, args.truths_file)
     threshold = misfit_threshold(1.0, 1, 14)   # delta chi^2 of 14 parameters at the floor, per 1 residual
     print(f"{'truth':10s} {'sine rms / noise':>17s} {'chi2 sine':>10s} {'chi2 step':>10s} {'chi2 total':>11s}")
     for name, truth in drawn:
         with np.errstate(all="ignore"):
-            rms, sine, step = chi2_at_truth(truth)
-        failed = rms > 100.0
+            rms, sine, step, failed = chi2_at_truth(truth)
         print(f"{name:10s} {rms:17.3f} {sine:10.2f} {step:10.2f} {sine + step:11.2f}"
               + (f"   (fails: more than {FIT_MAX_SUBSTEPS} substeps in a sample)" if failed else ""))
     print(f"\nthe ensemble's threshold: delta chi^2 = {threshold:.1f} (95 %, 14 parameters)")

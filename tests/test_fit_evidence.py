@@ -215,8 +215,11 @@ def test_a_fit_stuck_on_the_box_says_where():
     # A truth outside the box (block 2's shape coordinates beyond their bounds, as for a
     # bushing with n2 = 1.14): the best fit that the box allows sits on its bound, and the
     # warning names the coordinate instead of blaming the model.
+    from fmu_src.bushing_models import get_model
     from fmu_src.bushing_params import PARAMETER_NAMES
-    from identification.fitting import FitResult
+    from fmu_src.parameter_files import ParameterSet
+    from identification.fitting import FitResult, TestFit
+    from identification.noise import estimate_noise
     from identification.search_space import SearchSpace
     tests = short_tests(paper_parameters("table5"))
     space = SearchSpace.from_measurements([t.measurement for t in tests], steps=[t.kind == "step" for t in tests])
@@ -224,10 +227,6 @@ def test_a_fit_stuck_on_the_box_says_where():
     names = [c.parameter for c in space.coordinates]
     theta[names.index("gamma2")] = space.bounds()[names.index("gamma2"), 1]      # on the upper bound
     params = dict(zip(PARAMETER_NAMES, map(float, space.to_parameters(theta)[0])))
-    from fmu_src.parameter_files import ParameterSet
-    from fmu_src.bushing_models import get_model
-    from identification.fitting import TestFit
-    from identification.noise import estimate_noise
     fits = [TestFit(t.name, t.kind, estimate_noise(t.measurement.force_N), 0.05) for t in tests]
     result = FitResult(ParameterSet(get_model("proposed"), params), 20.0, fits, [], 0.01, [params], None,
                        "default", 0, 1, 1.0, space=space, final_starts=6)
