@@ -37,13 +37,14 @@ from identification.compiled_core import parameter_matrix
 from identification.engine import make_engine
 from identification.errors import IdentificationError
 from identification.ensemble import (PROBES, PROFILE_EVALUATIONS, PROFILE_ROUNDS, PUSH, STEPS, WALKERS,
-                                     Identifiability, SamplerReport, identifiability, misfit_threshold,
-                                     posterior_samples, profile_extremes, push_to_boundary, select_members,
-                                     threshold_scale)
+                                     Identifiability, SamplerReport, explore_region, identifiability,
+                                     misfit_threshold, push_to_boundary, select_members, threshold_scale)
 from identification.measurements import Measurement
-from identification.multistart import Problem, SearchSettings, StartRecord, jacobian, screen, successive_halving
+from identification.multistart import (Problem, SearchSettings, StartRecord, first_records, jacobian, run_stages,
+                                       screen)
 from identification.noise import NoiseEstimate, estimate_noise
 from identification.objectives import MIN_NOISE_FRACTION, Objective, nrmse
+from identification.refinement import refine_steps
 from identification.rig_tests import Manifest, RigTest
 from identification.search_space import KelvinVoigtFit, SearchSpace
 from identification.simulate import simulate
@@ -112,6 +113,7 @@ class FitResult:
     final_starts: int = 1
     sampler: SamplerReport | None = None
     notes: list[str] = field(default_factory=list)
+    steps_per_sample: list[int] = field(default_factory=list)   # the forward model's, per test
 
     @property
     def model(self) -> str:
@@ -180,6 +182,7 @@ class FitResult:
             out.update({"starts_agreeing": self.agreeing, "final_starts": self.final_starts,
                         "agreement_threshold_misfit": _round(self.threshold),
                         "ensemble_members": len(self.ensemble),
+                        "steps_per_sample": list(self.steps_per_sample),
                         "search_space": {"k_ref_N_per_mm": _round(self.space.k_ref),
                                          "c_ref_Ns_per_mm": _round(self.space.c_ref),
                                          "F_ref_N": _round(self.space.F_ref),
@@ -217,6 +220,9 @@ class FitResult:
             lines.append(f"starts: {self.agreeing} of {self.final_starts} final starts agree (misfit within "
                          f"{self.threshold:.2e} of the best: delta chi^2 at 95 % for {len(self.space.names)} parameters); "
                          f"ensemble: {len(self.ensemble)} parameter sets")
+        if self.steps_per_sample:
+            lines.append("forward model: " + ", ".join(f"{m} step{'s' if m > 1 else ''} per sample on {t.name}"
+                                                       for m, t in zip(self.steps_per_sample, self.tests)))
         if self.identifiability is not None:
             lines.append(self.identifiability.format())
         if self.sampler is not None:
@@ -328,32 +334,46 @@ def _search(tests, noise, model, preset, settings, seed, engine, progress, start
     else:
         theta, misfits = screen(problem, engine, settings.screening, seed, bars.screening)
     evaluations = ga_evaluations if preset == "paper" else len(misfits)
-    records = successive_halving(problem, engine, theta, misfits, settings.stages, bars.stage)
+    n, d = problem.objective.size, len(space.names)
+    *early, last = settings.stages
+    records = run_stages(problem, engine, first_records(theta, misfits, settings.stages[0][0]), early, bars.stage)
+    # The forward model's steps per sample, checked where the result is decided: at the best
+    # start before the last stage, and at the best fit (then the last stage runs again).
+    for _ in range(2):
+        best = min((r for r in records if r.stage == records[0].stage), key=lambda r: (r.misfit, r.start))
+        refinement = refine_steps(problem.objective, tests, space.to_parameters(best.theta[None, :]),
+                                  misfit_threshold(best.misfit, n, d) * n)
+        evaluations += refinement.simulations
+        if refinement.changed:
+            problem = Problem(refinement.objective, space)
+        elif records[0].stage == len(early):
+            break
+        records = run_stages(problem, engine, records, [last], bars.stage, first_stage=len(early))
     bars.close()
     evaluations += sum(r.evaluations - 1 for r in records)
 
-    best = min(records, key=lambda r: (r.misfit, r.start))
-    n, d = problem.objective.size, len(space.names)
+    final = [r for r in records if r.stage == len(early)]     # scored by the objective used from here on
+    best = min(final, key=lambda r: (r.misfit, r.start))
     threshold = misfit_threshold(best.misfit, n, d)
     scaled_jacobian, _ = jacobian(problem, best.theta)
     ident = identifiability(scaled_jacobian * np.sqrt(n), space.names, threshold * n)
     limit = best.misfit + threshold
-    extremes, extreme_misfits = profile_extremes(problem, best.theta, best.misfit, ident, limit, engine)
-    draws, _, sampler = posterior_samples(problem, best.theta, seed, threshold_scale(best.misfit, n, d))
-    pushed, pushed_misfits = push_to_boundary(problem, best.theta, draws, limit)
+    extremes, extreme_misfits, draws, sampler = explore_region(problem, best.theta, best.misfit, ident, limit, seed,
+                                                               threshold_scale(best.misfit, n, d), engine)
+    pushed, pushed_misfits = push_to_boundary(problem, best.theta, draws, limit, engine)
     evaluations += d + 1 + WALKERS * STEPS + len(draws) * len(PUSH) \
         + len(PROBES) * 2 * (d + 1) * (1 + PROFILE_ROUNDS * PROFILE_EVALUATIONS)
-    members = select_members(best.theta, [(r.theta, r.misfit) for r in records],
+    members = select_members(best.theta, [(r.theta, r.misfit) for r in final],
                              np.vstack([extremes, pushed]), np.concatenate([extreme_misfits, pushed_misfits]),
                              limit, space.bounds())
     rows = space.to_model_parameters(np.array(members))
     names = space.bushing.parameter_names
     ensemble = [dict(zip(names, map(float, row))) for row in rows]
     parameters = ParameterSet(space.bushing, ensemble[0])
-    result = FitResult(parameters, float(best.misfit), _test_fits(tests, noise, parameters), records, threshold,
+    steps = problem.objective.steps_per_sample
+    result = FitResult(parameters, float(best.misfit), _test_fits(tests, noise, parameters, steps), records, threshold,
                        ensemble, ident, preset, seed, evaluations, time.perf_counter() - started, engine.description,
-                       space, final_starts=sum(r.stage == records[0].stage for r in records),
-                       sampler=sampler)
+                       space, final_starts=len(final), sampler=sampler, steps_per_sample=steps)
     result.parameters.provenance = result.provenance()
     return result
 
@@ -374,11 +394,14 @@ def _fit_kelvin_voigt(tests, noise, started) -> FitResult:
     return result
 
 
-def _test_fits(tests, noise, parameters: ParameterSet) -> list[TestFit]:
+def _test_fits(tests, noise, parameters: ParameterSet, steps=None) -> list[TestFit]:
+    """Each test's noise and NRMSE at ``parameters``, simulated with ``steps`` per sample (per
+    test; default: chosen from the signal)."""
     fits = []
-    for test, level in zip(tests, noise):
+    for test, level, m_steps in zip(tests, noise, steps or [None] * len(tests)):
         m = test.measurement
-        predicted = simulate(parameters, m.time_s, m.displacement_mm, m.measured_velocity_mm_s)
+        predicted = simulate(parameters, m.time_s, m.displacement_mm, m.measured_velocity_mm_s,
+                             steps_per_sample=m_steps)
         fits.append(TestFit(test.name, test.kind, level, nrmse(predicted, m.force_N)))
     return fits
 

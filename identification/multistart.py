@@ -86,7 +86,7 @@ def screen(problem: Problem, engine, count: int, seed: int, progress=None) -> tu
     unit = qmc.Sobol(len(bounds), scramble=True, seed=np.random.default_rng(seed)).random(count)
     theta = bounds[:, 0] + unit * (bounds[:, 1] - bounds[:, 0])
     blocks = [theta[i:i + 256] for i in range(0, count, 256)]
-    misfits = engine.map(_misfit_task, blocks, problem, progress=progress and (lambda n: progress(n * 256)))
+    misfits = engine.map(misfit_block, blocks, problem, progress=progress and (lambda n: progress(n * 256)))
     return theta, np.concatenate(misfits)
 
 
@@ -110,7 +110,7 @@ def genetic_algorithm(problem: Problem, engine, seed: int, progress=None, popula
 
         def _evaluate(self, theta, out, *args, **kwargs):
             blocks = [theta[i:i + 64] for i in range(0, len(theta), 64)]
-            out["F"] = np.concatenate(engine.map(_misfit_task, blocks, problem))
+            out["F"] = np.concatenate(engine.map(misfit_block, blocks, problem))
             if progress:
                 progress(len(theta))
 
@@ -124,11 +124,25 @@ def successive_halving(problem: Problem, engine, theta: np.ndarray, misfits: np.
                        stages, progress=None) -> list[StartRecord]:
     """Run the stages from the best screened points; returns every start's record, the last
     stage's first, each group sorted by misfit."""
+    return run_stages(problem, engine, first_records(theta, misfits, stages[0][0]), stages, progress)
+
+
+def first_records(theta: np.ndarray, misfits: np.ndarray, count: int) -> list[StartRecord]:
+    """The ``count`` best screened points as records of starts that have not run yet."""
     order = np.argsort(misfits, kind="stable")
-    records = [StartRecord(int(rank), theta[index].copy(), float(misfits[index]), -1, 1)
-               for rank, index in enumerate(order[:stages[0][0]])]
-    for stage, (starts, evaluations) in enumerate(stages):
-        records.sort(key=lambda r: (r.misfit, r.start))
+    return [StartRecord(int(rank), theta[index].copy(), float(misfits[index]), -1, 1)
+            for rank, index in enumerate(order[:count])]
+
+
+def run_stages(problem: Problem, engine, records: list[StartRecord], stages, progress=None,
+               first_stage: int = 0) -> list[StartRecord]:
+    """Successive halving over ``stages`` (numbered from ``first_stage``): each stage continues
+    the best of ``records`` by their misfit so far; returns every record, the last stage's
+    first, each group sorted by misfit."""
+    records = list(records)
+    for stage, (starts, evaluations) in enumerate(stages, start=first_stage):
+        # a stage run again (after the objective was refined) continues the starts that ran it
+        records.sort(key=lambda r: (-(r.stage >= stage), r.misfit, r.start))
         running = records[:starts]
         results = engine.map(_least_squares_task, [(r.theta, evaluations) for r in running], problem,
                              progress=progress and (lambda n, s=stage: progress(s, n)))
@@ -154,7 +168,8 @@ def jacobian(problem: Problem, theta: np.ndarray, at: np.ndarray | None = None) 
     return ((shifted - at) / steps[:, None]).T, at
 
 
-def _misfit_task(problem: Problem, block: np.ndarray) -> np.ndarray:
+def misfit_block(problem: Problem, block: np.ndarray) -> np.ndarray:
+    """The misfits of a block of candidates (coordinates), one engine task."""
     return problem.misfit(block)
 
 

@@ -56,20 +56,33 @@ class PreparedTest:
 class Objective:
     """Misfit (chi^2/n) of candidate core parameter sets; see the module docstring."""
 
-    def __init__(self, tests: Sequence[RigTest], noise: Sequence[NoiseEstimate] | None = None):
+    def __init__(self, tests: Sequence[RigTest], noise: Sequence[NoiseEstimate] | None = None,
+                 steps: Sequence[int | None] | None = None):
+        """``steps``: communication steps per sample of each test (None: chosen from the
+        signal, ``forward_model.steps_per_sample``); ``identification.refinement`` raises them
+        where a candidate's response needs it."""
         if not tests:
             raise ValueError("the objective needs at least one training test")
         noise = list(noise) if noise is not None else [estimate_noise(t.measurement.force_N) for t in tests]
         if len(noise) != len(tests):
             raise ValueError(f"{len(noise)} noise levels for {len(tests)} tests")
+        steps = list(steps) if steps is not None else [None] * len(tests)
+        if len(steps) != len(tests):
+            raise ValueError(f"{len(steps)} step counts for {len(tests)} tests")
         self.noise = noise
         self.tests: list[PreparedTest] = []
-        for test, level in zip(tests, noise):
+        for test, level, m_steps in zip(tests, noise, steps):
             m = test.measurement
-            driven = prepare_input(m.time_s, m.displacement_mm, m.measured_velocity_mm_s, decimate_holds=True)
+            driven = prepare_input(m.time_s, m.displacement_mm, m.measured_velocity_mm_s, decimate_holds=True,
+                                   steps=m_steps)
             sigma = max(level.sigma_N, MIN_NOISE_FRACTION * level.rms_force_N)
             self.tests.append(PreparedTest(test.name, driven, m.force_N[driven.sample_index], sigma))
         self.size = sum(t.measured_N.size for t in self.tests)
+
+    @property
+    def steps_per_sample(self) -> list[int]:
+        """Communication steps per sample interval of each test's forward model."""
+        return [t.driven.steps_per_sample for t in self.tests]
 
     def residual_matrix(self, core_matrix: np.ndarray) -> np.ndarray:
         """Residuals of P candidates, shape (P, n); each row's sum of squares is its misfit."""
