@@ -338,17 +338,25 @@ def _search(tests, noise, model, preset, settings, seed, engine, progress, start
     *early, last = settings.stages
     records = run_stages(problem, engine, first_records(theta, misfits, settings.stages[0][0]), early, bars.stage)
     # The forward model's steps per sample, checked where the result is decided: at the best
-    # start before the last stage, and at the best fit (then the last stage runs again).
-    for _ in range(2):
-        best = min((r for r in records if r.stage == records[0].stage), key=lambda r: (r.misfit, r.start))
-        refinement = refine_steps(problem.objective, tests, space.to_parameters(best.theta[None, :]),
-                                  misfit_threshold(best.misfit, n, d) * n)
-        evaluations += refinement.simulations
-        if refinement.changed:
-            problem = Problem(refinement.objective, space)
-        elif records[0].stage == len(early):
-            break
-        records = run_stages(problem, engine, records, [last], bars.stage, first_stage=len(early))
+    # start before the last stage, and at the best fit; if that changes them, the last stage
+    # runs once more, and a third check only reports (identification.refinement).
+    notes = []
+    refinement = _check_steps(problem, tests, records, n, d)
+    problem = Problem(refinement.objective, space)
+    records = run_stages(problem, engine, records, [last], bars.stage, first_stage=len(early))
+    refinement_at_best = _check_steps(problem, tests, records, n, d)
+    evaluations += refinement.evaluations + refinement_at_best.evaluations
+    if refinement_at_best.changed:
+        problem = Problem(refinement_at_best.objective, space)
+        records = run_stages(problem, engine, records, [last], lambda s, k: bars.stage(s, k, again=True),
+                             first_stage=len(early))
+        final_check = _check_steps(problem, tests, records, n, d)
+        evaluations += final_check.evaluations
+        if final_check.changed:
+            notes.append(f"note: at the best fit the forward model would need "
+                         f"{'/'.join(map(str, final_check.objective.steps_per_sample))} steps per sample (it ran "
+                         f"{'/'.join(map(str, problem.objective.steps_per_sample))}); its own error may take more "
+                         "than a tenth of the confidence region")
     bars.close()
     evaluations += sum(r.evaluations - 1 for r in records)
 
@@ -373,7 +381,7 @@ def _search(tests, noise, model, preset, settings, seed, engine, progress, start
     steps = problem.objective.steps_per_sample
     result = FitResult(parameters, float(best.misfit), _test_fits(tests, noise, parameters, steps), records, threshold,
                        ensemble, ident, preset, seed, evaluations, time.perf_counter() - started, engine.description,
-                       space, final_starts=len(final), sampler=sampler, steps_per_sample=steps)
+                       space, final_starts=len(final), sampler=sampler, notes=notes, steps_per_sample=steps)
     result.parameters.provenance = result.provenance()
     return result
 
@@ -392,6 +400,14 @@ def _fit_kelvin_voigt(tests, noise, started) -> FitResult:
                        "linear", 0, 1, time.perf_counter() - started)
     result.parameters.provenance = result.provenance()
     return result
+
+
+def _check_steps(problem: Problem, tests, records, n: int, d: int):
+    """``refinement.refine_steps`` at the best start of the latest stage (its misfit sets the
+    region's delta chi^2)."""
+    best = min((r for r in records if r.stage == records[0].stage), key=lambda r: (r.misfit, r.start))
+    return refine_steps(problem.objective, tests, problem.space.to_parameters(best.theta[None, :]),
+                        misfit_threshold(best.misfit, n, d) * n)
 
 
 def _test_fits(tests, noise, parameters: ParameterSet, steps=None) -> list[TestFit]:
@@ -424,10 +440,10 @@ class _Progress:
     def screening(self, count: int):
         self._advance("screening", self.screening_total, "points", count)
 
-    def stage(self, index: int, count: int):
+    def stage(self, index: int, count: int, again: bool = False):
         starts, evaluations = self.settings.stages[index]
-        self._advance(f"stage {index + 1}/{len(self.settings.stages)} ({starts} starts x {evaluations})", starts,
-                      "starts", count)
+        self._advance(f"stage {index + 1}/{len(self.settings.stages)} ({starts} starts x {evaluations})"
+                      + (" again, finer steps" if again else ""), starts, "starts", count)
 
     def _advance(self, name, total, unit, count):
         if not self.enabled:

@@ -14,7 +14,9 @@ the input path between samples. So the fit drives the same compiled kernel with:
   split into ``m`` equal communication steps with the interpolant's displacement at their
   ends and the secant velocity over each (a continuous piecewise-linear path, no jumps),
   where ``m`` is the smallest number such that the input turns by at most
-  ``MAX_PHASE_PER_STEP_RAD`` per step (with the test's rms frequency rms(x'')/rms(x'));
+  ``MAX_PHASE_PER_STEP_RAD`` per step (with the test's rms frequency rms(x'')/rms(x')); the
+  fit raises it where the candidate's response is sharper than the input
+  (``identification.refinement``);
 - the output: eq. 5 at each sample instant with the interpolant's velocity there.
 
 It converges, as the step shrinks, to the continuous-time solution driven by the

@@ -19,10 +19,11 @@ tests. The difference estimates the error of m (the input path's error falls abo
 halving, ``tests/test_forward_model.py``), so the forward model's own error uses at most about
 a tenth of the region. Where the fit stays above the noise floor, delta chi^2 is widened by
 s^2 (``identification.ensemble``) and the budget with it: a model error far above the
-forward model's is not worth finer steps. m stops at MAX_STEPS_PER_SAMPLE.
+forward model's is not worth finer steps. m stops at MAX_REFINED_STEPS.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Sequence
 
@@ -35,50 +36,63 @@ from identification.simulate import simulate_driven
 
 ERROR_BUDGET = 0.1
 """The share of the confidence region's delta chi^2 that the forward model's error may use."""
-MAX_STEPS_PER_SAMPLE = 16
+MAX_REFINED_STEPS = 16
+"""Steps per sample the refinement goes up to (the signal alone chooses at most
+``forward_model.MAX_STEPS_PER_SAMPLE``); m is only doubled, so it stops at the last double
+within this."""
 
 
 @dataclass(frozen=True)
 class Refinement:
     """The outcome of one check: the objective to use (the same one if nothing changed),
-    whether the steps changed, the chi^2 of m against 2m per test at the steps kept (0 where
-    m is at its cap), and the simulations it took."""
+    whether the steps changed, the chi^2 of m against 2m per test at the steps kept (NaN
+    where 2m was not simulated: at the cap, or where it fails), and the cost of the check in
+    candidate evaluations (simulations of every test)."""
     objective: Objective
     changed: bool
     error_chi2: tuple[float, ...]
-    simulations: int
+    evaluations: int
 
 
 def refine_steps(objective: Objective, tests: Sequence[RigTest], core_row: np.ndarray, delta_chi2: float) -> Refinement:
     """Double each test's steps per sample while its forward-model error at the candidate
     ``core_row`` (one row of core parameters) exceeds its share of ``ERROR_BUDGET * delta_chi2``
-    (see the module docstring); returns the objective to use from here on."""
+    (see the module docstring); returns the objective to use from here on.
+
+    Where the candidate fails at m (more than FIT_MAX_SUBSTEPS substeps in a communication
+    step), finer steps may run it (the substep limit is per step); where it runs at m but
+    fails at 2m, m is kept. If it fails at every m, the test keeps the m it had."""
     if len(tests) != len(objective.tests):
         raise ValueError(f"{len(tests)} tests for an objective of {len(objective.tests)}")
     core = np.atleast_2d(core_row)
     budget = ERROR_BUDGET * delta_chi2 / len(tests)
-    steps, errors, simulations = [], [], 0
+    steps, errors, work = [], [], 0
     for test, prepared in zip(tests, objective.tests):
-        m = prepared.driven.steps_per_sample
+        first = m = prepared.driven.steps_per_sample
         coarse = simulate_driven(core, prepared.driven, FIT_MAX_SUBSTEPS)[0]
-        simulations += 1
-        error = 0.0
-        while m < MAX_STEPS_PER_SAMPLE:
+        work += m
+        error = math.nan
+        while 2 * m <= MAX_REFINED_STEPS:
             measurement = test.measurement
             finer = prepare_input(measurement.time_s, measurement.displacement_mm, measurement.measured_velocity_mm_s,
                                   decimate_holds=True, steps=2 * m)
             fine = simulate_driven(core, finer, FIT_MAX_SUBSTEPS)[0]
-            simulations += 1
-            if not np.all(np.isfinite(fine)):
-                break          # the finer steps fail too: they cannot tell us more
+            work += 2 * m
+            runs, ran = bool(np.all(np.isfinite(fine))), bool(np.all(np.isfinite(coarse)))
+            if ran and not runs:
+                error = math.nan
+                break
             with np.errstate(over="ignore", invalid="ignore"):
-                error = float(np.sum(((fine - coarse) / prepared.sigma_N) ** 2)) if np.all(np.isfinite(coarse)) \
-                    else float("inf")
+                error = float(np.sum(((fine - coarse) / prepared.sigma_N) ** 2)) if ran else math.inf
             if error <= budget:
                 break
-            m, coarse = 2 * m, fine
+            m, coarse, error = 2 * m, fine, math.nan
+        if not np.all(np.isfinite(coarse)):
+            m, error = first, math.nan      # it fails at every m: finer steps buy nothing
         steps.append(m)
         errors.append(error)
     changed = steps != objective.steps_per_sample
     refined = Objective(tests, objective.noise, steps) if changed else objective
-    return Refinement(refined, changed, tuple(errors), simulations)
+    # cost in evaluations of every test at its signal's m (a simulation's cost grows with m)
+    evaluations = math.ceil(work / max(1, sum(objective.steps_per_sample)))
+    return Refinement(refined, changed, tuple(errors), evaluations)

@@ -67,8 +67,17 @@ def test_starts_that_agree_above_the_floor_say_the_model_may_not_fit(capsys):
     assert message.startswith("not converged: training NRMSE") and "the starts agree" in message
 
 
-def test_the_same_seed_gives_the_same_file_on_one_worker_two_workers_and_a_dask_cluster(tmp_path):
+@pytest.mark.parametrize("refined", [False, True], ids=["signal_steps", "refined_steps"])
+def test_the_same_seed_gives_the_same_file_on_one_worker_two_workers_and_a_dask_cluster(tmp_path, monkeypatch,
+                                                                                         refined):
     from dask.distributed import LocalCluster
+    import identification.refinement as refinement
+    if refined:
+        # no error budget: every check doubles the steps (up to 2), so the last stage runs with
+        # an objective other than the screening's (the refinement runs in this process; the
+        # refined objective travels to the workers)
+        monkeypatch.setattr(refinement, "ERROR_BUDGET", 0.0)
+        monkeypatch.setattr(refinement, "MAX_REFINED_STEPS", 2)
     manifest = write_tests(tmp_path / "bushing", short_tests(paper_parameters("table5"), seed=4))
     files = []
     # 16 first-stage starts: more than the 8 chunks of 2 workers, so chunks hold several starts
@@ -79,6 +88,7 @@ def test_the_same_seed_gives_the_same_file_on_one_worker_two_workers_and_a_dask_
             assert main(["fit", "--tests", str(manifest), "--seed", "7", *budget, *engine, "--out", str(out)]) == 0
             files.append(out.read_bytes())
     assert files[0] == files[1] == files[2]
+    assert json.loads(files[0])["fit"]["steps_per_sample"][0] == (2 if refined else 1)
 
 
 def test_an_unreachable_scheduler_is_a_clear_error_not_a_hang(tmp_path, capsys):
