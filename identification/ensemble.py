@@ -43,9 +43,11 @@ from scipy.stats import chi2
 CONFIDENCE = 0.95
 DISTINCT = 1e-4
 """Members closer than this (in coordinates scaled by the box's size) are one."""
-WALKERS, STEPS, BURN_IN, MEMBERS = 32, 300, 100, 100
+WALKERS, STEPS, BURN_IN, MEMBERS = 32, 200, 100, 100
+"""200 steps: the 100 kept are about five autocorrelation times (about 20 steps on the paper's
+tests); with 300 the sampler took 34 s of the 118 s fit of the reliability benchmark's most
+expensive bushing (random 1)."""
 PUSH = (1.0, 1.25, 1.5, 2.0, 2.5, 3.0, 4.0, 6.0)
-PUSH_BLOCK = 200               # pushed candidates per engine task
 PROBES = (("sine", 4.0, 40.0, 0.25), ("sine", 4.0, 5.0, 0.4), ("step", 4.0, 0.05, 1.0))
 """Probe tests (kind, amplitude mm, frequency Hz or rise time s, duration s) at the corners of
 the design's candidates, whose predicted force the ensemble's extreme members bound."""
@@ -151,21 +153,15 @@ def posterior_samples(problem, best: np.ndarray, seed: int, scale: float = 1.0):
     return chain[chosen], misfit[chosen], report
 
 
-def push_to_boundary(problem, best: np.ndarray, draws: np.ndarray, limit: float,
-                     engine=None) -> tuple[np.ndarray, np.ndarray]:
+def push_to_boundary(problem, best: np.ndarray, draws: np.ndarray, limit: float) -> tuple[np.ndarray, np.ndarray]:
     """Each draw moved along the ray from ``best`` to the farthest of PUSH times its distance
     whose misfit is within ``limit`` (clipped to the box; the draw itself if none is), and the
-    misfits there. len(draws) x len(PUSH) candidates, in blocks on ``engine`` (default: here)."""
-    from identification.engine import SerialEngine
-    from identification.multistart import misfit_block
+    misfits there. One population call of len(draws) x len(PUSH) candidates."""
     bounds = problem.space.bounds()
     factors = np.asarray(PUSH)
     rays = best + factors[None, :, None] * (draws - best)[:, None, :]
     rays = np.clip(rays, bounds[:, 0], bounds[:, 1])
-    candidates = rays.reshape(-1, len(best))
-    blocks = [candidates[i:i + PUSH_BLOCK] for i in range(0, len(candidates), PUSH_BLOCK)]
-    results = (engine or SerialEngine()).map(misfit_block, blocks, problem)
-    misfits = (np.concatenate(results) if results else np.empty(0)).reshape(len(draws), len(factors))
+    misfits = problem.misfit(rays.reshape(-1, len(best))).reshape(len(draws), len(factors))
     pushed, pushed_misfits = draws.copy(), np.full(len(draws), np.inf)
     for i in range(len(draws)):
         within = np.flatnonzero(misfits[i] <= limit)
@@ -175,38 +171,29 @@ def push_to_boundary(problem, best: np.ndarray, draws: np.ndarray, limit: float,
 
 
 @dataclass(frozen=True)
-class RegionProblem:
-    """What a worker needs to explore the confidence region (picklable)."""
+class ProfileProblem:
+    """What a worker needs to find the extreme members of the probes (picklable)."""
     problem: object                  # multistart.Problem
     best: np.ndarray
     best_misfit: float
     limit: float                     # misfit within the region
     ident: Identifiability
-    seed: int                        # the posterior sampler's
-    scale: float                     # s^2 of the posterior
 
 
-def explore_region(problem, best: np.ndarray, best_misfit: float, ident: Identifiability, limit: float, seed: int,
-                   scale: float, engine) -> tuple[np.ndarray, np.ndarray, np.ndarray, SamplerReport]:
-    """The prediction profiles' ends and the posterior draws (see the module docstring), as
-    tasks of ``engine`` side by side: the sampler, the longest task, goes first and runs on one
-    worker while the profiles (one task per probe test and sign) share the others. Returns
-    the profile ends' coordinates and misfits (those found), the draws and the sampler's report."""
-    shared = RegionProblem(problem, best, best_misfit, limit, ident, seed, scale)
-    items = [None] + [(probe, sign) for probe in PROBES for sign in (1.0, -1.0)]
-    (draws, _, report), *profiles = engine.map(_region_task, items, shared, chunk_size=1)
-    found = [r for r in profiles if r is not None]
-    ends = np.array([theta for theta, _ in found]) if found else np.empty((0, len(best)))
-    return ends, np.array([misfit for _, misfit in found]), draws, report
+def profile_extremes(problem, best: np.ndarray, best_misfit: float, ident: Identifiability, limit: float,
+                     engine) -> tuple[np.ndarray, np.ndarray]:
+    """For each probe test and both signs, the member within the region whose predicted rms
+    force on the probe is largest or smallest (a prediction profile's end, Kreutz et al.
+    2012), one task each; returns their coordinates and misfits (those found)."""
+    shared = ProfileProblem(problem, best, best_misfit, limit, ident)
+    items = [(probe, sign) for probe in PROBES for sign in (1.0, -1.0)]
+    found = [r for r in engine.map(_profile_task, items, shared, chunk_size=1) if r is not None]
+    if not found:
+        return np.empty((0, len(best))), np.empty(0)
+    return np.array([theta for theta, _ in found]), np.array([misfit for _, misfit in found])
 
 
-def _region_task(shared: RegionProblem, item):
-    if item is None:
-        return posterior_samples(shared.problem, shared.best, shared.seed, shared.scale)
-    return _profile_task(shared, item)
-
-
-def _profile_task(shared: RegionProblem, item):
+def _profile_task(shared: ProfileProblem, item):
     """Maximise sign*g, g = the probe's rms force relative to the best fit's, keeping chi^2 near
     the region's edge: bounded least squares on the residuals [r*sqrt(n), c - (w/c)*sign*g],
     whose cost is chi^2/2 - w*sign*g + const (c large). w starts where the linearisation puts the

@@ -37,8 +37,9 @@ from identification.compiled_core import parameter_matrix
 from identification.engine import make_engine
 from identification.errors import IdentificationError
 from identification.ensemble import (PROBES, PROFILE_EVALUATIONS, PROFILE_ROUNDS, PUSH, STEPS, WALKERS,
-                                     Identifiability, SamplerReport, explore_region, identifiability,
-                                     misfit_threshold, push_to_boundary, select_members, threshold_scale)
+                                     Identifiability, SamplerReport, identifiability, misfit_threshold,
+                                     posterior_samples, profile_extremes, push_to_boundary, select_members,
+                                     threshold_scale)
 from identification.measurements import Measurement
 from identification.multistart import (Problem, SearchSettings, StartRecord, first_records, jacobian, run_stages,
                                        screen)
@@ -366,9 +367,10 @@ def _search(tests, noise, model, preset, settings, seed, engine, progress, start
     scaled_jacobian, _ = jacobian(problem, best.theta)
     ident = identifiability(scaled_jacobian * np.sqrt(n), space.names, threshold * n)
     limit = best.misfit + threshold
-    extremes, extreme_misfits, draws, sampler = explore_region(problem, best.theta, best.misfit, ident, limit, seed,
-                                                               threshold_scale(best.misfit, n, d), engine)
-    pushed, pushed_misfits = push_to_boundary(problem, best.theta, draws, limit, engine)
+    extremes, extreme_misfits = profile_extremes(problem, best.theta, best.misfit, ident, limit, engine)
+    # here, not on a worker: the compiled kernel runs the walkers on every core of this process
+    draws, _, sampler = posterior_samples(problem, best.theta, seed, threshold_scale(best.misfit, n, d))
+    pushed, pushed_misfits = push_to_boundary(problem, best.theta, draws, limit)
     evaluations += d + 1 + WALKERS * STEPS + len(draws) * len(PUSH) \
         + len(PROBES) * 2 * (d + 1) * (1 + PROFILE_ROUNDS * PROFILE_EVALUATIONS)
     members = select_members(best.theta, [(r.theta, r.misfit) for r in final],
