@@ -86,7 +86,7 @@ def screen(problem: Problem, engine, count: int, seed: int, progress=None) -> tu
     unit = qmc.Sobol(len(bounds), scramble=True, seed=np.random.default_rng(seed)).random(count)
     theta = bounds[:, 0] + unit * (bounds[:, 1] - bounds[:, 0])
     blocks = [theta[i:i + 256] for i in range(0, count, 256)]
-    misfits = engine.map(misfit_block, blocks, problem, progress=progress and (lambda n: progress(n * 256)))
+    misfits = engine.map(_misfit_task, blocks, problem, progress=progress and (lambda n: progress(n * 256)))
     return theta, np.concatenate(misfits)
 
 
@@ -110,7 +110,7 @@ def genetic_algorithm(problem: Problem, engine, seed: int, progress=None, popula
 
         def _evaluate(self, theta, out, *args, **kwargs):
             blocks = [theta[i:i + 64] for i in range(0, len(theta), 64)]
-            out["F"] = np.concatenate(engine.map(misfit_block, blocks, problem))
+            out["F"] = np.concatenate(engine.map(_misfit_task, blocks, problem))
             if progress:
                 progress(len(theta))
 
@@ -118,13 +118,6 @@ def genetic_algorithm(problem: Problem, engine, seed: int, progress=None, popula
                    mutation=PolynomialMutation(prob=1.0, prob_var=mutation_probability), eliminate_duplicates=True)
     result = minimize(Identification(), algorithm, ("n_gen", generations), seed=seed, verbose=False)
     return result.pop.get("X"), result.pop.get("F")[:, 0].copy()
-
-
-def successive_halving(problem: Problem, engine, theta: np.ndarray, misfits: np.ndarray,
-                       stages, progress=None) -> list[StartRecord]:
-    """Run the stages from the best screened points; returns every start's record, the last
-    stage's first, each group sorted by misfit."""
-    return run_stages(problem, engine, first_records(theta, misfits, stages[0][0]), stages, progress)
 
 
 def first_records(theta: np.ndarray, misfits: np.ndarray, count: int) -> list[StartRecord]:
@@ -168,8 +161,7 @@ def jacobian(problem: Problem, theta: np.ndarray, at: np.ndarray | None = None) 
     return ((shifted - at) / steps[:, None]).T, at
 
 
-def misfit_block(problem: Problem, block: np.ndarray) -> np.ndarray:
-    """The misfits of a block of candidates (coordinates), one engine task."""
+def _misfit_task(problem: Problem, block: np.ndarray) -> np.ndarray:
     return problem.misfit(block)
 
 
