@@ -35,7 +35,9 @@ from xml.dom.minidom import parseString
 from xml.etree import ElementTree as ET
 
 REPO = Path(__file__).resolve().parent
-LIBRARY_MODULES = ("bushing_core.py", "bushing_params.py", "bushing_models.py", "parameter_files.py")
+LIBRARY_MODULES = ("bushing_params.py", "model_definition.py", "integration.py", "proposed_model.py",
+                   "spencer_model.py", "bouc_wen_model.py", "kelvin_voigt_model.py", "bushing_models.py",
+                   "parameter_files.py")
 SLAVE_MODULE = "bushing_slave.py"
 
 sys.path.insert(0, str(REPO))
@@ -47,7 +49,7 @@ from fmu_src.parameter_files import parameter_document, read_parameter_set  # no
 PACKED_LIBRARY_INIT = '''"""Packed library of the bushing FMU (written by build_fmu.py)."""
 from pathlib import Path
 
-from . import bushing_core, bushing_models, parameter_files
+from . import bushing_models, integration, model_definition, parameter_files
 
 _DEFAULTS = parameter_files.read_parameter_set(Path(__file__).with_name("default_parameters.json"))
 MODEL = _DEFAULTS.model

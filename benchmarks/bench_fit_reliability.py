@@ -39,7 +39,7 @@ import numpy as np
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
-from fmu_src.bushing_params import PARAMETER_NAMES  # noqa: E402
+from fmu_src.proposed_model import PARAMETER_NAMES  # noqa: E402
 from fmu_src.parameter_files import load_parameters  # noqa: E402
 from identification.measurements import Measurement  # noqa: E402
 from identification.protocols import Sine, Step, sample_times  # noqa: E402

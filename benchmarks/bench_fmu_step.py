@@ -76,17 +76,18 @@ def time_fmu(fmu_path, inputs):
 
 
 def time_core(inputs_mm):
-    from fmu_src import bushing_core as core
+    from fmu_src.integration import advance
     from fmu_src.parameter_files import load_parameters
+    from fmu_src.proposed_model import MODEL
     params = load_parameters(REPO / "data" / "params_table5_combined.json")
-    model = core.compile_model(params)
-    state, state_x = core.initial_state(params), 0.0
+    constants = MODEL.constants(params)
+    state, state_x = MODEL.initial_state(constants, 0.0), 0.0
     started = time.perf_counter()
     substeps = 0
     for x, v in inputs_mm:
-        state, used = core.advance(model, state, state_x, x, v, STEP_S)
+        state, used = advance(MODEL, constants, state, state_x, x, v, STEP_S)
         state_x = x + v * STEP_S
-        core.force(state, state_x, v, params)
+        MODEL.force(constants, state, state_x, v)
         substeps += used
     return (time.perf_counter() - started) / len(inputs_mm), substeps / len(inputs_mm)
 

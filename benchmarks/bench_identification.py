@@ -33,8 +33,8 @@ def main() -> None:
     args = parser.parse_args()
 
     from scipy.integrate import solve_ivp
-    from fmu_src import bushing_core as core
-    from fmu_src.bushing_params import PARAMETER_NAMES
+    from fmu_src.integration import StepError
+    from fmu_src.proposed_model import MODEL, PARAMETER_NAMES, rhs
     from fmu_src.parameter_files import load_parameters
     from identification.compiled_core import simulate_population_held
     from identification.measurements import load_measurement
@@ -68,7 +68,7 @@ def main() -> None:
     for row in python_sample:
         try:
             simulate_python_core(dict(zip(PARAMETER_NAMES, row)), t, x, v)
-        except core.StepError:
+        except StepError:
             pass
     python_cost = (time.perf_counter() - started) / len(python_sample)
 
@@ -76,9 +76,9 @@ def main() -> None:
     started = time.perf_counter()
     for row in ivp_sample:
         p = dict(zip(PARAMETER_NAMES, row))
-        state = np.array(core.initial_state(p, x[0]))
+        state = np.array(MODEL.initial_state(MODEL.constants(p), x[0]))
         for k in range(t.size - 1):
-            state = solve_ivp(core.rhs, (0.0, t[k + 1] - t[k]), state, method="Radau", args=(x[k], v[k], p),
+            state = solve_ivp(rhs, (0.0, t[k + 1] - t[k]), state, method="Radau", args=(x[k], v[k], p),
                               rtol=1e-6, atol=1e-6).y[:, -1]
     ivp_cost = (time.perf_counter() - started) / len(ivp_sample)
 

@@ -2,7 +2,8 @@
 
 A thin layer: it declares the variables of one model of ``bushing_models`` (the proposed
 one, or a baseline), converts SI ports to the paper's N-mm-s units, validates every value it
-is given and calls ``bushing_core``. Nothing here changes the equations.
+is given and steps the model's own kernels through ``integration``. Nothing here knows the
+equations, and this error policy is the same for every model.
 
 The FMU's class is a subclass of :class:`BushingSlave` named after the model's FMI
 identifier, which build_fmu.py appends to the packed copy of this module (pythonfmu takes
@@ -41,18 +42,18 @@ from pythonfmu.enums import Fmi2Status
 # (fmpy's simulate_fmu does). So module-level code here must touch no files: the packed
 # library, imported once and then cached, reads the default parameters.
 if __package__:
-    from . import bushing_core as core, bushing_models as models
+    from . import integration, model_definition
     MODEL = None  # only an FMU built by build_fmu.py has a model and defaults
     DEFAULT_PARAMETERS = None
 else:
     _library = importlib.import_module(__name__ + "_lib")
-    core = _library.bushing_core
-    models = _library.bushing_models
+    integration = _library.integration
+    model_definition = _library.model_definition
     MODEL = _library.MODEL
     DEFAULT_PARAMETERS = _library.DEFAULT_PARAMETERS
 
 MM_PER_M = 1000.0
-PLAUSIBLE_TRAVEL_M = models.PLAUSIBLE_TRAVEL_MM / MM_PER_M
+PLAUSIBLE_TRAVEL_M = model_definition.PLAUSIBLE_TRAVEL_MM / MM_PER_M
 """|x| beyond this is far outside any rubber bushing's travel: most likely millimetres
 entered where metres are expected. It is warned about, not refused."""
 
@@ -85,11 +86,9 @@ class BushingSlave(Fmi2Slave):
             setattr(self, name, DEFAULT_PARAMETERS[name])
         self.x = 0.0  # m
         self.v = 0.0  # m/s
-        self._compiled = None          # core.CompiledModel of the parameters in force
-        self._parameters = None        # the core's 16 parameters in force (paper units)
-        self._force_offset = 0.0       # N, the model's constant force (preload)
+        self._constants = None         # MODEL.prepare of the parameters in force (paper units)
         self._parameters_changed = True
-        self._state = core.BushingState(0.0, 0.0, 0.0, 0.0)  # committed state, mm and N
+        self._state = tuple(0.0 for _ in MODEL.states)  # committed state, mm and N
         self._state_x_mm = 0.0         # displacement the committed state belongs to
         self._x_now_mm = 0.0           # current displacement: x as last set, else x_k + v_k*h
         self._last_force = 0.0         # N, last finite force
@@ -122,7 +121,7 @@ class BushingSlave(Fmi2Slave):
             self.register_variable(Real(
                 state.name, causality=Fmi2Causality.local, variability=Fmi2Variability.continuous,
                 description=f"internal state: {state.meaning} [{state.unit}]",
-                getter=self._state_getter(state.core_field, scale)))
+                getter=self._state_getter(state.index, scale)))
 
     # ---------------------------------------------------------------- variable access
     def _parameter_setter(self, name):
@@ -152,8 +151,7 @@ class BushingSlave(Fmi2Slave):
         if not math.isfinite(value):
             self._error(f"input v = {value} m/s is not a finite number; the next doStep will be refused")
 
-    def _state_getter(self, name, scale):
-        index = core.BushingState._fields.index(name)
+    def _state_getter(self, index, scale):
         return lambda: self._state[index] * scale
 
     def _force(self):
@@ -165,8 +163,9 @@ class BushingSlave(Fmi2Slave):
             try:
                 state = self._state
                 if self._x_now_mm != self._state_x_mm:
-                    state = core.apply_displacement_jump(self._compiled, state, self._x_now_mm - self._state_x_mm)
-                force = core.force(state, self._x_now_mm, self.v * MM_PER_M, self._parameters) + self._force_offset
+                    state = integration.apply_displacement_jump(MODEL, self._constants, state,
+                                                                self._x_now_mm - self._state_x_mm)
+                force = MODEL.force(self._constants, state, self._x_now_mm, self.v * MM_PER_M)
             except (ArithmeticError, ValueError):
                 force = math.nan
             if math.isfinite(force):
@@ -209,8 +208,8 @@ class BushingSlave(Fmi2Slave):
         raise InitializationError("; ".join(reasons))
 
     def _set_initial_state(self):
-        """Relaxed equilibrium at the current displacement (see bushing_core.initial_state)."""
-        self._state = core.initial_state(self._parameters, self._x_now_mm)
+        """Relaxed equilibrium at the current displacement (the model's initial_state)."""
+        self._state = MODEL.initial_state(self._constants, self._x_now_mm)
         self._state_x_mm = self._x_now_mm
         self._force_is_current = False
         self._initial_state_pending = False
@@ -230,11 +229,12 @@ class BushingSlave(Fmi2Slave):
         x_mm = self._x_now_mm
         v_mm = self.v * MM_PER_M
         try:
-            state, _ = core.advance(self._compiled, self._state, self._state_x_mm, x_mm, v_mm, step_size)
-        except core.StepError as exc:
+            state, _ = integration.advance(MODEL, self._constants, self._state, self._state_x_mm, x_mm, v_mm,
+                                           step_size)
+        except integration.StepError as exc:
             return self._refuse(f"doStep at t = {current_time} s refused: {exc}")
         x_end = x_mm + v_mm * step_size
-        force = core.force(state, x_end, v_mm, self._parameters) + self._force_offset
+        force = MODEL.force(self._constants, state, x_end, v_mm)
         if not math.isfinite(force):
             return self._refuse(f"doStep at t = {current_time} s refused: the force would be {force} N "
                                 f"(x = {self.x} m, v = {self.v} m/s); check the units of the inputs")
@@ -242,7 +242,7 @@ class BushingSlave(Fmi2Slave):
             self._force_warned = True
             self.log(f"F = {force:.4g} N at t = {current_time + step_size} s exceeds {self._force_bound:.3g} N, the "
                      f"force of all the bushing's springs and dashpots at {PLAUSIBLE_TRAVEL_M:g} m and "
-                     f"{models.PLAUSIBLE_VELOCITY_MM_S / MM_PER_M:g} m/s: check the units of "
+                     f"{model_definition.PLAUSIBLE_VELOCITY_MM_S / MM_PER_M:g} m/s: check the units of "
                      f"the inputs (x = {self.x} m, v = {self.v} m/s; the FMU takes metres)",
                      Fmi2Status.warning, "logStatusWarning")
         self._state = state
@@ -262,16 +262,13 @@ class BushingSlave(Fmi2Slave):
             for message in errors:
                 self._error(message)
             if errors:
-                self._compiled = None
-                self._parameters = None
+                self._constants = None
             else:
                 for message in warnings:
                     self.log(f"accepted, but {message}", Fmi2Status.warning, "logStatusWarning")
-                self._parameters = MODEL.core_parameters(values)
-                self._force_offset = MODEL.force_offset(values)
                 self._force_bound = MODEL.plausible_force_bound(values)
-                self._compiled = core.compile_model(self._parameters)
-        return self._compiled is not None
+                self._constants = MODEL.constants(values)
+        return self._constants is not None
 
     def _error(self, message):
         self.log(message, Fmi2Status.error, "logStatusError")
@@ -299,7 +296,7 @@ class BushingSlave(Fmi2Slave):
             setattr(self, name, value)
         self.x = state["x"]
         self.v = state["v"]
-        self._state = core.BushingState(*state["state"])
+        self._state = tuple(state["state"])
         self._state_x_mm = state["state_x_mm"]
         self._x_now_mm = state["x_now_mm"]
         self._last_force = state["last_force"]

@@ -1,14 +1,17 @@
-"""The model core compiled with numba, for simulating whole populations of parameter sets.
+"""The bushing models compiled with numba, for simulating whole populations of parameter sets.
 
-One definition: the source of ``fmu_src/bushing_core.py`` is written, with the population
-loop below appended, into a generated module in the cache folder (:func:`cache_directory`),
-where its kernels (plain float arithmetic, errors as status codes) are replaced by
-numba-compiled versions of themselves, so that they call each other compiled. The FMU runs
-the same functions as plain Python; ``tests/test_compiled_core.py`` checks the two agree to
-1e-9 (they are bitwise equal in practice). Compilation takes a few seconds on first use; numba
-caches the machine code on disk, so later processes load it.
+One definition. For each model, the source of its module (``fmu_src/<name>_model.py``) is
+written, with the population loop below appended, into a generated module in the cache folder
+(:func:`cache_directory`), where its kernels are replaced by numba-compiled versions of
+themselves; its imports of the shared machinery (``fmu_src/integration.py``) are pointed at a
+generated module of that machinery, compiled the same way, so that every kernel calls the
+others compiled. The FMU runs the same functions as plain Python;
+``tests/test_compiled_core.py`` checks the two agree bitwise for every model. Compilation
+takes a few seconds on a model's first use; numba caches the machine code on disk, so later
+processes load it.
 
-Units as in the core: mm, mm/s, N, s; parameters in the paper's N-mm-s units.
+Units as in the models: mm, mm/s, N, s; parameters in the paper's N-mm-s units, each model's
+own in its spec order (``parameter_matrix``).
 """
 from __future__ import annotations
 
@@ -25,43 +28,33 @@ from typing import Mapping
 import numba
 import numpy as np
 
-from fmu_src import bushing_core as _core
+from fmu_src import integration
 from fmu_src.bushing_models import get_model
-from fmu_src.bushing_params import PARAMETER_NAMES
+from fmu_src.proposed_model import PARAMETER_NAMES  # noqa: F401  (the proposed model's order, for callers)
 
-_KERNELS = ("_decay_factors", "_rk4_in_xi", "_segment", "_block_step", "_gain_variation",
-            "_substeps_needed", "_jump_kernel", "_integrate")
-_I = {name: i for i, name in enumerate(PARAMETER_NAMES)}
 CACHE_ENVIRONMENT = "BUSHING_CACHE_DIR"
+_MAX_SUBSTEPS = integration.DEFAULT_MAX_SUBSTEPS
 
 
 def _population_forces(matrix, t, x, v, out_index, out_velocity, max_substeps):
     """Forces of every parameter set (rows of ``matrix``) at the communication points
     ``t[out_index]``; the input over [t_k, t_k+1] is x_k + v_k*(t - t_k), as in the FMU, and the
-    force at an output point is eq. 5 with the velocity ``out_velocity`` (the FMU's direct
-    feedthrough of the velocity set at that instant).
+    force at an output point is the model's force with the velocity ``out_velocity`` (the FMU's
+    direct feedthrough of the velocity set at that instant).
 
-    Written here, never called here: its source is compiled in the generated module (see
-    :func:`_load_compiled_module`), where ``_jump_kernel`` and ``_integrate`` are the core's
-    compiled kernels and the parameter indices are constants."""
+    Written here, never called here: its source is compiled in each model's generated module
+    (see :func:`_model_source`), where ``prepare`` ... ``force`` are that model's compiled
+    kernels and ``_VALUES(row)`` the row's values as the tuple ``prepare`` takes."""
     count, samples, outputs = matrix.shape[0], t.size, out_index.size
     forces = np.full((count, outputs), np.nan)
     for i in numba.prange(count):
-        p = matrix[i]
-        C = p[_C0] + p[_C2]
-        K1 = p[_K0] + p[_K1]
-        # The tuple layout of bushing_core.compile_model (CompiledModel and its _Blocks).
-        model = (p[_K0], p[_K1], p[_K2], p[_C0], p[_C1], C, K1, p[_ALPHA1], p[_ALPHA2],
-                 (K1, p[_ALPHA1], p[_C1], p[_A1], p[_BETA1], p[_GAMMA1], p[_N1]),
-                 (p[_K2], p[_ALPHA2], C, p[_A2], p[_BETA2], p[_GAMMA2], p[_N2]))
+        row = matrix[i]
+        m = prepare(_VALUES(row))
         state_x = x[0]
-        y = p[_K1] * state_x / K1 if K1 > 0.0 else state_x  # bushing_core.initial_state
-        z1, w, z2 = 0.0, state_x, 0.0
+        state = initial_state(m, state_x)
         j = 0
         if out_index[0] == 0:
-            # bushing_core.force: eq. 5 with eq. 4
-            forces[i, 0] = p[_K0] * y + p[_C0] * ((p[_C2] * out_velocity[0] + p[_K2] * (state_x - w)
-                                                    + p[_ALPHA2] * z2) / C)
+            forces[i, 0] = force(m, state, state_x, out_velocity[0])
             j = 1
         for k in range(samples - 1):
             if j == outputs:
@@ -69,49 +62,66 @@ def _population_forces(matrix, t, x, v, out_index, out_velocity, max_substeps):
             h = t[k + 1] - t[k]
             status = _OK
             if x[k] != state_x:
-                y, z1, w, z2, status = _jump_kernel(model, y, z1, w, z2, x[k] - state_x)
+                state, status = jump(m, state, x[k] - state_x)
             if status == _OK:
-                y, z1, w, z2, used, status = _integrate(model, y, z1, w, z2, x[k], v[k], h, max_substeps)
+                state, used, status = integrate(m, state, x[k], v[k], h, max_substeps)
             if status != _OK:
                 break  # this candidate failed: NaN from here on
             state_x = x[k] + v[k] * h
             if out_index[j] == k + 1:
-                forces[i, j] = p[_K0] * y + p[_C0] * ((p[_C2] * out_velocity[j] + p[_K2] * (state_x - w)
-                                                        + p[_ALPHA2] * z2) / C)
+                forces[i, j] = force(m, state, state_x, out_velocity[j])
                 j += 1
     return forces
 
 
-def _compiled_source() -> str:
-    """One module: the core's source, its kernels compiled, and the population loop. Generated
-    as a file so that numba can cache the machine code on disk, and named after a hash of its
-    content, so that a change to the core or to the loop compiles afresh (numba's cache checks
-    only the file's own time stamp, not the sources of the functions a kernel calls)."""
-    indices = "\n".join(f"_{name.upper()} = {index}" for name, index in _I.items())
-    return (inspect.getsource(_core)
-            + "\n\n# ---- appended by identification/compiled_core.py ----\n"
-            + "import numba\nimport numpy as np\n\n"
-            + "_OK = OK\n" + indices + "\n"
-            # error_model="numpy": a division by zero gives inf/nan (caught as NOT_FINITE)
-            # instead of an exception that would abort the whole population.
-            + f"for _name in {_KERNELS!r}:\n"
-            + "    globals()[_name] = numba.njit(error_model='numpy', cache=True)(globals()[_name])\n\n\n"
+_JIT_KERNELS = (
+    # error_model="numpy": a division by zero gives inf/nan (caught as NOT_FINITE) instead of an
+    # exception that would abort the whole population.
+    "for _name in KERNELS:\n"
+    "    globals()[_name] = numba.njit(error_model='numpy', cache=True)(globals()[_name])\n")
+
+
+def _integration_source() -> str:
+    """The shared machinery, its kernels compiled."""
+    return inspect.getsource(integration) + "\n\n# ---- appended by identification/compiled_core.py ----\n" \
+        + "import numba\n\n" + _JIT_KERNELS
+
+
+def _model_source(model_name: str, integration_module: str) -> str:
+    """One model's module, its kernels compiled, and the population loop. Its relative imports
+    point at the package (plain Python: specs, checks) and at the compiled machinery."""
+    bushing = get_model(model_name)
+    source = inspect.getsource(sys.modules[bushing.kernel_module])
+    source = source.replace("from .integration import", f"from {integration_module} import")
+    source = source.replace("from .", "from fmu_src.")
+    values = ", ".join(f"row[{i}]" for i in range(len(bushing.specs)))
+    return (source + "\n\n# ---- appended by identification/compiled_core.py ----\n"
+            + f"import numba\nimport numpy as np\nfrom {integration_module} import OK as _OK\n\n"
+            + _JIT_KERNELS + "\n\n"
+            + f"@numba.njit(cache=True)\ndef _VALUES(row):\n    return ({values},)\n\n\n"
             + inspect.getsource(_population_forces)
             + "\n\n_simulate_population = numba.njit(error_model='numpy', parallel=True, cache=True)"
               "(_population_forces)\n")
 
 
 def cache_directory() -> Path:
-    """Where the generated module and numba's cache live: $BUSHING_CACHE_DIR, else
+    """Where the generated modules and numba's cache live: $BUSHING_CACHE_DIR, else
     $XDG_CACHE_HOME/boucwen-bushing, else ~/.cache/boucwen-bushing."""
     if os.environ.get(CACHE_ENVIRONMENT):
         return Path(os.environ[CACHE_ENVIRONMENT])
     return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "boucwen-bushing"
 
 
-def _load_compiled_module():
-    source = _compiled_source()
-    name = f"bushing_compiled_{hashlib.sha256(source.encode()).hexdigest()[:16]}"
+def _module_name(prefix: str, source: str) -> str:
+    """Named after a hash of the content, so that a change to a model, to the machinery or to
+    the loop compiles afresh (numba's cache checks only the file's own time stamp, not the
+    sources of the functions a kernel calls; a model's source names the machinery's hash)."""
+    return f"{prefix}_{hashlib.sha256(source.encode()).hexdigest()[:16]}"
+
+
+def _load_generated(name: str, source: str):
+    if name in sys.modules:
+        return sys.modules[name]
     try:
         folder = cache_directory()
         folder.mkdir(parents=True, exist_ok=True)
@@ -123,9 +133,11 @@ def _load_compiled_module():
             os.replace(partial, path)
     except OSError as exc:
         warnings.warn(f"cannot write the compiled model's cache in {cache_directory()} ({exc}); compiling "
-                      f"in memory at every start (set {CACHE_ENVIRONMENT} to a writable folder)", stacklevel=3)
+                      f"in memory at every start (set {CACHE_ENVIRONMENT} to a writable folder)", stacklevel=4)
         module = types.ModuleType(name)
-        exec(compile(source.replace(", cache=True", ""), f"<{name}>", "exec"), module.__dict__)
+        sys.modules[name] = module
+        exec(compile(source.replace(", cache=True", "").replace("(cache=True)", "()"), f"<{name}>", "exec"),
+             module.__dict__)
         return module
     spec = importlib.util.spec_from_file_location(name, path)
     module = importlib.util.module_from_spec(spec)
@@ -134,37 +146,44 @@ def _load_compiled_module():
     return module
 
 
-_compiled = _load_compiled_module()
-_jump_kernel = _compiled._jump_kernel
-_integrate = _compiled._integrate
-_simulate_population = _compiled._simulate_population
-_OK = _core.OK
-_C0, _K0, _C1, _K1, _C2, _K2 = _I["c0"], _I["k0"], _I["c1"], _I["k1"], _I["c2"], _I["k2"]
-_ALPHA1, _ALPHA2, _BETA1, _BETA2 = _I["alpha1"], _I["alpha2"], _I["beta1"], _I["beta2"]
-_GAMMA1, _GAMMA2, _N1, _N2, _A1, _A2 = _I["gamma1"], _I["gamma2"], _I["n1"], _I["n2"], _I["A1"], _I["A2"]
+_compiled_models: dict[str, types.ModuleType] = {}
+
+
+def compiled_model(model: str = "proposed") -> types.ModuleType:
+    """The generated, compiled module of ``model`` (loaded on first use)."""
+    name = get_model(model).name
+    if name not in _compiled_models:
+        machinery_source = _integration_source()
+        machinery = _module_name("bushing_integration", machinery_source)
+        _load_generated(machinery, machinery_source)
+        source = _model_source(name, machinery)
+        _compiled_models[name] = _load_generated(_module_name(f"bushing_{name}", source), source)
+    return _compiled_models[name]
 
 
 def simulate_population_held(parameter_sets, time_s, displacement_mm, velocity_mm_s,
-                             max_substeps: int = _core.DEFAULT_MAX_SUBSTEPS) -> np.ndarray:
-    """Forces [N], shape (P, samples), of P parameter sets under the FMU's input convention.
+                             max_substeps: int = _MAX_SUBSTEPS, model: str = "proposed") -> np.ndarray:
+    """Forces [N], shape (P, samples), of P parameter sets of ``model`` under the FMU's input
+    convention.
 
     The FMU with a communication point at every sample: over [t_k, t_k+1] the displacement is
     x_k + v_k*(t - t_k) and the velocity v_k held (a displacement jump where x_k+1 differs from
     x_k + v_k*h), and the force at t_k+1 is read before the next inputs are set (velocity v_k).
     This is what a co-simulation master sees; the identification's forward model
     (``identification.forward_model``) drives the same kernel with a finer, consistent input.
-    ``parameter_sets`` is a (P, 16) array in ``PARAMETER_NAMES`` order or a sequence of
-    mappings; the sets must be valid. A candidate whose step fails (overflow, non-finite
-    state, too many substeps) gets NaN from that sample on. Runs on all cores.
+    ``parameter_sets``: see :func:`parameter_matrix`; the sets must be valid. A candidate whose
+    step fails (overflow, non-finite state, too many substeps) gets NaN from that sample on.
+    Runs on all cores.
     """
     t, x, v = _input_arrays(time_s, displacement_mm, velocity_mm_s)
     out_velocity = np.concatenate([v[:1], v[:-1]])
-    return _simulate_population(parameter_matrix(parameter_sets), t, x, v, np.arange(t.size), out_velocity,
-                                max_substeps)
+    return compiled_model(model)._simulate_population(parameter_matrix(parameter_sets, model), t, x, v,
+                                                      np.arange(t.size), out_velocity, max_substeps)
 
 
 def simulate_population_at(parameter_sets, time_s, displacement_mm, velocity_mm_s, output_index,
-                           output_velocity_mm_s, max_substeps: int = _core.DEFAULT_MAX_SUBSTEPS) -> np.ndarray:
+                           output_velocity_mm_s, max_substeps: int = _MAX_SUBSTEPS,
+                           model: str = "proposed") -> np.ndarray:
     """Forces [N], shape (P, outputs), at the communication points ``time_s[output_index]``
     (increasing), with the force's viscous feedthrough taken at ``output_velocity_mm_s``; the
     input between communication points as in :func:`simulate_population_held`."""
@@ -174,7 +193,8 @@ def simulate_population_at(parameter_sets, time_s, displacement_mm, velocity_mm_
     if not (out_index.ndim == 1 and out_index.size >= 1 and out_index.shape == out_velocity.shape
             and np.all(np.diff(out_index) > 0) and 0 <= out_index[0] and out_index[-1] < t.size):
         raise ValueError("output_index must be increasing indices into time_s, one output velocity each")
-    return _simulate_population(parameter_matrix(parameter_sets), t, x, v, out_index, out_velocity, max_substeps)
+    return compiled_model(model)._simulate_population(parameter_matrix(parameter_sets, model), t, x, v, out_index,
+                                                      out_velocity, max_substeps)
 
 
 def _input_arrays(time_s, displacement_mm, velocity_mm_s):
@@ -187,25 +207,24 @@ def _input_arrays(time_s, displacement_mm, velocity_mm_s):
     return t, x, v
 
 
-def parameter_matrix(parameter_sets) -> np.ndarray:
-    """(P, 16) float array in PARAMETER_NAMES order from a sequence of mappings or an array."""
+def parameter_matrix(parameter_sets, model: str = "proposed") -> np.ndarray:
+    """(P, m) float array of P parameter sets of ``model`` in its parameter order (its specs'),
+    from a sequence of mappings or an array."""
+    names = get_model(model).parameter_names
     if isinstance(parameter_sets, np.ndarray):
         matrix = np.atleast_2d(np.asarray(parameter_sets, dtype=float))
     else:
-        matrix = np.array([[float(p[name]) for name in PARAMETER_NAMES] for p in parameter_sets])
-    if matrix.ndim != 2 or matrix.shape[1] != len(PARAMETER_NAMES):
-        raise ValueError(f"expected a (P, {len(PARAMETER_NAMES)}) parameter matrix "
-                         f"in the order {', '.join(PARAMETER_NAMES)}, got shape {matrix.shape}")
+        matrix = np.array([[float(p[name]) for name in names] for p in parameter_sets])
+    if matrix.ndim != 2 or matrix.shape[1] != len(names):
+        raise ValueError(f"expected a (P, {len(names)}) parameter matrix of the {get_model(model).name} model "
+                         f"in the order {', '.join(names)}, got shape {matrix.shape}")
     return np.ascontiguousarray(matrix)
 
 
 def simulate_model_held(model: str, params: Mapping[str, float], time_s, displacement_mm,
                         velocity_mm_s) -> np.ndarray:
     """Force [N] of one parameter set of any model of ``bushing_models`` (by name) under the
-    FMU's input convention (:func:`simulate_population_held`): the core's force of the model's
-    16 core parameters plus its constant force (preload). Raises ParameterError for an
+    FMU's input convention (:func:`simulate_population_held`). Raises ParameterError for an
     invalid set."""
-    bushing = get_model(model)
-    values = bushing.check(params)
-    forces = simulate_population_held([bushing.core_parameters(values)], time_s, displacement_mm, velocity_mm_s)[0]
-    return forces + bushing.force_offset(values)
+    values = get_model(model).check(params)
+    return simulate_population_held([values], time_s, displacement_mm, velocity_mm_s, model=model)[0]

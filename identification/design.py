@@ -113,7 +113,7 @@ def design(ensemble, noise_N: float | None = None, candidates: list[Candidate] |
     if noise_N is None:
         noise_N = _training_noise(ensemble)
     candidates = candidates or candidate_tests()
-    matrix = parameter_matrix([bushing.core_parameters(s) for s in sets])
+    matrix = parameter_matrix(sets, bushing.name)
     ranked = []
     iterator = candidates
     if progress:
@@ -124,7 +124,7 @@ def design(ensemble, noise_N: float | None = None, candidates: list[Candidate] |
         t = sample_times(protocol.duration_s, RATE_HZ)
         x, v = protocol.signals(t)
         driven = prepare_input(t, x, v, decimate_holds=True)
-        forces = simulate_driven(matrix, driven)
+        forces = simulate_driven(matrix, driven, model=bushing.name)
         runs = np.all(np.isfinite(forces), axis=1)
         if runs.sum() < 2 or not runs[0]:
             continue   # the best set, or all but one, cannot be simulated on it: not a test to propose

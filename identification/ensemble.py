@@ -213,7 +213,7 @@ def _profile_task(shared: ProfileProblem, item):
     weights = np.diff(np.append(driven.sample_index, t.size))
 
     def rms(thetas):
-        forces = simulate_driven(space.to_parameters(np.atleast_2d(thetas)), driven)
+        forces = simulate_driven(space.to_parameters(np.atleast_2d(thetas)), driven, model=space.model)
         return np.sqrt(np.average(forces ** 2, axis=1, weights=weights))
 
     bounds = space.bounds()

@@ -326,7 +326,7 @@ def _settings(base: SearchSettings, screening: int | None, starts: int | None) -
 def _search(tests, noise, model, preset, settings, seed, engine, progress, started) -> FitResult:
     measurements = [t.measurement for t in tests]
     space = SearchSpace.from_measurements(measurements, model, steps=[t.kind == "step" for t in tests])
-    problem = Problem(Objective(tests, noise), space)
+    problem = Problem(Objective(tests, noise, model=space.model), space)
     ga_evaluations = PAPER_GA["population"] * PAPER_GA["generations"]
     bars = _Progress(progress, settings, ga_evaluations if preset == "paper" else settings.screening)
     if preset == "paper":
@@ -396,8 +396,8 @@ def _fit_kelvin_voigt(tests, noise, started) -> FitResult:
                                 or [t.measurement for t in tests], nonnegative=True)
     values = {"k": linear.k, "c": linear.c, "preload": 0.0}
     parameters = ParameterSet(bushing, values)
-    objective = Objective(tests, noise)
-    misfit = float(objective(parameter_matrix([bushing.core_parameters(values)]))[0])
+    objective = Objective(tests, noise, model=bushing.name)
+    misfit = float(objective(parameter_matrix([values], bushing.name))[0])
     result = FitResult(parameters, misfit, _test_fits(tests, noise, parameters), [], 0.0, [values], None,
                        "linear", 0, 1, time.perf_counter() - started)
     result.parameters.provenance = result.provenance()

@@ -54,13 +54,14 @@ class PreparedTest:
 
 
 class Objective:
-    """Misfit (chi^2/n) of candidate core parameter sets; see the module docstring."""
+    """Misfit (chi^2/n) of candidate parameter sets of ``model``; see the module docstring."""
 
     def __init__(self, tests: Sequence[RigTest], noise: Sequence[NoiseEstimate] | None = None,
-                 steps: Sequence[int | None] | None = None):
+                 steps: Sequence[int | None] | None = None, model: str = "proposed"):
         """``steps``: communication steps per sample of each test (None: chosen from the
         signal, ``forward_model.steps_per_sample``); ``identification.refinement`` raises them
-        where a candidate's response needs it."""
+        where a candidate's response needs it. Candidates are (P, m) matrices of ``model``'s
+        parameters in its order (``compiled_core.parameter_matrix``)."""
         if not tests:
             raise ValueError("the objective needs at least one training test")
         noise = list(noise) if noise is not None else [estimate_noise(t.measurement.force_N) for t in tests]
@@ -70,6 +71,7 @@ class Objective:
         if len(steps) != len(tests):
             raise ValueError(f"{len(steps)} step counts for {len(tests)} tests")
         self.noise = noise
+        self.model = model
         self.tests: list[PreparedTest] = []
         for test, level, m_steps in zip(tests, noise, steps):
             m = test.measurement
@@ -84,23 +86,23 @@ class Objective:
         """Communication steps per sample interval of each test's forward model."""
         return [t.driven.steps_per_sample for t in self.tests]
 
-    def residual_matrix(self, core_matrix: np.ndarray) -> np.ndarray:
+    def residual_matrix(self, matrix: np.ndarray) -> np.ndarray:
         """Residuals of P candidates, shape (P, n); each row's sum of squares is its misfit."""
         scale = 1.0 / math.sqrt(self.size)
         parts = []
         for test in self.tests:
-            predicted = simulate_driven(core_matrix, test.driven, FIT_MAX_SUBSTEPS)
+            predicted = simulate_driven(matrix, test.driven, FIT_MAX_SUBSTEPS, self.model)
             parts.append((predicted - test.measured_N) * (scale / test.sigma_N))
         residual = np.concatenate(parts, axis=1)
         return np.where(np.isfinite(residual), residual, FAILED_RESIDUAL * scale)
 
-    def __call__(self, core_matrix: np.ndarray) -> np.ndarray:
+    def __call__(self, matrix: np.ndarray) -> np.ndarray:
         """Misfit of each of P candidates, shape (P,)."""
-        return np.sum(self.residual_matrix(np.atleast_2d(core_matrix)) ** 2, axis=1)
+        return np.sum(self.residual_matrix(np.atleast_2d(matrix)) ** 2, axis=1)
 
-    def test_misfits(self, core_matrix: np.ndarray) -> np.ndarray:
+    def test_misfits(self, matrix: np.ndarray) -> np.ndarray:
         """(NRMSE_i/noise_i)^2 on the residual samples of each test, shape (P, tests)."""
-        residual = self.residual_matrix(np.atleast_2d(core_matrix)) * math.sqrt(self.size)
+        residual = self.residual_matrix(np.atleast_2d(matrix)) * math.sqrt(self.size)
         bounds = np.cumsum([0] + [t.measured_N.size for t in self.tests])
         return np.column_stack([np.mean(residual[:, a:b] ** 2, axis=1) for a, b in zip(bounds[:-1], bounds[1:])])
 

@@ -82,8 +82,7 @@ def predict(parameters, time_s, displacement_mm, velocity_mm_s=None, model: str 
     docstring). Units: s, mm, mm/s, N."""
     bushing, sets = members_of(parameters, model)
     driven = prepare_input(time_s, displacement_mm, velocity_mm_s)
-    forces = simulate_driven(parameter_matrix([bushing.core_parameters(s) for s in sets]), driven)
-    forces = forces + np.array([bushing.force_offset(s) for s in sets])[:, None]
+    forces = simulate_driven(parameter_matrix(sets, bushing.name), driven, model=bushing.name)
     failed = ~np.isfinite(forces[0])
     if failed.any():
         raise IdentificationError(f"the simulation of the best parameter set fails from t = "

@@ -54,9 +54,9 @@ class Refinement:
     evaluations: int
 
 
-def refine_steps(objective: Objective, tests: Sequence[RigTest], core_row: np.ndarray, delta_chi2: float) -> Refinement:
+def refine_steps(objective: Objective, tests: Sequence[RigTest], row: np.ndarray, delta_chi2: float) -> Refinement:
     """Double each test's steps per sample while its forward-model error at the candidate
-    ``core_row`` (one row of core parameters) exceeds its share of ``ERROR_BUDGET * delta_chi2``
+    ``row`` (one row of the objective's model's parameters) exceeds its share of ``ERROR_BUDGET * delta_chi2``
     (see the module docstring); returns the objective to use from here on.
 
     Where the candidate fails at m (more than FIT_MAX_SUBSTEPS substeps in a communication
@@ -64,19 +64,19 @@ def refine_steps(objective: Objective, tests: Sequence[RigTest], core_row: np.nd
     fails at 2m, m is kept. If it fails at every m, the test keeps the m it had."""
     if len(tests) != len(objective.tests):
         raise ValueError(f"{len(tests)} tests for an objective of {len(objective.tests)}")
-    core = np.atleast_2d(core_row)
+    candidate = np.atleast_2d(row)
     budget = ERROR_BUDGET * delta_chi2 / len(tests)
     steps, errors, work = [], [], 0
     for test, prepared in zip(tests, objective.tests):
         first = m = prepared.driven.steps_per_sample
-        coarse = simulate_driven(core, prepared.driven, FIT_MAX_SUBSTEPS)[0]
+        coarse = simulate_driven(candidate, prepared.driven, FIT_MAX_SUBSTEPS, objective.model)[0]
         work += m
         error = math.nan
         while 2 * m <= MAX_REFINED_STEPS:
             measurement = test.measurement
             finer = prepare_input(measurement.time_s, measurement.displacement_mm, measurement.measured_velocity_mm_s,
                                   decimate_holds=True, steps=2 * m)
-            fine = simulate_driven(core, finer, FIT_MAX_SUBSTEPS)[0]
+            fine = simulate_driven(candidate, finer, FIT_MAX_SUBSTEPS, objective.model)[0]
             work += 2 * m
             runs, ran = bool(np.all(np.isfinite(fine))), bool(np.all(np.isfinite(coarse)))
             if ran and not runs:
@@ -92,7 +92,7 @@ def refine_steps(objective: Objective, tests: Sequence[RigTest], core_row: np.nd
         steps.append(m)
         errors.append(error)
     changed = steps != objective.steps_per_sample
-    refined = Objective(tests, objective.noise, steps) if changed else objective
+    refined = Objective(tests, objective.noise, steps, objective.model) if changed else objective
     # cost in evaluations of every test at its signal's m (a simulation's cost grows with m)
     evaluations = math.ceil(work / max(1, sum(objective.steps_per_sample)))
     return Refinement(refined, changed, tuple(errors), evaluations)

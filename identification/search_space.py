@@ -40,7 +40,6 @@ import numpy as np
 from scipy.optimize import lsq_linear
 
 from fmu_src.bushing_models import get_model
-from identification.compiled_core import parameter_matrix
 from identification.errors import IdentificationError
 from identification.measurements import Measurement
 
@@ -213,13 +212,9 @@ class SearchSpace:
         return np.column_stack([value[name] for name in names])
 
     def to_parameters(self, coordinates: np.ndarray) -> np.ndarray:
-        """(P, d) coordinates -> (P, 16) parameters of the core that simulate the model
-        (for the proposed model, its own 16 parameters with alpha1 = alpha2 = 1)."""
-        rows = self.to_model_parameters(coordinates)
-        if self.model == "proposed":
-            return rows
-        names, bushing = self.bushing.parameter_names, self.bushing
-        return parameter_matrix([bushing.core_parameters(dict(zip(names, row))) for row in rows])
+        """(P, d) coordinates -> (P, m) parameters of the model, what its compiled kernels take
+        (``compiled_core.parameter_matrix``; for the proposed model alpha1 = alpha2 = 1)."""
+        return np.ascontiguousarray(self.to_model_parameters(coordinates))
 
     def to_coordinates(self, params: Mapping[str, float]) -> np.ndarray:
         """The inverse of :meth:`to_model_parameters` (after rescaling every alpha to 1)."""

@@ -18,7 +18,7 @@ from typing import Mapping
 
 import numpy as np
 
-from fmu_src.bushing_params import PARAMETER_NAMES, PARAMETER_UNITS
+from fmu_src.proposed_model import PARAMETER_NAMES, PARAMETER_UNITS
 from identification.errors import IdentificationError
 from identification.forward_model import prepare_input
 from identification.protocols import Sine, Step, sample_times

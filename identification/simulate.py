@@ -36,19 +36,17 @@ def simulate(parameters, time_s, displacement_mm, velocity_mm_s=None, model: str
     """
     values, bushing = _parameters_and_model(parameters, model)
     driven = prepare_input(time_s, displacement_mm, velocity_mm_s, steps=steps_per_sample)
-    return simulate_driven(_core_matrix(bushing, [values]), driven)[0] + bushing.force_offset(values)
+    return simulate_driven(parameter_matrix([values], bushing.name), driven, model=bushing.name)[0]
 
 
-def simulate_driven(core_matrix: np.ndarray, driven: DrivenInput, max_substeps: int | None = None) -> np.ndarray:
-    """Forces [N], shape (P, outputs), of a (P, 16) matrix of core parameters on a prepared
-    input, at its output samples (``driven.sample_index``). NaN from where a candidate fails."""
+def simulate_driven(matrix: np.ndarray, driven: DrivenInput, max_substeps: int | None = None,
+                    model: str = "proposed") -> np.ndarray:
+    """Forces [N], shape (P, outputs), of a (P, m) matrix of ``model``'s parameters
+    (``compiled_core.parameter_matrix``) on a prepared input, at its output samples
+    (``driven.sample_index``). NaN from where a candidate fails."""
     kwargs = {} if max_substeps is None else {"max_substeps": max_substeps}
-    return simulate_population_at(core_matrix, driven.time_s, driven.displacement_mm, driven.velocity_mm_s,
-                                  driven.output_index, driven.output_velocity_mm_s, **kwargs)
-
-
-def _core_matrix(bushing, parameter_sets) -> np.ndarray:
-    return parameter_matrix([bushing.core_parameters(values) for values in parameter_sets])
+    return simulate_population_at(matrix, driven.time_s, driven.displacement_mm, driven.velocity_mm_s,
+                                  driven.output_index, driven.output_velocity_mm_s, model=model, **kwargs)
 
 
 def _parameters_and_model(parameters, model):

@@ -10,25 +10,23 @@ from typing import Mapping
 
 import numpy as np
 
-from fmu_src import bushing_core as core
 from fmu_src.bushing_models import get_model
+from fmu_src.integration import advance
 
 
 def simulate_python_core(params: Mapping[str, float], time_s, displacement_mm, velocity_mm_s,
              substeps_per_sample: int = 1, model: str = "proposed") -> np.ndarray:
     """Force [N] at every sample time of the bushing ``model`` (``bushing_models``) with ``params``,
-    through ``bushing_core.advance`` as the FMU calls it.
+    through ``integration.advance`` and the model's own kernels, as the FMU calls them.
 
     Between samples k and k+1 the displacement is x_k + v_k*(t - t_k) and the velocity v_k,
     exactly as in the FMU with communication points at the sample times (where x_{k+1}
     differs from x_k + v_k*h the model takes it as a displacement jump); the state starts in
-    the relaxed equilibrium at x_0 (``bushing_core.initial_state``). ``substeps_per_sample``
+    the relaxed equilibrium at x_0 (the model's ``initial_state``). ``substeps_per_sample``
     > 1 splits each interval into equal communication steps (for fine reference runs).
     """
     bushing = get_model(model)
-    values = bushing.check(params)
-    p = bushing.core_parameters(values)
-    compiled = core.compile_model(p)
+    constants = bushing.constants(bushing.check(params))
     t = np.asarray(time_s, dtype=float)
     x = np.asarray(displacement_mm, dtype=float)
     v = np.asarray(velocity_mm_s, dtype=float)
@@ -36,14 +34,14 @@ def simulate_python_core(params: Mapping[str, float], time_s, displacement_mm, v
         raise ValueError(f"time, displacement and velocity must be 1-D arrays of equal length, "
                          f"got shapes {t.shape}, {x.shape}, {v.shape}")
     state_x = float(x[0])
-    state = core.initial_state(p, state_x)
+    state = bushing.initial_state(constants, state_x)
     forces = np.empty_like(t)
-    forces[0] = core.force(state, state_x, v[0], p)
+    forces[0] = bushing.force(constants, state, state_x, v[0])
     for k in range(t.size - 1):
         x_k, v_k = float(x[k]), float(v[k])
         h = (float(t[k + 1]) - float(t[k])) / substeps_per_sample
         for i in range(substeps_per_sample):
-            state, _ = core.advance(compiled, state, state_x, x_k + v_k * h * i, v_k, h)
+            state, _ = advance(bushing, constants, state, state_x, x_k + v_k * h * i, v_k, h)
             state_x = x_k + v_k * h * (i + 1)
-        forces[k + 1] = core.force(state, state_x, v_k, p)
-    return forces + bushing.force_offset(values)
+        forces[k + 1] = bushing.force(constants, state, state_x, v_k)
+    return forces

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from conftest import paper_parameters
-from fmu_src.bushing_params import PARAMETER_NAMES
+from fmu_src.proposed_model import PARAMETER_NAMES
 from identification.compiled_core import simulate_population_held
 from identification.protocols import Random, Sine, sample_times
 from test_fmu_numerics import simulate_with_fmpy
@@ -48,17 +48,30 @@ def test_parameter_matrix_rejects_wrong_shapes():
         simulate_population_held(np.ones((3, 5)), np.arange(3.0), np.zeros(3), np.zeros(3))
 
 
-def test_compiled_forces_equal_the_python_core_on_a_random_population():
+def random_population(model: str, count: int, seed: int):
+    """``count`` sets of ``model``: its default set with each value scaled by 0.7-1.3."""
+    from fmu_src.bushing_models import get_model
+    from fmu_src.parameter_files import read_parameter_set
+    from conftest import REPO
+    bushing = get_model(model)
+    default = read_parameter_set(REPO / "data" / bushing.default_file, model).parameters
+    base = np.array([default[name] for name in bushing.parameter_names])
+    return bushing.parameter_names, base * np.random.default_rng(seed).uniform(0.7, 1.3, (count, base.size))
+
+
+@pytest.mark.parametrize("model", ["proposed", "spencer", "bouc_wen", "kelvin_voigt"])
+def test_compiled_forces_equal_the_python_kernels_bitwise_for_every_model(model):
+    # One definition, two paths: the FMU's plain-Python kernels (tests/python_core.py steps them
+    # as the FMU does) and their numba-compiled copies must give the same floats.
     from python_core import simulate_python_core
-    rng = np.random.default_rng(2)
-    base = np.array([paper_parameters("table5")[name] for name in PARAMETER_NAMES])
-    matrix = base * rng.uniform(0.7, 1.3, (40, len(PARAMETER_NAMES)))
+    names, matrix = random_population(model, 40 if model == "proposed" else 12, 2)
     t = sample_times(0.3, 1000.0)
-    x, v = Sine(2.0, 10.0).signals(t)
-    compiled = simulate_population_held(matrix, t, x, v)
+    x, v = Random(2.0, 0.3, seed=5).signals(t)
+    x = x + 0.01 * np.sin(2 * np.pi * 50 * t)       # off the held path: a displacement jump at every step
+    compiled = simulate_population_held(matrix, t, x, v, model=model)
     for row, forces in zip(matrix, compiled):
-        python = simulate_python_core(dict(zip(PARAMETER_NAMES, row)), t, x, v)
-        np.testing.assert_allclose(forces, python, rtol=1e-9, atol=1e-9 * np.max(np.abs(python)))
+        python = simulate_python_core(dict(zip(names, row)), t, x, v, model=model)
+        np.testing.assert_array_equal(forces, python)
 
 
 CACHE_PROBE = """
@@ -66,8 +79,9 @@ import numpy as np
 from identification import compiled_core
 t = np.linspace(0.0, 0.02, 21)
 compiled_core.simulate_population_held([dict(zip(compiled_core.PARAMETER_NAMES, [1.0] * 16))], t, t, np.ones_like(t))
-stats = compiled_core._simulate_population.stats
-print(compiled_core._compiled.__file__, len(stats.cache_hits), len(stats.cache_misses))
+module = compiled_core.compiled_model("proposed")
+stats = module._simulate_population.stats
+print(module.__file__, len(stats.cache_hits), len(stats.cache_misses))
 """
 
 
@@ -92,14 +106,21 @@ def test_the_compiled_model_is_cached_on_disk_for_the_next_process(tmp_path):
     assert run_cache_probe(tmp_path) == (path, 1, 0)   # ... the next one loads the machine code
 
 
-def test_the_cached_module_is_named_after_its_content_so_a_changed_core_compiles_afresh():
+def test_the_cached_module_is_named_after_its_content_so_a_changed_model_compiles_afresh():
     # numba checks only the time stamp of a kernel's own file: the name must change with the
-    # source of everything compiled into it (the core and the population loop).
+    # source of everything compiled into it (the model, the shared machinery, the loop).
     import hashlib
     import inspect
-    from fmu_src import bushing_core
+    import sys
+    from fmu_src import integration, spencer_model
     from identification import compiled_core
-    source = open(compiled_core._compiled.__file__).read()
-    assert inspect.getsource(bushing_core) in source
+    module = compiled_core.compiled_model("spencer")
+    source = open(module.__file__).read()
+    assert inspect.getsource(spencer_model.integrate) in source
     assert inspect.getsource(compiled_core._population_forces) in source
-    assert compiled_core._compiled.__name__ == f"bushing_compiled_{hashlib.sha256(source.encode()).hexdigest()[:16]}"
+    assert module.__name__ == f"bushing_spencer_{hashlib.sha256(source.encode()).hexdigest()[:16]}"
+    machinery_name = next(name for name in sys.modules if name.startswith("bushing_integration_"))
+    machinery_source = open(sys.modules[machinery_name].__file__).read()
+    assert inspect.getsource(integration) in machinery_source
+    assert machinery_name == f"bushing_integration_{hashlib.sha256(machinery_source.encode()).hexdigest()[:16]}"
+    assert f"from {machinery_name} import" in source       # a changed machinery renames the model's module too

@@ -231,7 +231,7 @@ def test_a_fit_stuck_on_the_box_says_where():
     # bushing with n2 = 1.14): the best fit that the box allows sits on its bound, and the
     # warning names the coordinate instead of blaming the model.
     from fmu_src.bushing_models import get_model
-    from fmu_src.bushing_params import PARAMETER_NAMES
+    from fmu_src.proposed_model import PARAMETER_NAMES
     from fmu_src.parameter_files import ParameterSet
     from identification.fitting import FitResult, TestFit
     from identification.noise import estimate_noise

@@ -5,7 +5,7 @@ from fmpy import read_model_description
 from fmpy.validation import validate_fmu
 
 from conftest import paper_parameters
-from fmu_src.bushing_params import PARAMETER_NAMES, PARAMETER_UNITS
+from fmu_src.proposed_model import PARAMETER_NAMES, PARAMETER_UNITS
 
 
 def test_fmpy_validation_finds_no_problem(fmu_path):

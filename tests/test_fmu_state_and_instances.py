@@ -63,17 +63,18 @@ def test_tunable_parameter_change_continues_from_the_current_state(fmu_path):
     fmu.free()
 
     # Reference: the core with Table 5 for 50 steps, then Table 2 from that state.
-    from fmu_src import bushing_core as core
+    from fmu_src.integration import advance
+    from fmu_src.proposed_model import MODEL
     table5 = paper_parameters("table5")
     t = sample_times(0.1, 1000.0)
     x, v = SINE.signals(t)
-    state, state_x = core.initial_state(table5, 0.0), 0.0
+    state, state_x = MODEL.initial_state(MODEL.constants(table5), 0.0), 0.0
     for k in range(100):
-        params = table5 if k < 50 else table2
-        state, _ = core.advance(core.compile_model(params), state, state_x, x[k], v[k], STEP)
+        constants = MODEL.constants(table5 if k < 50 else table2)
+        state, _ = advance(MODEL, constants, state, state_x, x[k], v[k], STEP)
         state_x = x[k] + v[k] * STEP
         if k >= 50:
-            assert after_change[k - 50] == pytest.approx(core.force(state, state_x, v[k], table2), rel=1e-12)
+            assert after_change[k - 50] == pytest.approx(MODEL.force(constants, state, state_x, v[k]), rel=1e-12)
 
 
 def test_instances_with_different_parameters_stay_independent(fmu_path):

@@ -48,7 +48,7 @@ def test_converges_as_the_communication_step_shrinks():
     errors = [np.sqrt(np.mean((simulate(params, t, displacement(t), velocity(t), steps_per_sample=m) - fine) ** 2))
               for m in (2, 4, 8)]
     # measured 1.50, 0.54, 0.38 N: the input path's error falls ~3x per halving until the
-    # core's own substep error (bushing_core.THETA) is what remains
+    # model's own substep error (integration.THETA) is what remains
     assert errors[0] > errors[1] > errors[2] and errors[2] < errors[0] / 3, errors
 
 

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from conftest import DATA, paper_parameters
-from fmu_src.bushing_params import PARAMETER_NAMES, ParameterError
+from fmu_src.bushing_params import ParameterError
+from fmu_src.proposed_model import PARAMETER_NAMES
 from fmu_src.parameter_files import load_parameters, save_parameters
 from identification.compiled_core import simulate_population_held
 from fmu_src.bushing_models import MODELS

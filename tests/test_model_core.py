@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 from conftest import paper_eq5, paper_equations, paper_parameters, reference_force, reference_jump
-from fmu_src import bushing_core as core
+from fmu_src.integration import StepError, advance, apply_displacement_jump
+from fmu_src.proposed_model import MODEL as PROPOSED
 from fmu_src.bushing_models import MODELS
 from fmu_src.bushing_params import ParameterError
 from identification.protocols import Random, Sine, Step, sample_times
@@ -66,12 +67,13 @@ def test_without_hysteresis_steady_sine_converges_to_analytic_complex_stiffness(
 def test_initial_state_is_relaxed_equilibrium_with_static_stiffness():
     params = paper_parameters("table5")
     x0 = 1.5
-    state = core.initial_state(params, x0)
+    constants = PROPOSED.constants(params)
+    state = PROPOSED.initial_state(constants, x0)
     static_stiffness = params["k0"] * params["k1"] / (params["k0"] + params["k1"])
-    assert core.force(state, x0, 0.0, params) == pytest.approx(static_stiffness * x0, rel=1e-12)
+    assert PROPOSED.force(constants, state, x0, 0.0) == pytest.approx(static_stiffness * x0, rel=1e-12)
     assert paper_equations(0.0, state, params, lambda t: x0, lambda t: 0.0) == pytest.approx([0, 0, 0, 0], abs=1e-9)
-    held, _ = core.advance(core.compile_model(params), state, x0, x0, 0.0, 5.0)
-    assert core.force(held, x0, 0.0, params) == pytest.approx(static_stiffness * x0, rel=1e-12)
+    held, _ = advance(PROPOSED, constants, state, x0, x0, 0.0, 5.0)
+    assert PROPOSED.force(constants, held, x0, 0.0) == pytest.approx(static_stiffness * x0, rel=1e-12)
 
 
 def test_random_input_matches_radau():
@@ -82,26 +84,27 @@ def test_advance_reports_unbounded_growth_and_leaves_input_state():
     # Without the alpha2 feedback and with n2 = 1, dz2/dx = A2 + 3.4/mm * z2 grows like
     # exp(3.4/mm * x): a ramp to 2 m (metres entered where millimetres were meant) overflows.
     params = dict(paper_parameters("table5"), alpha2=0.0, n2=1.0)
-    model = core.compile_model(params)
-    state = core.initial_state(params, 0.0)
-    with pytest.raises(core.StepError, match="units"):
-        core.advance(model, state, 0.0, 0.0, 2000.0 / 0.4, 0.4)
-    assert state == core.initial_state(params, 0.0)
+    constants = PROPOSED.constants(params)
+    state = PROPOSED.initial_state(constants, 0.0)
+    with pytest.raises(StepError, match="units"):
+        advance(PROPOSED, constants, state, 0.0, 0.0, 2000.0 / 0.4, 0.4)
+    assert state == PROPOSED.initial_state(constants, 0.0)
 
 
 def test_paper_tables_saturate_instead_of_overflowing_for_a_2m_stroke():
     # With alpha2 > 0 the growing gain of z2 also raises lam2, so u2 decays and z2 stays
     # finite: the model gives a (physically absurd) finite force, which the FMU flags.
     params = paper_parameters("table5")
-    state, _ = core.advance(core.compile_model(params), core.initial_state(params), 0.0, 0.0, 2000.0 / 0.4, 0.4)
+    constants = PROPOSED.constants(params)
+    state, _ = advance(PROPOSED, constants, PROPOSED.initial_state(constants, 0.0), 0.0, 0.0, 2000.0 / 0.4, 0.4)
     assert all(math.isfinite(value) for value in state)
 
 
 def test_advance_refuses_instead_of_hanging_when_substeps_run_out():
     params = paper_parameters("table5")
-    model = core.compile_model(params)
-    with pytest.raises(core.StepError, match="substeps"):
-        core.advance(model, core.initial_state(params), 0.0, 0.0, 500.0, 0.01, max_substeps=3)
+    constants = PROPOSED.constants(params)
+    with pytest.raises(StepError, match="substeps"):
+        advance(PROPOSED, constants, PROPOSED.initial_state(constants, 0.0), 0.0, 0.0, 500.0, 0.01, max_substeps=3)
 
 
 validate_parameters = MODELS["proposed"].validate
@@ -148,18 +151,18 @@ def test_paper_constraint_violations_are_warnings_not_errors(change, fragment):
 @pytest.mark.parametrize("jump_mm", [0.3, -0.8, 2.5])
 def test_displacement_jump_is_the_limit_of_a_steep_ramp_of_the_papers_equations(jump_mm):
     # The reference is scipy's Radau on the paper's eqs. 1-4 over a 1 ns ramp (conftest), not
-    # the jump map of the core.
+    # the model's jump kernel.
     params = paper_parameters("table5")
-    model = core.compile_model(params)
-    start, _ = core.advance(model, core.initial_state(params), 0.0, 0.0, 50.0, 0.02)  # history; x = 1 mm
-    jumped = core.apply_displacement_jump(model, start, jump_mm)
+    constants = PROPOSED.constants(params)
+    start, _ = advance(PROPOSED, constants, PROPOSED.initial_state(constants, 0.0), 0.0, 0.0, 50.0, 0.02)  # x = 1 mm
+    jumped = apply_displacement_jump(PROPOSED, constants, start, jump_mm)
     reference = reference_jump(params, start, 1.0, jump_mm)
     y, z1, w, z2 = jumped
     assert abs(y - reference[0]) < 1e-5 * abs(jump_mm) and abs(w - reference[2]) < 1e-5 * abs(jump_mm)
     assert abs(z1 - reference[1]) < 1e-5 * max(abs(start[1]), 1.0)        # z1 does not jump
     z2_scale = max(abs(start[3]), abs(reference[3]))  # z2 may pass through zero on the way
     assert abs(z2 - reference[3]) < 3e-4 * z2_scale
-    jump_force = core.force(jumped, 1.0 + jump_mm, 0.0, params)
+    jump_force = PROPOSED.force(constants, jumped, 1.0 + jump_mm, 0.0)
     assert abs(jump_force - paper_eq5(params, reference, 1.0 + jump_mm, 0.0)) < 3e-4 * abs(jump_force)
 
 

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from conftest import paper_parameters
-from fmu_src.bushing_params import PARAMETER_NAMES
+from fmu_src.proposed_model import PARAMETER_NAMES
 from identification.measurements import Measurement
 from identification.protocols import Sine, Step, sample_times
 from identification.search_space import TIME_CONSTANT_FLOOR, SearchSpace, rescale_hysteresis

@@ -1,0 +1,71 @@
+"""The classic single Bouc-Wen element (Ok et al., 2005), Fig. 6 of the paper.
+
+    F = c0*dx/dt + k0*x + alpha*z,   dz/dt = g(z, sgn dx/dt)*dx/dt   (eq. 1's bracket g, the
+    paper's beta and gamma)
+
+Units N-mm-s: z is a force in N, alpha dimensionless, A in N/mm. The state is ``(z,)``.
+
+The element is driven by the displacement itself, so within a step (dx/dt = v constant) z
+depends on time only through x: a step is the walk of z along v*h (``integration``), in RK4
+pieces over each of which g changes by at most ``integration.THETA``; no time stiffness.
+"""
+from __future__ import annotations
+
+import math
+
+from .bushing_params import DAMPING, EXPONENT, GAIN, SPRING, WEIGHT, ParameterSpec
+from .integration import DEFAULT_MAX_SUBSTEPS, HEUN_JUMP_LIMIT, NOT_FINITE, OK, THETA, THETA_JUMP, walk_along_xi
+from .model_definition import BushingModel, StateSpec
+from .spencer_model import single_block_checks
+
+PARAMETER_SPECS = (
+    ParameterSpec("c0", "N.s/mm", "viscous damping in parallel", **DAMPING),
+    ParameterSpec("k0", "N/mm", "linear stiffness in parallel", **SPRING),
+    ParameterSpec("alpha", "1", "weight of the hysteretic force z", **WEIGHT),
+    ParameterSpec("A", "N/mm", "Bouc-Wen initial stiffness", **GAIN),
+    ParameterSpec("beta", "N^(1-n)/mm", "Bouc-Wen shape parameter on |u|*z*|z|^(n-1) (as in eq. 1)"),
+    ParameterSpec("gamma", "N^(1-n)/mm", "Bouc-Wen shape parameter on u*|z|^n (as in eq. 1)"),
+    ParameterSpec("n", "1", "Bouc-Wen exponent", **EXPONENT),
+)
+KERNELS = ("prepare", "initial_state", "jump", "integrate", "force")
+
+
+# ---------------------------------------------------------------------------- kernels
+def prepare(p):
+    """The 7 values in ``PARAMETER_SPECS`` order, as they are."""
+    c0, k0, alpha, A, beta, gamma, n = p
+    return (c0, k0, alpha, A, beta, gamma, n)
+
+
+def initial_state(m, x0):
+    """Virgin hysteresis: z = 0 (F = k0*x0 at rest)."""
+    return (0.0,)
+
+
+def force(m, state, x, v):
+    """F = c0*v + k0*x + alpha*z [N]."""
+    c0, k0, alpha, A, beta, gamma, n = m
+    return c0 * v + k0 * x + alpha * state[0]
+
+
+def jump(m, state, jump_mm):
+    """z walks along the jump."""
+    c0, k0, alpha, A, beta, gamma, n = m
+    z, status = walk_along_xi(state[0], jump_mm, A, beta, gamma, n, HEUN_JUMP_LIMIT, THETA_JUMP,
+                              DEFAULT_MAX_SUBSTEPS)
+    return (z,), status
+
+
+def integrate(m, state, x, v, h, max_substeps):
+    """z walks along v*h; returns (state, 1, status)."""
+    c0, k0, alpha, A, beta, gamma, n = m
+    z, status = walk_along_xi(state[0], v * h, A, beta, gamma, n, 0.0, THETA, max_substeps)
+    if status == OK and not math.isfinite(z):
+        status = NOT_FINITE
+    return (z,), 1, status
+
+
+MODEL = BushingModel(
+    "bouc_wen", "SingleBoucWenBushing", "single Bouc-Wen", PARAMETER_SPECS,
+    (StateSpec("z", 0, "N", "hysteretic force"),), "params_bouc_wen_fit_synthetic_table5.json",
+    prepare, initial_state, jump, integrate, force, further_checks=single_block_checks)

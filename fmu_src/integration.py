@@ -1,0 +1,265 @@
+"""Integration machinery shared by the bushing models: no model's equations live here.
+
+A model (``proposed_model``, ``spencer_model``, ``bouc_wen_model``, ``kelvin_voigt_model``)
+writes its equations as five kernels and uses the pieces below to step them:
+
+- a Bouc-Wen block in the form the models share. Where a Bouc-Wen element (eq. 1 or 2 of the
+  paper) sits in series with a dashpot c and a spring K, and the displacement's velocity v is
+  constant over a step, the block is an autonomous two-state system in the element's relative
+  velocity u and its hysteretic force z:
+
+      du/dt = a - lam*u,   lam = (K + alpha*g)/c,   dz/dt = g(z, sgn u)*u,
+      g = A - (gamma + beta*sgn(u)*sgn(z))*|z|^n     (the bracket of eqs. 1-2, N/mm)
+
+  (``a`` is the drive of the linear part, constant over the step). All stiffness sits in the
+  linear decay of u, which is propagated exactly for a frozen lam (an exponential integrator:
+  stable for any lam*h). Because z depends on time only through xi = integral of u, z follows
+  the scalar autonomous ODE dz/dxi = g(z, sgn u), advanced with classical RK4 in xi. lam is
+  then re-evaluated with the mean gain over the substep and the substep repeated once (second
+  order in the coupling), or, where that changes xi by under 1 %, z extended by one Taylor
+  step. A substep is split where u crosses zero, so each part stays on one branch of sgn().
+  ``block_step`` advances a block; ``substeps_needed`` chooses substeps a priori so that g and
+  lam change by at most ``THETA`` over each (there is no fixed time limit: the linear part is
+  exact).
+- a walk of z along a given relative displacement xi (``walk_along_xi``): a displacement jump
+  (an impulse in dx/dt) moves z that way, and so does a step of a Bouc-Wen element driven
+  directly by the displacement.
+- the driver ``advance``: a model's jump and integration kernels for one communication step,
+  their status codes turned into ``StepError`` with a message naming the inputs (the FMU's
+  error policy lives in ``bushing_slave``; this is where the step's failures are worded).
+
+Kernels are plain float arithmetic that raise nothing and report errors as status codes (OK,
+TOO_MANY_SUBSTEPS, NOT_FINITE), so that the identification compiles these same functions with
+numba (``identification/compiled_core.py``); ``KERNELS`` lists the ones compiled.
+
+Units (the paper's): displacements in mm, velocities in mm/s, hysteretic forces in N, time in s.
+"""
+from __future__ import annotations
+
+import math
+
+THETA = 0.35
+"""Largest relative change of the Bouc-Wen gain g (and of lam) allowed within one substep.
+Measured against Radau at 1 ms steps (tests/test_model_core.py): the force error stays below
+5e-4 of its peak for the paper's tables, c1 = 0.01 and a 30 Hz, 3 mm sine; 0.5 would give 5e-3."""
+
+THETA_JUMP = 0.1
+"""The same bound for the RK4 pieces of a walk along xi: jumps are rare (small ones take a Heun
+step), so they can afford the tighter bound; a 2.5 mm jump is then exact to 1e-5."""
+
+HEUN_JUMP_LIMIT = 0.05
+"""A walk over which g changes by less than this fraction takes one Heun step (local error
+~HEUN_JUMP_LIMIT^2/12 = 2e-4 of the walk's own, O(h^2) small, increment of z)."""
+
+DEFAULT_MAX_SUBSTEPS = 20000
+"""Substeps allowed per call of :func:`advance` before it gives up (guards against hangs)."""
+
+OK, TOO_MANY_SUBSTEPS, NOT_FINITE = 0, 1, 2
+"""Status codes of the kernels."""
+
+KERNELS = ("decay_factors", "rk4_in_xi", "block_segment", "block_step", "gain_variation", "substeps_needed",
+           "walk_along_xi")
+"""The functions of this module that the identification compiles with numba."""
+
+
+class StepError(ArithmeticError):
+    """The step cannot be computed (overflow, non-finite result, too many substeps)."""
+
+
+def hysteretic_gain(z: float, u: float, A: float, beta: float, gamma: float, n: float) -> float:
+    """The bracket of eqs. 1-2: A - (gamma + beta*sgn(u)*sgn(z))*|z|^n  [N/mm]."""
+    return A - (gamma + beta * _sign(u) * _sign(z)) * abs(z) ** n
+
+
+def _sign(value: float) -> float:
+    return 1.0 if value > 0.0 else (-1.0 if value < 0.0 else 0.0)
+
+
+def decay_factors(x: float) -> tuple[float, float, float]:
+    """E = exp(-x), phi1 = (1 - E)/x, phi2 = (x - 1 + E)/x^2, accurate also near x = 0."""
+    if -1e-3 < x < 1e-3:
+        return 1.0 - x + 0.5 * x * x, 1.0 - 0.5 * x + x * x / 6.0, 0.5 - x / 6.0 + x * x / 24.0
+    E = math.exp(-x)
+    phi1 = (1.0 - E) / x
+    return E, phi1, (1.0 - phi1) / x
+
+
+def rk4_in_xi(z: float, dxi: float, A: float, cpos: float, cneg: float, n: float) -> float:
+    """Classical RK4 for dz/dxi = A - c*|z|^n with c = cpos for z > 0 and cneg for z < 0."""
+    k1 = A - (cpos * z ** n if z > 0.0 else cneg * (-z) ** n)
+    zt = z + 0.5 * dxi * k1
+    k2 = A - (cpos * zt ** n if zt > 0.0 else cneg * (-zt) ** n)
+    zt = z + 0.5 * dxi * k2
+    k3 = A - (cpos * zt ** n if zt > 0.0 else cneg * (-zt) ** n)
+    zt = z + dxi * k3
+    k4 = A - (cpos * zt ** n if zt > 0.0 else cneg * (-zt) ** n)
+    return z + dxi * (k1 + 2.0 * (k2 + k3) + k4) / 6.0
+
+
+def block_segment(u0, z0, h, a, blk, sigma):
+    """Advance (u, z) of a block by h on the branch sgn(u) = sigma; returns (u, z, xi).
+
+    ``blk`` = (K, alpha, c, A, beta, gamma, n): the block's constants (module docstring)."""
+    K, alpha, c, A, beta, gamma, n = blk
+    cpos = gamma + beta * sigma
+    cneg = gamma - beta * sigma
+    g0 = A - (cpos * z0 ** n if z0 > 0.0 else cneg * (-z0) ** n)
+    lam = (K + alpha * g0) / c
+    E, phi1, phi2 = decay_factors(lam * h)
+    xi = h * (u0 * phi1 + a * h * phi2)
+    if xi == 0.0:
+        return u0 * E + a * h * phi1, z0, 0.0
+    z1 = rk4_in_xi(z0, xi, A, cpos, cneg, n)
+    # lam with the mean gain over the substep; xi changes by O(h^2), so one repeat suffices.
+    lam = (K + alpha * (z1 - z0) / xi) / c
+    E, phi1, phi2 = decay_factors(lam * h)
+    corrected = h * (u0 * phi1 + a * h * phi2)
+    if abs(corrected - xi) <= 0.01 * abs(xi):
+        # A small correction (always so when lam*h << 1): one Taylor step from the end of the
+        # RK4 path; its error, (1/2)*THETA*(dxi/xi)^2 of the substep's dz, is below 2e-5.
+        z1 = z1 + (A - (cpos * z1 ** n if z1 > 0.0 else cneg * (-z1) ** n)) * (corrected - xi)
+    else:
+        z1 = rk4_in_xi(z0, corrected, A, cpos, cneg, n)
+    return u0 * E + a * h * phi1, z1, corrected
+
+
+def block_step(u0, z0, h, a, blk):
+    """Advance a block by h, splitting the substep where u changes sign; returns (u, z, xi)."""
+    if u0 == 0.0:
+        if a == 0.0:
+            return 0.0, z0, 0.0
+        return block_segment(u0, z0, h, a, blk, 1.0 if a > 0.0 else -1.0)
+    sigma = 1.0 if u0 > 0.0 else -1.0
+    if a * u0 < 0.0:
+        K, alpha, c, A, beta, gamma, n = blk
+        cz = (gamma + beta * sigma) if z0 > 0.0 else (gamma - beta * sigma)
+        lam = (K + alpha * (A - cz * abs(z0) ** n)) / c
+        if lam > 0.0:
+            u_target = a / lam
+            t_cross = -math.log(u_target / (u_target - u0)) / lam
+            if t_cross < h:
+                _, z_mid, xi_a = block_segment(u0, z0, t_cross, a, blk, sigma)
+                u1, z1, xi_b = block_segment(0.0, z_mid, h - t_cross, a, blk, -sigma)
+                return u1, z1, xi_a + xi_b
+    return block_segment(u0, z0, h, a, blk, sigma)
+
+
+def gain_variation(z0, g0, z_pred, A, cpos, cneg, n):
+    """Gain at z_pred and how much g varies on the way from z0; returns (g_pred, dg, crosses).
+
+    g has a cusp at z = 0 (g = A there): where z changes sign, the variation is measured
+    through it, which the secant from g0 to g_pred can miss entirely.
+    """
+    g_pred = A - (cpos * z_pred ** n if z_pred > 0.0 else cneg * (-z_pred) ** n)
+    crosses_zero = (z_pred > 0.0) != (z0 > 0.0)
+    dg = abs(g0 - A) + abs(g_pred - A) if crosses_zero else abs(g_pred - g0)
+    return g_pred, dg, crosses_zero
+
+
+def substeps_needed(u0, z0, T, a, blk):
+    """Substeps so that g and lam of a block change by at most THETA (relative) over each,
+    predicted from the start of the remaining interval T."""
+    K, alpha, c, A, beta, gamma, n = blk
+    rate = u0
+    if a * u0 <= 0.0 and a != 0.0:
+        # u heads towards a/lam, possibly across zero: bound the travel by the larger speed.
+        sigma = 1.0 if a > 0.0 else -1.0
+    else:
+        sigma = 1.0 if u0 >= 0.0 else -1.0
+    cpos = gamma + beta * sigma
+    cneg = gamma - beta * sigma
+    g0 = A - (cpos * z0 ** n if z0 > 0.0 else cneg * (-z0) ** n)
+    lam_c = K + alpha * g0
+    if a != 0.0 and lam_c > 0.0:
+        target = a * c / lam_c
+        if abs(target) > abs(rate):
+            rate = target
+    _, dg, _ = gain_variation(z0, g0, z0 + g0 * rate * T, A, cpos, cneg, n)
+    if dg == 0.0:
+        return 1
+    rel = dg / abs(g0) if g0 != 0.0 else math.inf
+    rel_lam = abs(alpha) * dg / (abs(lam_c) + c / T)
+    worst = rel if rel > rel_lam else rel_lam
+    if worst <= THETA:
+        return 1
+    if worst == math.inf or worst > 1e9:
+        return 1_000_000_000
+    return int(math.ceil(worst / THETA))
+
+
+def walk_along_xi(z, xi_total, A, beta, gamma, n, heun_limit, theta, max_pieces):
+    """z after the relative displacement ``xi_total`` [mm] of a Bouc-Wen element (dz/dxi =
+    g(z, sgn xi), the branch fixed by the sign of xi); returns (z, status).
+
+    Pieces are chosen so that g changes by at most ``theta`` over each (RK4 on each); a walk
+    over which g changes by less than ``heun_limit`` takes one Heun step instead. At most
+    ``max_pieces`` solves (TOO_MANY_SUBSTEPS beyond)."""
+    sigma = 1.0 if xi_total > 0.0 else -1.0
+    cpos = gamma + beta * sigma
+    cneg = gamma - beta * sigma
+    remaining = xi_total
+    for _ in range(max_pieces):
+        # The a-priori rule of the time steps: bound the change of g per piece.
+        g0 = A - (cpos * z ** n if z > 0.0 else cneg * (-z) ** n)
+        g_pred, dg, crosses_zero = gain_variation(z, g0, z + g0 * remaining, A, cpos, cneg, n)
+        if not crosses_zero and dg <= heun_limit * abs(g0):
+            # The usual case of a jump, O(h^2) from a master that passes the instantaneous
+            # velocity: Heun's step from the two gains just computed.
+            z = z + 0.5 * remaining * (g0 + g_pred)
+            break
+        allowed = theta * abs(g0)
+        pieces = 1 if dg <= allowed else min(int(math.ceil(dg / (allowed + 1e-300))), 1000)
+        piece = remaining / pieces
+        z = rk4_in_xi(z, piece, A, cpos, cneg, n)
+        remaining -= piece
+        if pieces == 1:
+            break
+    else:
+        return z, TOO_MANY_SUBSTEPS
+    return z, OK
+
+
+# ---------------------------------------------------------------------------- the driver
+def advance(model, constants, state, state_x: float, x: float, v: float, h: float,
+            max_substeps: int = DEFAULT_MAX_SUBSTEPS) -> tuple[tuple, int]:
+    """One step of ``model`` (a ``model_definition.BushingModel``): displacement x + v*t [mm]
+    for 0 <= t <= h [s], h > 0, from ``state`` (valid at displacement ``state_x`` [mm]; where
+    the step starts elsewhere, the difference is applied first as a displacement jump).
+    ``constants``: ``model.prepare`` of its parameters. Returns the state valid at x + v*h and
+    the substeps used. Raises StepError if the result would overflow or is not finite, or if
+    more than ``max_substeps`` are needed; ``state`` (a tuple) is never modified."""
+    try:
+        status, new = OK, state
+        if x != state_x:
+            new, status = model.jump(constants, new, x - state_x)
+        used = 0
+        if status == OK:
+            new, used, status = model.integrate(constants, new, x, v, h, max_substeps)
+    except (OverflowError, ZeroDivisionError, ValueError) as exc:
+        raise StepError(f"the step overflowed ({exc}) at x = {x:g} mm, v = {v:g} mm/s, "
+                        f"state = {tuple(state)}; check the units of the inputs "
+                        "(the FMU takes metres and m/s) and the parameters") from None
+    if status == TOO_MANY_SUBSTEPS:
+        raise StepError(f"the step of {h:g} s would need more than {max_substeps} substeps "
+                        f"(x = {x:g} mm, v = {v:g} mm/s); check the units of the inputs "
+                        "(the FMU takes metres and m/s) or shorten the communication step")
+    if status == NOT_FINITE:
+        raise StepError(f"the step gave a non-finite state {tuple(new)} at x = {x:g} mm, "
+                        f"v = {v:g} mm/s; check the units of the inputs (the FMU takes metres "
+                        "and m/s) and the parameters")
+    return new, used
+
+
+def apply_displacement_jump(model, constants, state, jump_mm: float) -> tuple:
+    """``model``'s response to an instantaneous displacement jump [mm] (an impulse in dx/dt).
+
+    A master that sets x_{k+1} different from x_k + v_k*h (e.g. the instantaneous velocity
+    instead of the mean over the step) makes such a jump at every step; treating it as a
+    displacement of the whole model, not of its springs alone, keeps dx/dt = v consistent."""
+    if jump_mm == 0.0:
+        return tuple(state)
+    new, status = model.jump(constants, state, jump_mm)
+    if status != OK:
+        raise StepError(f"a displacement jump of {jump_mm:g} mm needs too many substeps; "
+                        "check the units of the inputs (the FMU takes metres)")
+    return new

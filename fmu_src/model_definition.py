@@ -1,0 +1,122 @@
+"""What a bushing model is: ``BushingModel``, the one definition that the FMU, the compiled path
+of the identification and the tests all read.
+
+A model module (``proposed_model`` and its siblings) gives its names, units, bounds and
+meanings (``ParameterSpec``), its internal states (``StateSpec``), the checks beyond each
+value's range, its default parameter file, and its equations as five kernels:
+
+    prepare(p) -> constants               p: the parameter values, a tuple in ``specs`` order
+    initial_state(constants, x0) -> state     relaxed equilibrium at displacement x0 [mm]
+    jump(constants, state, jump_mm) -> (state, status)
+    integrate(constants, state, x, v, h, max_substeps) -> (state, substeps, status)
+    force(constants, state, x, v) -> F [N]
+
+A state is a tuple of floats (``states`` names them, in order; empty for a model without
+state). Over a step the displacement is x + v*t [mm] for 0 <= t <= h [s] with v [mm/s]
+constant; ``jump`` is the model's exact response to an instantaneous displacement jump, and
+``force`` is the force at displacement x with velocity v, positive for positive x.
+Kernels are plain float arithmetic that raise nothing and return status codes
+(``integration.OK`` ...), so that ``identification/compiled_core.py`` compiles the same
+source with numba; ``KERNELS`` of the module lists every function it must compile (the
+five and their helpers). The shared machinery they step with is ``integration``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable, Mapping
+
+from .bushing_params import ParameterError, ParameterSpec, number_errors, range_errors
+
+PLAUSIBLE_TRAVEL_MM = 100.0
+PLAUSIBLE_VELOCITY_MM_S = 1000.0
+"""Beyond a rubber bushing's travel and speed in service: the FMU warns above them (most likely
+millimetres entered where metres are expected), and :meth:`BushingModel.plausible_force_bound`
+is the force there."""
+
+
+@dataclass(frozen=True)
+class StateSpec:
+    """An internal state exposed by the FMU: entry ``index`` of the model's state tuple."""
+    name: str
+    index: int
+    unit: str      # "N" or "m" at the FMU (the kernels work in mm)
+    meaning: str
+
+
+def _no_further_check(p: Mapping[str, float]) -> tuple[list[str], list[str]]:
+    return [], []
+
+
+@dataclass(frozen=True)
+class BushingModel:
+    name: str                    # command-line name: proposed, spencer, bouc_wen, kelvin_voigt
+    identifier: str              # FMI modelIdentifier and the "model" of parameter files
+    title: str
+    specs: tuple[ParameterSpec, ...]
+    states: tuple[StateSpec, ...]
+    default_file: str            # parameter set in data/ used as the FMU's defaults
+    prepare: Callable
+    initial_state: Callable
+    jump: Callable
+    integrate: Callable
+    force: Callable
+    further_checks: Callable[[Mapping[str, float]], tuple[list[str], list[str]]] = _no_further_check
+    """(errors, warnings) beyond each value's range, for a complete set of finite floats."""
+    force_offset: Callable[[Mapping[str, float]], float] = lambda p: 0.0
+    """The part of the force [N] that is constant (a preload): counted in the plausible bound."""
+
+    @property
+    def parameter_names(self) -> tuple[str, ...]:
+        return tuple(spec.name for spec in self.specs)
+
+    @property
+    def units(self) -> dict[str, str]:
+        return {spec.name: spec.unit for spec in self.specs}
+
+    @property
+    def kernel_module(self) -> str:
+        """The module whose source defines the kernels (what the compiled path compiles)."""
+        return self.integrate.__module__
+
+    def validate(self, params: Mapping[str, float]) -> tuple[list[str], list[str]]:
+        """(errors, warnings) for a parameter set of this model, never raising. Errors make it
+        unusable (missing, non-numbers, NaN, what the equations cannot take); warnings are
+        physically doubtful but simulable values."""
+        errors = number_errors(params, self.units, f" of the {self.name} model")
+        if errors:
+            return errors, []
+        values = {name: float(params[name]) for name in self.parameter_names}
+        errors, warnings = self.further_checks(values)
+        return range_errors(values, self.specs) + errors, warnings
+
+    def check(self, params: Mapping[str, float]) -> dict[str, float]:
+        """The parameters as floats in spec order, or ParameterError listing every problem
+        (unknown names included)."""
+        errors, _ = self.validate(params)
+        unknown = sorted(set(params) - set(self.parameter_names))
+        if unknown:
+            errors.append(f"unknown parameter names {unknown} for the {self.name} model; "
+                          f"allowed: {', '.join(self.parameter_names)}")
+        if errors:
+            raise ParameterError(f"invalid {self.name} parameters: " + "; ".join(errors))
+        return {name: float(params[name]) for name in self.parameter_names}
+
+    def values(self, params: Mapping[str, float]) -> tuple[float, ...]:
+        """The values in spec order, the ``p`` of :meth:`prepare` (no validation)."""
+        return tuple(float(params[name]) for name in self.parameter_names)
+
+    def constants(self, params: Mapping[str, float]):
+        """``prepare`` of a parameter mapping."""
+        return self.prepare(self.values(params))
+
+    def plausible_force_bound(self, params: Mapping[str, float]) -> float:
+        """A force [N] no bushing with these parameters should reach in service: every spring
+        and Bouc-Wen gain of the model (A weighted by its alpha) and every dashpot in parallel,
+        at PLAUSIBLE_TRAVEL_MM and PLAUSIBLE_VELOCITY_MM_S, plus the constant force. Above it
+        the inputs are most likely in the wrong units (millimetres in the metre port)."""
+        def weight(name):   # a Bouc-Wen gain A<i> counts with its alpha<i>
+            return abs(params.get("alpha" + name[1:], 1.0)) if name.startswith("A") else 1.0
+        stiffness = sum(abs(params[s.name]) * weight(s.name) for s in self.specs if s.unit == "N/mm")
+        damping = sum(abs(params[s.name]) for s in self.specs if s.unit == "N.s/mm")
+        return (stiffness * PLAUSIBLE_TRAVEL_MM + damping * PLAUSIBLE_VELOCITY_MM_S
+                + abs(self.force_offset(params)))

@@ -1,0 +1,183 @@
+"""The proposed bushing model of the paper: eqs. 1-5, 16 parameters. No FMI code here.
+
+    dz1/dt = g1*(dx/dt - dy/dt),  dz2/dt = g2*(dx/dt - dw/dt)                       (eqs. 1-2)
+    g_i = A_i - (gamma_i + beta_i*sgn(u_i)*sgn(z_i))*|z_i|^n_i
+    c1*(dx/dt - dy/dt) + k1*(x - y) - k0*y + alpha1*z1 = 0                          (eq. 3)
+    (c0 + c2)*dw/dt = c2*dx/dt + k2*(x - w) + alpha2*z2                              (eq. 4)
+    F = k0*y + c0*dw/dt                                                              (eq. 5)
+
+Units (the paper's): displacements x, y, w in mm, velocities in mm/s, hysteretic forces
+z1, z2 and the bushing force F in N, time in s; parameters in N-mm-s units (below), so that
+the paper's tables can be typed in verbatim. The state is ``(y, z1, w, z2)``.
+
+How it is stepped (``integration``). With dx/dt = v constant over a step, each Bouc-Wen block
+is the shared block form in its relative velocity u and hysteretic force z
+(differentiate eqs. 3-4 and substitute eqs. 1-2):
+
+    block 1:  u1 = v - dy/dt,  du1/dt = k0*v/c1 - lam1*u1,  lam1 = (k0 + k1 + alpha1*g1)/c1
+    block 2:  u2 = v - dw/dt,  du2/dt = -lam2*u2,           lam2 = (k2 + alpha2*g2)/(c0 + c2)
+
+The equations are stiff (with Table 5 the y-z1 mode decays at ~5000 1/s, and at ~5e5 1/s for
+c1 = 0.01, while w relaxes over ~50 s) and non-smooth; the shared exponential step is stable
+for any stiffness. y is recovered from the invariant c1*u1 = -(k1*(x - y) - k0*y + alpha1*z1),
+w by integrating dw/dt = v - u2.
+"""
+from __future__ import annotations
+
+import math
+from typing import Mapping
+
+from .bushing_params import DAMPING, EXPONENT, GAIN, SPRING, WEIGHT, ParameterSpec
+from .integration import (DEFAULT_MAX_SUBSTEPS, HEUN_JUMP_LIMIT, NOT_FINITE, OK, THETA_JUMP, TOO_MANY_SUBSTEPS,
+                          block_step, hysteretic_gain, substeps_needed, walk_along_xi)
+from .model_definition import BushingModel, StateSpec
+
+IDENTIFIER = "BoucWenBushing"
+
+PARAMETER_SPECS: tuple[ParameterSpec, ...] = (
+    ParameterSpec("c0", "N.s/mm", "dashpot in series with the right block; roll-off at low velocity", **DAMPING),
+    ParameterSpec("k0", "N/mm", "spring from the left plate y to ground; main static stiffness", **SPRING),
+    ParameterSpec("c1", "N.s/mm", "dashpot between x and y; relaxation of the impact force",
+                  minimum=0.0, exclusive=True, why="it divides eq. 3"),
+    ParameterSpec("k1", "N/mm", "spring between x and y (standard solid)", **SPRING),
+    ParameterSpec("c2", "N.s/mm", "dashpot between x and w; viscous damping at large velocity", **DAMPING),
+    ParameterSpec("k2", "N/mm", "spring between x and w; stiffness at large velocity", **SPRING),
+    ParameterSpec("alpha1", "1", "weight of the hysteretic force z1 on the left plate", **WEIGHT),
+    ParameterSpec("alpha2", "1", "weight of the hysteretic force z2 on the right plate", **WEIGHT),
+    ParameterSpec("beta1", "N^(1-n1)/mm", "Bouc-Wen shape parameter of z1 (eq. 1)"),
+    ParameterSpec("beta2", "N^(1-n2)/mm", "Bouc-Wen shape parameter of z2 (eq. 2)"),
+    ParameterSpec("gamma1", "N^(1-n1)/mm", "Bouc-Wen shape parameter of z1 (eq. 1)"),
+    ParameterSpec("gamma2", "N^(1-n2)/mm", "Bouc-Wen shape parameter of z2 (eq. 2)"),
+    ParameterSpec("n1", "1", "Bouc-Wen exponent of z1 (smoothness of the transition)", **EXPONENT),
+    ParameterSpec("n2", "1", "Bouc-Wen exponent of z2", **EXPONENT),
+    ParameterSpec("A1", "N/mm", "Bouc-Wen initial stiffness of z1", **GAIN),
+    ParameterSpec("A2", "N/mm", "Bouc-Wen initial stiffness of z2", **GAIN),
+)
+PARAMETER_NAMES: tuple[str, ...] = tuple(spec.name for spec in PARAMETER_SPECS)
+PARAMETER_UNITS: dict[str, str] = {spec.name: spec.unit for spec in PARAMETER_SPECS}
+
+KERNELS = ("prepare", "initial_state", "jump", "integrate", "force")
+
+
+def constraint_checks(p: Mapping[str, float]) -> tuple[list[str], list[str]]:
+    """(errors, warnings) beyond each value's range, for a complete set of finite floats.
+
+    Error: c0 + c2 = 0 (it divides eq. 4). Warnings: the paper's identification constraints
+    (A >= 1, beta >= 0, beta1 + gamma1 > 0, beta2 - gamma2 > 0), which the equations do not
+    need but a fitted bushing should satisfy.
+    """
+    errors: list[str] = []
+    warnings: list[str] = []
+    if not p["c0"] + p["c2"] > 0:
+        errors.append(f"c0 + c2 = {p['c0'] + p['c2']} N.s/mm must be > 0 (it divides eq. 4)")
+    for name in ("A1", "A2"):
+        if p[name] < 1:
+            warnings.append(f"{name} = {p[name]} N/mm violates the paper's constraint {name} >= 1")
+    for name in ("beta1", "beta2"):
+        if p[name] < 0:
+            warnings.append(f"{name} = {p[name]} violates the paper's constraint {name} >= 0")
+    if not p["beta1"] + p["gamma1"] > 0:
+        warnings.append(f"beta1 + gamma1 = {p['beta1'] + p['gamma1']} violates the paper's constraint "
+                        "beta1 + gamma1 > 0")
+    if not p["beta2"] - p["gamma2"] > 0:
+        warnings.append(f"beta2 - gamma2 = {p['beta2'] - p['gamma2']} violates the paper's constraint "
+                        "beta2 - gamma2 > 0")
+    return errors, warnings
+
+
+def rhs(t: float, state, x0: float, v: float, p: Mapping[str, float]) -> list[float]:
+    """Eqs. 1-4 for the input x = x0 + v*t: [dy/dt, dz1/dt, dw/dt, dz2/dt], for scipy's
+    ``solve_ivp`` in references; the kernels below solve the same equations in block form."""
+    y, z1, w, z2 = state
+    x = x0 + v * t
+    dy = (p["c1"] * v + p["k1"] * (x - y) - p["k0"] * y + p["alpha1"] * z1) / p["c1"]
+    dw = (p["c2"] * v + p["k2"] * (x - w) + p["alpha2"] * z2) / (p["c0"] + p["c2"])
+    dz1 = (v - dy) * hysteretic_gain(z1, v - dy, p["A1"], p["beta1"], p["gamma1"], p["n1"])
+    dz2 = (v - dw) * hysteretic_gain(z2, v - dw, p["A2"], p["beta2"], p["gamma2"], p["n2"])
+    return [dy, dz1, dw, dz2]
+
+
+# ---------------------------------------------------------------------------- kernels
+def prepare(p):
+    """Constants of the hot loop from the 16 values in ``PARAMETER_SPECS`` order: (k0, k1, k2,
+    c0, c1, c2, C = c0 + c2, K1 = k0 + k1, alpha1, alpha2, block 1, block 2), each block
+    (K, alpha, c, A, beta, gamma, n) as ``integration`` takes it."""
+    c0, k0, c1, k1, c2, k2, alpha1, alpha2, beta1, beta2, gamma1, gamma2, n1, n2, A1, A2 = p
+    C = c0 + c2
+    K1 = k0 + k1
+    return (k0, k1, k2, c0, c1, c2, C, K1, alpha1, alpha2,
+            (K1, alpha1, c1, A1, beta1, gamma1, n1),
+            (k2, alpha2, C, A2, beta2, gamma2, n2))
+
+
+def initial_state(m, x0):
+    """Relaxed static equilibrium at displacement x0 [mm] with virgin hysteresis: z1 = z2 = 0,
+    k1*(x0 - y) = k0*y and w = x0, so F = k0*k1/(k0 + k1)*x0, the static stiffness times x0,
+    held while x0 is. (With k0 = k1 = 0, y affects nothing and is set to x0.)"""
+    k1, K1 = m[1], m[7]
+    y0 = k1 * x0 / K1 if K1 > 0.0 else x0
+    return (y0, 0.0, x0, 0.0)
+
+
+def force(m, state, x, v):
+    """Eq. 5 with eq. 4: F = k0*y + c0*dw/dt [N], positive for positive x (the force the
+    bushing exerts on its base, i.e. the force needed to hold the upper plate at x)."""
+    k0, k1, k2, c0, c1, c2, C, K1, alpha1, alpha2, blk1, blk2 = m
+    y, z1, w, z2 = state
+    return k0 * y + c0 * ((c2 * v + k2 * (x - w) + alpha2 * z2) / C)
+
+
+def jump(m, state, jump_mm):
+    """Exact response to a displacement jump (an impulse in dx/dt): the dashpot c1 carries y
+    along (y += jump, z1 unchanged); the dashpots c0, c2 split it (w += c2/(c0 + c2)*jump) and
+    block 2 sees the relative displacement xi = c0/(c0 + c2)*jump, along which z2 walks."""
+    k0, k1, k2, c0, c1, c2, C, K1, alpha1, alpha2, blk1, blk2 = m
+    y, z1, w, z2 = state
+    z2, status = walk_along_xi(z2, c0 / C * jump_mm, blk2[3], blk2[4], blk2[5], blk2[6],
+                               HEUN_JUMP_LIMIT, THETA_JUMP, DEFAULT_MAX_SUBSTEPS)
+    if status != OK:
+        return (y, z1, w, z2), status
+    return (y + jump_mm, z1, w + (C - c0) / C * jump_mm, z2), OK
+
+
+def integrate(m, state, x, v, h, max_substeps):
+    """Both blocks over the step; returns (state, substeps used, status)."""
+    k0, k1, k2, c0, c1, c2, C, K1, alpha1, alpha2, blk1, blk2 = m
+    y, z1, w, z2 = state
+    a1 = k0 * v / c1
+    elapsed = 0.0
+    used = 0
+    while True:
+        remaining = h - elapsed
+        x_now = x + v * elapsed
+        u1 = -(k1 * (x_now - y) - k0 * y + alpha1 * z1) / c1
+        u2 = (c0 * v - k2 * (x_now - w) - alpha2 * z2) / C
+        count = max(substeps_needed(u1, z1, remaining, a1, blk1),
+                    substeps_needed(u2, z2, remaining, 0.0, blk2))
+        if used + 1 > max_substeps or count > max_substeps:
+            return (y, z1, w, z2), used, TOO_MANY_SUBSTEPS
+        sub = remaining if count == 1 else remaining / count
+        u1, z1, xi1 = block_step(u1, z1, sub, a1, blk1)
+        u2, z2, xi2 = block_step(u2, z2, sub, 0.0, blk2)
+        elapsed = h if count == 1 else elapsed + sub
+        x_now = x + v * elapsed
+        # The invariant keeps y consistent with u1; the stiff k/c1 coupling would amplify
+        # any quadrature error of y into u1.
+        y = (k1 * x_now + alpha1 * z1 + c1 * u1) / K1 if K1 > 0.0 else y + v * sub - xi1
+        w = w + v * sub - xi2
+        used += 1
+        if count == 1:
+            break
+    if not (math.isfinite(y) and math.isfinite(z1) and math.isfinite(w) and math.isfinite(z2)):
+        return (y, z1, w, z2), used, NOT_FINITE
+    return (y, z1, w, z2), used, OK
+
+
+MODEL = BushingModel(
+    "proposed", IDENTIFIER, "proposed (paper eqs. 1-5)", PARAMETER_SPECS,
+    (StateSpec("z1", 1, "N", "hysteretic force of the left block (eq. 1)"),
+     StateSpec("z2", 3, "N", "hysteretic force of the right block (eq. 2)"),
+     StateSpec("y", 0, "m", "displacement of the left plate (eq. 3)"),
+     StateSpec("w", 2, "m", "displacement of the right plate (eq. 4)")),
+    "params_table5_combined.json", prepare, initial_state, jump, integrate, force,
+    further_checks=constraint_checks)

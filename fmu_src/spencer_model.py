@@ -1,0 +1,115 @@
+"""Spencer's phenomenological MR-damper model (Spencer et al., 1997), Fig. 7 of the paper.
+
+    F = c1*dy/dt + k1*(x - x0)
+    dy/dt = [alpha*z + c0*dx/dt + k0*(x - y)] / (c0 + c1)
+    dz/dt = -gamma*|u|*z*|z|^(n-1) - beta*u*|z|^n + A*u,   u = dx/dt - dy/dt
+
+Spencer puts gamma on the |u| term where the paper's eqs. 1-2 put beta; the parameters keep
+Spencer's names and meaning (in the shared block form, the paper's beta is Spencer's gamma).
+Units N-mm-s as for the proposed model: z is a force in N, so alpha is dimensionless and A in
+N/mm (Spencer writes z in m and alpha in N/m; the force is the same with z_here =
+alpha_Spencer*z_Spencer). The state is ``(y, z)``, y in mm.
+
+Stepped as one block of ``integration`` (differentiate the y equation and substitute dz/dt):
+u = (c1*v - k0*(x - y) - alpha*z)/(c0 + c1), du/dt = -lam*u, lam = (k0 + alpha*g)/(c0 + c1);
+y follows dy/dt = v - u.
+"""
+from __future__ import annotations
+
+import math
+from typing import Mapping
+
+from .bushing_params import DAMPING, EXPONENT, GAIN, SPRING, WEIGHT, ParameterSpec
+from .integration import (DEFAULT_MAX_SUBSTEPS, HEUN_JUMP_LIMIT, NOT_FINITE, OK, THETA_JUMP, TOO_MANY_SUBSTEPS,
+                          block_step, substeps_needed, walk_along_xi)
+from .model_definition import BushingModel, StateSpec
+
+PARAMETER_SPECS = (
+    ParameterSpec("c0", "N.s/mm", "viscous damping in parallel with the Bouc-Wen element (large velocities)",
+                  **DAMPING),
+    ParameterSpec("k0", "N/mm", "stiffness in parallel with the Bouc-Wen element (large velocities)", **SPRING),
+    ParameterSpec("c1", "N.s/mm", "dashpot from the internal displacement y to ground (roll-off at low velocity)",
+                  minimum=0.0, exclusive=True, why="it divides dy/dt"),
+    ParameterSpec("k1", "N/mm", "accumulator spring from x to ground", **SPRING),
+    ParameterSpec("x0", "mm", "initial displacement of the accumulator spring k1 (preload -k1*x0)"),
+    ParameterSpec("alpha", "1", "weight of the hysteretic force z", **WEIGHT),
+    ParameterSpec("A", "N/mm", "Bouc-Wen initial stiffness", **GAIN),
+    ParameterSpec("beta", "N^(1-n)/mm", "Spencer's beta: on u*|z|^n (the paper's gamma)"),
+    ParameterSpec("gamma", "N^(1-n)/mm", "Spencer's gamma: on |u|*z*|z|^(n-1) (the paper's beta)"),
+    ParameterSpec("n", "1", "Bouc-Wen exponent", **EXPONENT),
+)
+KERNELS = ("prepare", "initial_state", "jump", "integrate", "force")
+
+
+def single_block_checks(p: Mapping[str, float]) -> tuple[list[str], list[str]]:
+    """Beyond each value's range (shared with the single Bouc-Wen, whose element's shape
+    parameters are also named beta, gamma): beta + gamma > 0 for a bounded loop."""
+    warnings = []
+    if not p["beta"] + p["gamma"] > 0:
+        warnings.append(f"beta + gamma = {p['beta'] + p['gamma']} should be > 0 (bounded hysteresis)")
+    return [], warnings
+
+
+# ---------------------------------------------------------------------------- kernels
+def prepare(p):
+    """(c0, k0, c1, k1, x0, alpha, C = c0 + c1, block (K, alpha, c, A, beta, gamma, n) in the
+    paper's beta/gamma) from the 10 values in ``PARAMETER_SPECS`` order."""
+    c0, k0, c1, k1, x0, alpha, A, beta, gamma, n = p
+    C = c0 + c1
+    return (c0, k0, c1, k1, x0, alpha, C, (k0, alpha, C, A, gamma, beta, n))
+
+
+def initial_state(m, x0):
+    """At rest at displacement x0 [mm]: y = x0, z = 0 (F = k1*(x0 - x0_spring))."""
+    return (x0, 0.0)
+
+
+def force(m, state, x, v):
+    """F = c1*dy/dt + k1*(x - x0) [N]."""
+    c0, k0, c1, k1, x0, alpha, C, blk = m
+    y, z = state
+    return c1 * ((alpha * z + c0 * v + k0 * (x - y)) / C) + k1 * (x - x0)
+
+
+def jump(m, state, jump_mm):
+    """An impulse in dx/dt: the dashpots c0 (across the element) and c1 (to ground) split it,
+    y += c0/(c0 + c1)*jump, and z walks along the element's share c1/(c0 + c1)*jump."""
+    c0, k0, c1, k1, x0, alpha, C, blk = m
+    y, z = state
+    z, status = walk_along_xi(z, c1 / C * jump_mm, blk[3], blk[4], blk[5], blk[6],
+                              HEUN_JUMP_LIMIT, THETA_JUMP, DEFAULT_MAX_SUBSTEPS)
+    if status != OK:
+        return (y, z), status
+    return (y + c0 / C * jump_mm, z), OK
+
+
+def integrate(m, state, x, v, h, max_substeps):
+    """The block over the step; returns (state, substeps used, status)."""
+    c0, k0, c1, k1, x0, alpha, C, blk = m
+    y, z = state
+    elapsed = 0.0
+    used = 0
+    while True:
+        remaining = h - elapsed
+        u = (c1 * v - k0 * (x + v * elapsed - y) - alpha * z) / C
+        count = substeps_needed(u, z, remaining, 0.0, blk)
+        if used + 1 > max_substeps or count > max_substeps:
+            return (y, z), used, TOO_MANY_SUBSTEPS
+        sub = remaining if count == 1 else remaining / count
+        u, z, xi = block_step(u, z, sub, 0.0, blk)
+        elapsed = h if count == 1 else elapsed + sub
+        y = y + v * sub - xi
+        used += 1
+        if count == 1:
+            break
+    if not (math.isfinite(y) and math.isfinite(z)):
+        return (y, z), used, NOT_FINITE
+    return (y, z), used, OK
+
+
+MODEL = BushingModel(
+    "spencer", "SpencerBushing", "Spencer (1997)", PARAMETER_SPECS,
+    (StateSpec("z", 1, "N", "hysteretic force"),
+     StateSpec("y", 0, "m", "internal displacement (between the Bouc-Wen element and c1)")),
+    "params_spencer_fit_synthetic_table5.json", prepare, initial_state, jump, integrate, force,
+    further_checks=single_block_checks, force_offset=lambda p: -p["k1"] * p["x0"])
