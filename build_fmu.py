@@ -2,10 +2,11 @@
 
 Writes ``DIR/<identifier>.fmu`` (FMI 2.0 co-simulation, pythonfmu) of the model NAME
 (``proposed``, the default: ``BoucWenBushing.fmu``; ``spencer``: ``SpencerBushing``;
-``bouc_wen``: ``SingleBoucWenBushing``; ``kelvin_voigt``: ``KelvinVoigtBushing``) whose
+``bouc_wen``: ``SingleBoucWenBushing``; ``kelvin_voigt``: ``KelvinVoigtBushing``; ``six_axis``:
+``SixAxisBushing``, six uncoupled axes each one of the four, see ``fmu_src/axes.py``) whose
 parameter start values are the set in FILE, project JSON or SSP 1.0 ``.ssv`` (default: the
 paper's Table 5 for the proposed model, the baselines' fits to the synthetic Table 5 tests
-in ``data/`` for the others).
+in ``data/`` for the others, ``data/params_six_axis_illustrative.json`` for six axes).
 
 What the build adds to pythonfmu's output, and why:
 - Unique module names. The slave module is packed as ``boucwen_bushing_<hash>.py`` with its
@@ -35,7 +36,7 @@ from xml.dom.minidom import parseString
 from xml.etree import ElementTree as ET
 
 REPO = Path(__file__).resolve().parent
-LIBRARY_MODULES = ("bushing_params.py", "model_definition.py", "integration.py", "proposed_model.py",
+LIBRARY_MODULES = ("bushing_params.py", "model_definition.py", "integration.py", "axes.py", "proposed_model.py",
                    "spencer_model.py", "bouc_wen_model.py", "kelvin_voigt_model.py", "bushing_models.py",
                    "parameter_files.py")
 SLAVE_MODULE = "bushing_slave.py"
@@ -43,19 +44,20 @@ SLAVE_MODULE = "bushing_slave.py"
 sys.path.insert(0, str(REPO))
 import fmu_src  # noqa: E402
 from fmu_src import __version__, bushing_params  # noqa: E402
+from fmu_src.axes import SIX_AXIS_IDENTIFIER  # noqa: E402
 from fmu_src.bushing_models import MODEL_NAMES, get_model  # noqa: E402
-from fmu_src.parameter_files import parameter_document, read_parameter_set  # noqa: E402
+from fmu_src.parameter_files import (fmu_axes, parameter_document, read_parameter_set, read_six_axis,  # noqa: E402
+                                     six_axis_document)
 
 PACKED_LIBRARY_INIT = '''"""Packed library of the bushing FMU (written by build_fmu.py)."""
 from pathlib import Path
 
-from . import bushing_models, integration, model_definition, parameter_files
+from . import axes, bushing_models, integration, model_definition, parameter_files
 
-_DEFAULTS = parameter_files.read_parameter_set(Path(__file__).with_name("default_parameters.json"))
-MODEL = _DEFAULTS.model
-DEFAULT_PARAMETERS = _DEFAULTS.parameters
+AXES = parameter_files.fmu_axes(Path(__file__).with_name("default_parameters.json"))
 '''
-PORT_UNITS = {"x": "m", "v": "m/s", "F": "N"}
+SIX_AXIS = "six_axis"
+SIX_AXIS_DEFAULT_FILE = "params_six_axis_illustrative.json"
 
 
 SOURCE_DIR = Path(fmu_src.__file__).resolve().parent
@@ -68,7 +70,7 @@ class BuildError(RuntimeError):
 def default_parameter_file(model: str = "proposed") -> Path:
     """The parameter set an FMU of ``model`` gets when no ``--params`` is given: in the
     checkout's data/, or in the installed package ``bushing_data`` (the same files)."""
-    name = get_model(model).default_file
+    name = SIX_AXIS_DEFAULT_FILE if model in (SIX_AXIS, SIX_AXIS_IDENTIFIER) else get_model(model).default_file
     checkout = REPO / "data" / name
     if checkout.is_file():
         return checkout
@@ -85,15 +87,23 @@ def build_fmu(params_file: str | Path | None = None, out_dir: str | Path = "dist
     (default: :func:`default_parameter_file`); return its path."""
     from pythonfmu.builder import FmuBuilder
 
-    bushing = get_model(model)
-    params_file = Path(params_file) if params_file is not None else default_parameter_file(bushing.name)
-    parameters = read_parameter_set(params_file, bushing.name).parameters
-    defaults_json = parameter_document(parameters, bushing.name,
-                                       {"source": f"build_fmu.py --model {bushing.name} --params {params_file.name}"})
+    six = model in (SIX_AXIS, SIX_AXIS_IDENTIFIER)
+    name = SIX_AXIS if six else get_model(model).name
+    params_file = Path(params_file) if params_file is not None else default_parameter_file(name)
+    source = {"source": f"build_fmu.py --model {name} --params {params_file.name}"}
+    if six:
+        axes = read_six_axis(params_file).axes
+        defaults_json = six_axis_document({axis: (one.model.identifier, one.parameters) for axis, one in axes.items()},
+                                          source)
+        identifier, title = SIX_AXIS_IDENTIFIER, "six-axis bushing"
+    else:
+        bushing = get_model(name)
+        defaults_json = parameter_document(read_parameter_set(params_file, name).parameters, name, source)
+        identifier, title = bushing.identifier, f"{bushing.title} model"
     defaults_text = json.dumps(defaults_json, indent=2) + "\n"
     slave_text = ((SOURCE_DIR / SLAVE_MODULE).read_text()
-                  + f"\n\nclass {bushing.identifier}(BushingSlave):\n"
-                    f"    \"\"\"The {bushing.title} model (written by build_fmu.py).\"\"\"\n"
+                  + f"\n\nclass {identifier}(BushingSlave):\n"
+                    f"    \"\"\"The {title} (written by build_fmu.py).\"\"\"\n"
                     f"    version = {__version__!r}\n")
 
     digest = hashlib.sha256(slave_text.encode())
@@ -125,7 +135,7 @@ def build_fmu(params_file: str | Path | None = None, out_dir: str | Path = "dist
             for loaded in [m for m in sys.modules if m.startswith(module_name)]:
                 del sys.modules[loaded]
 
-    _rewrite_model_description(fmu_path, parameters, bushing)
+    _rewrite_model_description(fmu_path, _axes_of_document(defaults_text))
     from fmpy.validation import validate_fmu
     problems = validate_fmu(str(fmu_path))
     if problems:
@@ -133,14 +143,30 @@ def build_fmu(params_file: str | Path | None = None, out_dir: str | Path = "dist
     return fmu_path
 
 
-def _rewrite_model_description(fmu_path: Path, parameters: dict[str, float], bushing) -> None:
+def _axes_of_document(text: str) -> list:
+    """parameter_files.fmu_axes of a parameter document (what the packed library will read)."""
+    with tempfile.TemporaryDirectory(prefix="bushing_defaults_") as folder:
+        path = Path(folder) / "default_parameters.json"
+        path.write_text(text)
+        return fmu_axes(path)
+
+
+def _rewrite_model_description(fmu_path: Path, axes: list) -> None:
+    """``axes``: [(axes.Axis, model on it, parameters)] as the FMU's library builds them."""
     with zipfile.ZipFile(fmu_path) as archive:
         entries = {info.filename: archive.read(info.filename) for info in archive.infolist()}
     root = ET.fromstring(entries["modelDescription.xml"])
     root.set("generationTool", f"boucwen-bushing {__version__} (build_fmu.py) with {root.get('generationTool')}")
-    _add_units(root, {**PORT_UNITS, **bushing.units, **{s.name: s.unit for s in bushing.states}})
-    _set_parameter_starts(root, parameters)
-    _add_model_structure(root)
+    units, starts = {}, {}
+    for axis, model, parameters in axes:
+        units.update({axis.displacement: axis.displacement_unit, axis.velocity: axis.velocity_unit,
+                      axis.output: axis.output_unit})
+        units.update({axis.prefix + name: unit for name, unit in model.units.items()})
+        units.update({axis.prefix + s.name: axis.state_port(s.unit)[0] for s in model.states})
+        starts.update({axis.prefix + name: value for name, value in parameters.items()})
+    _add_units(root, units)
+    _set_parameter_starts(root, starts)
+    _add_model_structure(root, [axis for axis, _, _ in axes])
     text = parseString(ET.tostring(root, encoding="UTF-8")).toprettyxml(indent="  ", encoding="UTF-8")
     entries["modelDescription.xml"] = b"\n".join(line for line in text.splitlines() if line.strip())
     with zipfile.ZipFile(fmu_path, "w", zipfile.ZIP_DEFLATED) as archive:
@@ -175,28 +201,34 @@ def _set_parameter_starts(root: ET.Element, parameters: dict[str, float]) -> Non
             variable.find("Real").set("start", repr(parameters[variable.get("name")]))
 
 
-def _add_model_structure(root: ET.Element) -> None:
+def _add_model_structure(root: ET.Element, axes) -> None:
     index = {v.get("name"): str(i + 1) for i, v in enumerate(root.iter("ScalarVariable"))}
     structure = root.find("ModelStructure")
     for child in list(structure):
         structure.remove(child)
     # F = k0*y + c0*(c2*v + k2*(x - w) + alpha2*z2)/(c0 + c2) (+ a constant for the
-    # baselines): direct feedthrough of x and v.
+    # baselines): direct feedthrough of its own axis's x and v, and of nothing else (the axes
+    # are uncoupled).
     outputs = ET.SubElement(structure, "Outputs")
-    ET.SubElement(outputs, "Unknown", index=index["F"], dependencies=f"{index['x']} {index['v']}",
-                  dependenciesKind="dependent dependent")
+    for axis in axes:
+        ET.SubElement(outputs, "Unknown", index=index[axis.output],
+                      dependencies=f"{index[axis.displacement]} {index[axis.velocity]}",
+                      dependenciesKind="dependent dependent")
     initial = ET.SubElement(structure, "InitialUnknowns")
-    ET.SubElement(initial, "Unknown", index=index["F"])
+    for axis in axes:
+        ET.SubElement(initial, "Unknown", index=index[axis.output])
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="bushing-build-fmu", description=__doc__.splitlines()[0])
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
-    parser.add_argument("--model", default="proposed", choices=MODEL_NAMES,
-                        help="which bushing model (default: proposed, the paper's eqs. 1-5)")
+    parser.add_argument("--model", default="proposed", choices=(*MODEL_NAMES, SIX_AXIS),
+                        help="which bushing model (default: proposed, the paper's eqs. 1-5); six_axis: the "
+                             "six-axis bushing SixAxisBushing, each axis one of the models")
     parser.add_argument("--params", help="parameter set of the model, project JSON or SSP 1.0 .ssv "
                                          "(paper N-mm-s units); default: the paper's Table 5 for the "
-                                         "proposed model, data/params_<model>_fit_synthetic_table5.json otherwise")
+                                         "proposed model, data/params_<model>_fit_synthetic_table5.json for the "
+                                         f"others, data/{SIX_AXIS_DEFAULT_FILE} for six_axis")
     parser.add_argument("--out", default="dist", help="output directory (default: dist/ in the working directory)")
     args = parser.parse_args(argv)
     try:

@@ -68,6 +68,16 @@ UNIT_DEFINITIONS: dict[str, dict[str, str] | None] = {
     # the baseline models (bushing_models)
     "mm": {"m": "1", "factor": "0.001"},
     "N^(1-n)/mm": None,
+    # ports and parameters of the rotational axes (fmu_src/axes.py)
+    "rad": {"rad": "1"},
+    "rad/s": {"rad": "1", "s": "-1"},
+    "N.m": {"kg": "1", "m": "2", "s": "-2"},
+    "N.mm": {"kg": "1", "m": "2", "s": "-2", "factor": "0.001"},
+    "N.mm/rad": {"kg": "1", "m": "2", "s": "-2", "rad": "-1", "factor": "0.001"},
+    "N.mm.s/rad": {"kg": "1", "m": "2", "s": "-1", "rad": "-1", "factor": "0.001"},
+    "(N.mm)^(1-n)/rad": None,
+    "(N.mm)^(1-n1)/rad": None,
+    "(N.mm)^(1-n2)/rad": None,
 }
 
 

@@ -1,13 +1,14 @@
 """pythonfmu adapter: the FMI 2.0 co-simulation face of the bushing models.
 
-A thin layer: it declares the variables of one model of ``bushing_models`` (the proposed
-one, or a baseline), converts SI ports to the paper's N-mm-s units, validates every value it
-is given and steps the model's own kernels through ``integration``. Nothing here knows the
-equations, and this error policy is the same for every model.
+A thin layer: it declares the variables of its axes (one axis of one model of
+``bushing_models``, or the six axes of ``SixAxisBushing``, each one of the models; see
+``axes``), converts SI ports to the kernels' units, validates every value it is given and steps
+each axis's model through ``integration``. Nothing here knows the equations, and this error
+policy is the same for every model and every axis.
 
-The FMU's class is a subclass of :class:`BushingSlave` named after the model's FMI
-identifier, which build_fmu.py appends to the packed copy of this module (pythonfmu takes
-the class with the longest hierarchy), so every model has its own modelIdentifier.
+The FMU's class is a subclass of :class:`BushingSlave` named after the FMI identifier, which
+build_fmu.py appends to the packed copy of this module (pythonfmu takes the class with the
+longest hierarchy), so every model has its own modelIdentifier.
 
 Error policy. pythonfmu 0.7 knows three outcomes of a call: fmi2OK, fmi2Discard (do_step
 returns False) and fmi2Fatal (any Python exception); it cannot return fmi2Error.
@@ -18,10 +19,10 @@ returns False) and fmi2Fatal (any Python exception); it cannot return fmi2Error.
   visibly: fmpy raises, libcosim reports a failed step. (exitInitializationMode itself does not
   fail: libcosim aborts the process on that.)
 - During the run, a setter stores the value and logs a problem at once; a doStep that cannot
-  succeed (a parameter made invalid, a non-finite input, overflow, too many substeps) logs the
-  reason and returns False: fmi2Discard, with the committed state untouched, so the master can
-  fix the value and step again.
-The output F is never NaN or Inf: it falls back to the last finite force.
+  succeed (a parameter made invalid, a non-finite input, overflow, too many substeps, on any
+  axis) logs the reason, naming the axis, and returns False: fmi2Discard, with the committed
+  state of every axis untouched, so the master can fix the value and step again.
+An output is never NaN or Inf: it falls back to the last finite value.
 
 Packaging. Inside an FMU this module is renamed to a name unique to the build, and its
 siblings live in the package ``<that name>_lib``, so several FMUs of this project (even
@@ -42,150 +43,180 @@ from pythonfmu.enums import Fmi2Status
 # (fmpy's simulate_fmu does). So module-level code here must touch no files: the packed
 # library, imported once and then cached, reads the default parameters.
 if __package__:
-    from . import integration, model_definition
-    MODEL = None  # only an FMU built by build_fmu.py has a model and defaults
-    DEFAULT_PARAMETERS = None
+    from . import axes, integration
+    AXES = None   # only an FMU built by build_fmu.py has axes, models and defaults
 else:
     _library = importlib.import_module(__name__ + "_lib")
+    axes = _library.axes
     integration = _library.integration
-    model_definition = _library.model_definition
-    MODEL = _library.MODEL
-    DEFAULT_PARAMETERS = _library.DEFAULT_PARAMETERS
-
-MM_PER_M = 1000.0
-PLAUSIBLE_TRAVEL_M = model_definition.PLAUSIBLE_TRAVEL_MM / MM_PER_M
-"""|x| beyond this is far outside any rubber bushing's travel: most likely millimetres
-entered where metres are expected. It is warned about, not refused."""
+    AXES = _library.AXES   # [(axes.Axis, BushingModel on that axis, default parameters)]
 
 
 class InitializationError(RuntimeError):
     """Start values with which the simulation cannot start (fmi2Fatal at the first doStep)."""
 
 
-def _description(model) -> str:
-    if model is None or model.name == "proposed":
+def _description(axis_models) -> str:
+    if axis_models is None or (len(axis_models) == 1 and axis_models[0][1].name == "proposed"):
         return ("Nonlinear rubber bushing, one axis: the modified Spencer/Bouc-Wen model of "
                 "'New nonlinear bushing model for general excitations using Bouc-Wen hysteretic "
                 "model' (eqs. 1-5). Ports in SI, parameters in the paper's N-mm-s units.")
-    return (f"Bushing, one axis: the {model.title} baseline model of the Bouc-Wen bushing project. "
-            "Ports in SI, parameters in N-mm-s units.")
+    if len(axis_models) == 1:
+        return (f"Bushing, one axis: the {axis_models[0][1].title} baseline model of the Bouc-Wen bushing project. "
+                "Ports in SI, parameters in N-mm-s units.")
+    return ("Six-axis rubber bushing between markers I and J (uncoupled axes, small rotations; "
+            "inputs and outputs in J's axes): " + ", ".join(f"{axis.name} {model.title}" for axis, model, _ in axis_models)
+            + ". Ports in SI; translational parameters in N-mm-s units, rotational in N.mm, rad, s.")
+
+
+class _AxisState:
+    """One axis of the slave: its model, parameters as set, inputs, and committed state (in the
+    kernels' units: mm or rad, N or N.mm)."""
+
+    def __init__(self, axis, model, defaults):
+        self.axis = axis
+        self.model = model
+        self.values = {name: float(defaults[name]) for name in model.parameter_names}
+        self.x = 0.0                   # port displacement as set (m or rad)
+        self.v = 0.0                   # port velocity as set (m/s or rad/s)
+        self.constants = None          # model.prepare of the parameters in force
+        self.parameters_changed = True
+        self.state = tuple(0.0 for _ in model.states)
+        self.state_x = 0.0             # kernel displacement the committed state belongs to
+        self.x_now = 0.0               # current kernel displacement: x as last set, else x_k + v_k*h
+        self.last_output = 0.0         # last finite output, port units (N or N.m)
+        self.output_is_current = False  # last_output belongs to the current inputs and state
+        self.travel_warned = False     # the implausible-travel warning is given once
+        self.output_bound = math.inf   # port units; above it the output is implausible (warned once)
+        self.output_warned = False
+        self.stale_output_logged = False   # the stale-output error is given once per episode
+        self.last_errors = []          # the parameter errors of the last validation
 
 
 class BushingSlave(Fmi2Slave):
     author = "Bouc-Wen bushing project"
-    description = _description(MODEL)
+    description = _description(AXES)
     version = None  # the project's version, written into each FMU's class by build_fmu.py
     license = "MIT"
     default_experiment = DefaultExperiment(start_time=0.0, stop_time=1.0, step_size=1e-3)
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        if MODEL is None:
+        if AXES is None:
             raise RuntimeError("the bushing slave runs inside an FMU built by build_fmu.py")
-        for name in MODEL.parameter_names:
-            setattr(self, name, DEFAULT_PARAMETERS[name])
-        self.x = 0.0  # m
-        self.v = 0.0  # m/s
-        self._constants = None         # MODEL.prepare of the parameters in force (paper units)
-        self._parameters_changed = True
-        self._state = tuple(0.0 for _ in MODEL.states)  # committed state, mm and N
-        self._state_x_mm = 0.0         # displacement the committed state belongs to
-        self._x_now_mm = 0.0           # current displacement: x as last set, else x_k + v_k*h
-        self._last_force = 0.0         # N, last finite force
-        self._force_is_current = False  # _last_force belongs to the current inputs and state
+        self._axes = [_AxisState(axis, model, defaults) for axis, model, defaults in AXES]
         self._initial_state_pending = True  # set at exit of initialization, or first valid step
-        self._travel_warned = False    # the implausible-travel warning is given once
-        self._force_bound = math.inf   # N, above it the force is implausible (warned once)
-        self._force_warned = False
-        self._stale_force_logged = False   # the stale-force error is given once per episode
-        self._last_errors = []         # the parameter errors of the last validation
+        for a in self._axes:
+            self._register_axis(a)
 
-        for spec in MODEL.specs:
+    def _register_axis(self, a):
+        axis, model = a.axis, a.model
+        for spec in model.specs:
             self.register_variable(Real(
-                spec.name, causality=Fmi2Causality.parameter, variability=Fmi2Variability.tunable,
-                description=f"{spec.description} [{spec.unit}]",
-                setter=self._parameter_setter(spec.name)))
+                axis.prefix + spec.name, causality=Fmi2Causality.parameter, variability=Fmi2Variability.tunable,
+                description=f"{axis.label}{spec.description} [{spec.unit}]",
+                getter=self._parameter_getter(a, spec.name), setter=self._parameter_setter(a, spec.name)))
+        what = "rotation" if axis.rotational else "displacement"
         self.register_variable(Real(
-            "x", causality=Fmi2Causality.input, variability=Fmi2Variability.continuous,
-            description="relative displacement of the bushing (upper plate minus base) [m]",
-            setter=self._set_displacement))
+            axis.displacement, causality=Fmi2Causality.input, variability=Fmi2Variability.continuous,
+            description=(f"relative {what} of I with respect to J about/along {axis.name[-1]} "
+                         f"[{axis.displacement_unit}]" if axis.name else
+                         "relative displacement of the bushing (upper plate minus base) [m]"),
+            getter=lambda: a.x, setter=lambda value: self._set_displacement(a, value)))
         self.register_variable(Real(
-            "v", causality=Fmi2Causality.input, variability=Fmi2Variability.continuous,
-            description="relative velocity dx/dt [m/s]", setter=self._set_velocity))
+            axis.velocity, causality=Fmi2Causality.input, variability=Fmi2Variability.continuous,
+            description=f"relative velocity d{axis.displacement}/dt [{axis.velocity_unit}]",
+            getter=lambda: a.v, setter=lambda value: self._set_velocity(a, value)))
         self.register_variable(Real(
-            "F", causality=Fmi2Causality.output, variability=Fmi2Variability.continuous,
-            description="bushing force, positive for positive x (force on the base) [N]",
-            getter=self._force))
-        for state in MODEL.states:
-            scale = 1.0 / MM_PER_M if state.unit == "m" else 1.0
+            axis.output, causality=Fmi2Causality.output, variability=Fmi2Variability.continuous,
+            description=(f"{'moment' if axis.rotational else 'force'} on J along/about {axis.name[-1]}, positive "
+                         f"for a positive {axis.displacement} [{axis.output_unit}]" if axis.name else
+                         "bushing force, positive for positive x (force on the base) [N]"),
+            getter=lambda: self._output(a)))
+        for state in model.states:
+            unit, scale = axis.state_port(state.unit)
+            index = state.index
             self.register_variable(Real(
-                state.name, causality=Fmi2Causality.local, variability=Fmi2Variability.continuous,
-                description=f"internal state: {state.meaning} [{state.unit}]",
-                getter=self._state_getter(state.index, scale)))
+                axis.prefix + state.name, causality=Fmi2Causality.local, variability=Fmi2Variability.continuous,
+                description=f"{axis.label}internal state: {state.meaning} [{unit}]",
+                getter=lambda index=index, scale=scale: a.state[index] * scale))
 
     # ---------------------------------------------------------------- variable access
-    def _parameter_setter(self, name):
+    @staticmethod
+    def _parameter_getter(a, name):
+        return lambda: a.values[name]
+
+    def _parameter_setter(self, a, name):
         def set_parameter(value):
-            setattr(self, name, value)
-            self._parameters_changed = True
-            self._force_is_current = False
+            a.values[name] = value
+            a.parameters_changed = True
+            a.output_is_current = False
             if not math.isfinite(value):
-                self._error(f"parameter {name} = {value} [{MODEL.units[name]}] is not "
+                self._error(f"{a.axis.label}parameter {name} = {value} [{a.model.units[name]}] is not "
                             "a finite number; the next doStep will be refused until it is")
         return set_parameter
 
-    def _set_displacement(self, value):
-        self.x = value
-        self._x_now_mm = value * MM_PER_M
-        self._force_is_current = False
+    def _set_displacement(self, a, value):
+        axis = a.axis
+        a.x = value
+        a.x_now = value * axis.to_kernel
+        a.output_is_current = False
         if not math.isfinite(value):
-            self._error(f"input x = {value} m is not a finite number; the next doStep will be refused")
-        elif abs(value) > PLAUSIBLE_TRAVEL_M and not self._travel_warned:
-            self._travel_warned = True
-            self.log(f"input x = {value} m exceeds {PLAUSIBLE_TRAVEL_M} m, far beyond a bushing's travel; "
-                     "the FMU takes metres (2 mm is x = 0.002)", Fmi2Status.warning, "logStatusWarning")
+            self._error(f"input {axis.displacement} = {value} {axis.displacement_unit} is not a finite number; "
+                        "the next doStep will be refused")
+        elif abs(value) > axis.plausible_travel and not a.travel_warned:
+            a.travel_warned = True
+            if axis.rotational:
+                message = (f"input {axis.displacement} = {value} rad exceeds {axis.plausible_travel} rad: the "
+                           "bushing takes rotations as small angles (each component of the rotation vector about "
+                           "its own axis), which is approximate beyond about 20 degrees")
+            else:
+                message = (f"input {axis.displacement} = {value} m exceeds {axis.plausible_travel} m, far beyond a "
+                           f"bushing's travel; the FMU takes metres (2 mm is {axis.displacement} = 0.002)")
+            self.log(message, Fmi2Status.warning, "logStatusWarning")
 
-    def _set_velocity(self, value):
-        self.v = value
-        self._force_is_current = False
+    def _set_velocity(self, a, value):
+        a.v = value
+        a.output_is_current = False
         if not math.isfinite(value):
-            self._error(f"input v = {value} m/s is not a finite number; the next doStep will be refused")
+            self._error(f"input {a.axis.velocity} = {value} {a.axis.velocity_unit} is not a finite number; "
+                        "the next doStep will be refused")
 
-    def _state_getter(self, index, scale):
-        return lambda: self._state[index] * scale
-
-    def _force(self):
-        """F at the current time and displacement. If x was set away from the displacement of
-        the committed state, F includes the model's instantaneous response to that jump."""
-        if self._force_is_current:
-            return self._last_force
-        if self._refresh_parameters():
+    def _output(self, a):
+        """The axis's output at the current time and displacement. If the displacement was set
+        away from the one of the committed state, it includes the model's instantaneous
+        response to that jump."""
+        if a.output_is_current:
+            return a.last_output
+        if self._refresh_parameters(a):
             try:
-                state = self._state
-                if self._x_now_mm != self._state_x_mm:
-                    state = integration.apply_displacement_jump(MODEL, self._constants, state,
-                                                                self._x_now_mm - self._state_x_mm)
-                force = MODEL.force(self._constants, state, self._x_now_mm, self.v * MM_PER_M)
+                state = a.state
+                if a.x_now != a.state_x:
+                    state = integration.apply_displacement_jump(a.model, a.constants, state, a.x_now - a.state_x)
+                output = a.model.force(a.constants, state, a.x_now, a.v * a.axis.to_kernel) * a.axis.from_kernel
             except (ArithmeticError, ValueError):
-                force = math.nan
-            if math.isfinite(force):
-                self._last_force = force
-                self._force_is_current = True
-                self._stale_force_logged = False
-                return force
-            reason = f"the force at x = {self.x} m, v = {self.v} m/s is not finite ({force})"
+                output = math.nan
+            if math.isfinite(output):
+                a.last_output = output
+                a.output_is_current = True
+                a.stale_output_logged = False
+                return output
+            reason = (f"it is not finite ({output}) at {a.axis.displacement} = {a.x} {a.axis.displacement_unit}, "
+                      f"{a.axis.velocity} = {a.v} {a.axis.velocity_unit}")
         else:
-            reason = "the parameters are invalid (see the errors above)"
-        if not self._stale_force_logged:   # once until a current force can be computed again
-            self._stale_force_logged = True
-            self._error(f"F cannot be computed: {reason}; F keeps its last finite value {self._last_force} N")
-        return self._last_force
+            reason = f"the parameters{' of axis ' + a.axis.name if a.axis.name else ''} are invalid (see the errors above)"
+        if not a.stale_output_logged:   # once until a current output can be computed again
+            a.stale_output_logged = True
+            self._error(f"{a.axis.output} cannot be computed: {reason}; {a.axis.output} keeps its last finite "
+                        f"value {a.last_output} {a.axis.output_unit}")
+        return a.last_output
 
     # ---------------------------------------------------------------- FMI life cycle
     def exit_initialization_mode(self):
         # Never raise here: libcosim aborts the whole process on a failed exitInitializationMode,
         # while it reports a failed step. Invalid start values are logged now and fail the first step.
-        if self._refresh_parameters() and math.isfinite(self._x_now_mm):
+        usable = [self._refresh_parameters(a) for a in self._axes]
+        if all(usable) and all(math.isfinite(a.x_now) for a in self._axes):
             self._set_initial_state()
 
     def _fail_to_start(self):
@@ -194,7 +225,8 @@ class BushingSlave(Fmi2Slave):
         other than fmi2Discard, and it makes fmi2Fatal (fmpy raises, libcosim reports a failed
         step). fmi2Discard would not do: fmpy ends the run silently on it. pythonfmu passes log
         messages to the host only with debug logging on, so the reasons also go to stderr."""
-        reasons = self._last_errors or ["the parameters are invalid"]
+        reasons = [a.axis.label + error for a in self._axes for error in a.last_errors] \
+            or ["the parameters are invalid"]
         for message in reasons:
             print(f"{self.instance_name}: {message}", file=sys.stderr)
         self._error("the simulation cannot start: " + "; ".join(reasons))
@@ -208,67 +240,84 @@ class BushingSlave(Fmi2Slave):
         raise InitializationError("; ".join(reasons))
 
     def _set_initial_state(self):
-        """Relaxed equilibrium at the current displacement (the model's initial_state)."""
-        self._state = MODEL.initial_state(self._constants, self._x_now_mm)
-        self._state_x_mm = self._x_now_mm
-        self._force_is_current = False
+        """Each axis at relaxed equilibrium at its current displacement (its model's initial_state)."""
+        for a in self._axes:
+            a.state = a.model.initial_state(a.constants, a.x_now)
+            a.state_x = a.x_now
+            a.output_is_current = False
         self._initial_state_pending = False
 
     def do_step(self, current_time, step_size):
         if not 0.0 < step_size < math.inf:
             return self._refuse(f"communication step size {step_size} s must be a finite number > 0")
-        if not self._refresh_parameters():
+        if not all([self._refresh_parameters(a) for a in self._axes]):
             if self._initial_state_pending:   # never started: nothing a master can do in the run
                 self._fail_to_start()
             return self._refuse("doStep refused: the parameters are invalid (see the errors above)")
-        if not (math.isfinite(self.x) and math.isfinite(self.v)):
-            name, value, unit = ("x", self.x, "m") if not math.isfinite(self.x) else ("v", self.v, "m/s")
-            return self._refuse(f"doStep refused: input {name} = {value} {unit} is not a finite number")
+        for a in self._axes:
+            axis = a.axis
+            if not (math.isfinite(a.x) and math.isfinite(a.v)):
+                name, value, unit = ((axis.displacement, a.x, axis.displacement_unit) if not math.isfinite(a.x)
+                                     else (axis.velocity, a.v, axis.velocity_unit))
+                return self._refuse(f"doStep refused: input {name} = {value} {unit} is not a finite number")
         if self._initial_state_pending:  # the values at initialization could not be used
             self._set_initial_state()
-        x_mm = self._x_now_mm
-        v_mm = self.v * MM_PER_M
-        try:
-            state, _ = integration.advance(MODEL, self._constants, self._state, self._state_x_mm, x_mm, v_mm,
-                                           step_size)
-        except integration.StepError as exc:
-            return self._refuse(f"doStep at t = {current_time} s refused: {exc}")
-        x_end = x_mm + v_mm * step_size
-        force = MODEL.force(self._constants, state, x_end, v_mm)
-        if not math.isfinite(force):
-            return self._refuse(f"doStep at t = {current_time} s refused: the force would be {force} N "
-                                f"(x = {self.x} m, v = {self.v} m/s); check the units of the inputs")
-        if abs(force) > self._force_bound and not self._force_warned:
-            self._force_warned = True
-            self.log(f"F = {force:.4g} N at t = {current_time + step_size} s exceeds {self._force_bound:.3g} N, the "
-                     f"force of all the bushing's springs and dashpots at {PLAUSIBLE_TRAVEL_M:g} m and "
-                     f"{model_definition.PLAUSIBLE_VELOCITY_MM_S / MM_PER_M:g} m/s: check the units of "
-                     f"the inputs (x = {self.x} m, v = {self.v} m/s; the FMU takes metres)",
-                     Fmi2Status.warning, "logStatusWarning")
-        self._state = state
-        self._state_x_mm = self._x_now_mm = x_end
-        self._last_force = force
-        self._force_is_current = True
+        steps = []     # every axis first, then commit all: a refusal leaves every axis as it was
+        for a in self._axes:
+            axis = a.axis
+            x, v = a.x_now, a.v * axis.to_kernel
+            try:
+                state, _ = integration.advance(a.model, a.constants, a.state, a.state_x, x, v, step_size)
+            except integration.StepError as exc:
+                return self._refuse(f"doStep at t = {current_time} s refused: {axis.label}{exc}")
+            x_end = x + v * step_size
+            output = a.model.force(a.constants, state, x_end, v) * axis.from_kernel
+            if not math.isfinite(output):
+                return self._refuse(f"doStep at t = {current_time} s refused: {axis.output} would be {output} "
+                                    f"{axis.output_unit} ({axis.displacement} = {a.x} {axis.displacement_unit}, "
+                                    f"{axis.velocity} = {a.v} {axis.velocity_unit}); check the units of the inputs")
+            steps.append((a, state, x_end, output))
+        for a, state, x_end, output in steps:
+            self._warn_if_implausible(a, output, current_time + step_size)
+            a.state = state
+            a.state_x = a.x_now = x_end
+            a.last_output = output
+            a.output_is_current = True
         return True
 
-    def _refresh_parameters(self) -> bool:
-        """Validate and compile the parameters once after they change, logging errors and
+    def _warn_if_implausible(self, a, output, time):
+        if abs(output) > a.output_bound and not a.output_warned:
+            a.output_warned = True
+            axis = a.axis
+            speed = ("rotation and angular velocity" if axis.rotational else "travel and speed")
+            self.log(f"{axis.output} = {output:.4g} {axis.output_unit} at t = {time} s exceeds "
+                     f"{a.output_bound:.3g} {axis.output_unit}, the {'moment' if axis.rotational else 'force'} of "
+                     f"all the bushing's springs and dashpots at the largest plausible {speed}: check the units of "
+                     f"the inputs ({axis.displacement} = {a.x} {axis.displacement_unit}, {axis.velocity} = {a.v} "
+                     f"{axis.velocity_unit}; the FMU takes {'radians' if axis.rotational else 'metres'})",
+                     Fmi2Status.warning, "logStatusWarning")
+
+    def _refresh_parameters(self, a) -> bool:
+        """Validate and prepare an axis's parameters once after they change, logging errors and
         warnings; True if the parameters in force are usable."""
-        if self._parameters_changed:
-            self._parameters_changed = False
-            values = {name: getattr(self, name) for name in MODEL.parameter_names}
-            errors, warnings = MODEL.validate(values)
-            self._last_errors = errors
+        if a.parameters_changed:
+            a.parameters_changed = False
+            errors, warnings = a.model.validate(a.values)
+            a.last_errors = errors
             for message in errors:
-                self._error(message)
+                self._error(a.axis.label + message)
             if errors:
-                self._constants = None
+                a.constants = None
             else:
                 for message in warnings:
-                    self.log(f"accepted, but {message}", Fmi2Status.warning, "logStatusWarning")
-                self._force_bound = MODEL.plausible_force_bound(values)
-                self._constants = MODEL.constants(values)
-        return self._constants is not None
+                    self.log(f"{a.axis.label}accepted, but {message}", Fmi2Status.warning, "logStatusWarning")
+                if a.axis.rotational:   # 1 rad and the plausible angular velocity, in N.mm -> N.m
+                    bound = a.model.plausible_force_bound(a.values, 1.0, axes.PLAUSIBLE_ANGULAR_VELOCITY_RAD_S)
+                else:
+                    bound = a.model.plausible_force_bound(a.values)
+                a.output_bound = bound * a.axis.from_kernel
+                a.constants = a.model.constants(a.values)
+        return a.constants is not None
 
     def _error(self, message):
         self.log(message, Fmi2Status.error, "logStatusError")
@@ -278,29 +327,25 @@ class BushingSlave(Fmi2Slave):
         return False
 
     # ---------------------------------------------------------------- FMU state
-    # pythonfmu's default state holds the registered variables only; the committed ODE
-    # state, the reported displacement and the last force must travel with it too.
+    # pythonfmu's default state holds the registered variables only; each axis's committed
+    # state, its reported displacement and its last output must travel with it too.
     def _get_fmu_state(self):
         return {
-            "parameters": {name: getattr(self, name) for name in MODEL.parameter_names},
-            "x": self.x, "v": self.v,
-            "state": list(self._state),
-            "state_x_mm": self._state_x_mm,
-            "x_now_mm": self._x_now_mm,
-            "last_force": self._last_force,
+            "axes": [{"parameters": dict(a.values), "x": a.x, "v": a.v, "state": list(a.state),
+                      "state_x": a.state_x, "x_now": a.x_now, "last_output": a.last_output}
+                     for a in self._axes],
             "initial_state_pending": self._initial_state_pending,
         }
 
     def _set_fmu_state(self, state):
-        for name, value in state["parameters"].items():
-            setattr(self, name, value)
-        self.x = state["x"]
-        self.v = state["v"]
-        self._state = tuple(state["state"])
-        self._state_x_mm = state["state_x_mm"]
-        self._x_now_mm = state["x_now_mm"]
-        self._last_force = state["last_force"]
-        self._force_is_current = False
+        for a, saved in zip(self._axes, state["axes"]):
+            a.values.update(saved["parameters"])
+            a.x, a.v = saved["x"], saved["v"]
+            a.state = tuple(saved["state"])
+            a.state_x, a.x_now = saved["state_x"], saved["x_now"]
+            a.last_output = saved["last_output"]
+            a.output_is_current = False
+            a.parameters_changed = True
+            self._refresh_parameters(a)
         self._initial_state_pending = state["initial_state_pending"]
-        self._parameters_changed = True
-        self._refresh_parameters()
+

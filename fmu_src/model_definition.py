@@ -32,6 +32,8 @@ PLAUSIBLE_VELOCITY_MM_S = 1000.0
 """Beyond a rubber bushing's travel and speed in service: the FMU warns above them (most likely
 millimetres entered where metres are expected), and :meth:`BushingModel.plausible_force_bound`
 is the force there."""
+STIFFNESS_UNITS = ("N/mm", "N.mm/rad")
+DAMPING_UNITS = ("N.s/mm", "N.mm.s/rad")
 
 
 @dataclass(frozen=True)
@@ -109,14 +111,15 @@ class BushingModel:
         """``prepare`` of a parameter mapping."""
         return self.prepare(self.values(params))
 
-    def plausible_force_bound(self, params: Mapping[str, float]) -> float:
+    def plausible_force_bound(self, params: Mapping[str, float], travel: float = PLAUSIBLE_TRAVEL_MM,
+                              velocity: float = PLAUSIBLE_VELOCITY_MM_S) -> float:
         """A force [N] no bushing with these parameters should reach in service: every spring
         and Bouc-Wen gain of the model (A weighted by its alpha) and every dashpot in parallel,
-        at PLAUSIBLE_TRAVEL_MM and PLAUSIBLE_VELOCITY_MM_S, plus the constant force. Above it
-        the inputs are most likely in the wrong units (millimetres in the metre port)."""
+        at ``travel`` [mm] and ``velocity`` [mm/s], plus the constant force. Above it the inputs
+        are most likely in the wrong units (millimetres in the metre port). On a rotational
+        axis (``axes``): rad, rad/s and N.mm."""
         def weight(name):   # a Bouc-Wen gain A<i> counts with its alpha<i>
             return abs(params.get("alpha" + name[1:], 1.0)) if name.startswith("A") else 1.0
-        stiffness = sum(abs(params[s.name]) * weight(s.name) for s in self.specs if s.unit == "N/mm")
-        damping = sum(abs(params[s.name]) for s in self.specs if s.unit == "N.s/mm")
-        return (stiffness * PLAUSIBLE_TRAVEL_MM + damping * PLAUSIBLE_VELOCITY_MM_S
-                + abs(self.force_offset(params)))
+        stiffness = sum(abs(params[s.name]) * weight(s.name) for s in self.specs if s.unit in STIFFNESS_UNITS)
+        damping = sum(abs(params[s.name]) for s in self.specs if s.unit in DAMPING_UNITS)
+        return stiffness * travel + damping * velocity + abs(self.force_offset(params))

@@ -12,6 +12,12 @@ Every read is validated against the model: missing or unknown names, non-numbers
 unit other than the parameter's raise ``ParameterError`` naming the file, the parameter and
 what is allowed.
 
+Six axes (``SixAxisBushing``, see ``axes``): ``{"model": "SixAxisBushing", "units": "N-mm-s",
+"axes": {"x": {"model": "BoucWenBushing", "parameters": {...}}, ..., "rz": {"model":
+"KelvinVoigtBushing", "parameters": {...}}}}``, every one of the six axes present, rotational
+axes in N.mm, rad, s; as SSV one ParameterSet named ``SixAxisBushing`` with the FMU's names
+``x.k0`` ..., each axis's model told by its parameter names. Errors name the axis.
+
 For fmpy users: ``simulate_fmu(fmu, start_values=load_parameters("bushing.ssv"), ...)``.
 """
 from __future__ import annotations
@@ -22,6 +28,7 @@ from pathlib import Path
 from typing import Mapping
 from xml.etree import ElementTree as ET
 
+from .axes import ONE_AXIS, SIX_AXES, SIX_AXIS_IDENTIFIER, SIX_AXIS_NAMES, model_on_axis
 from .bushing_models import BushingModel, MODELS, get_model
 from .bushing_params import UNIT_DEFINITIONS, UNIT_SYSTEM, ParameterError
 
@@ -185,18 +192,22 @@ def save_parameters(path: str | Path, params: Mapping[str, float], model: str = 
 
 
 def _write_ssv(path: Path, params: Mapping[str, float], model: BushingModel) -> None:
-    values = model.check(params)
+    _write_ssv_values(path, model.identifier, model.check(params), model.units)
+
+
+def _write_ssv_values(path: Path, set_name: str, values: Mapping[str, float], units: Mapping[str, str]) -> None:
+    """One ssv:ParameterSet of ``values`` (names in order) with their ``units``."""
     ssv, ssc = SSV_NAMESPACES["ssv"], SSV_NAMESPACES["ssc"]
     ET.register_namespace("ssv", ssv)
     ET.register_namespace("ssc", ssc)
-    root = ET.Element(f"{{{ssv}}}ParameterSet", version="1.0", name=model.identifier)
+    root = ET.Element(f"{{{ssv}}}ParameterSet", version="1.0", name=set_name)
     parameters = ET.SubElement(root, f"{{{ssv}}}Parameters")
     # SSP requires a BaseUnit for every unit, which N^(1-n)/mm (beta, gamma) cannot have:
     # those values go without a unit attribute rather than with a false one.
-    expressible = {name: unit for name, unit in model.units.items() if UNIT_DEFINITIONS[unit] is not None}
-    for name in model.parameter_names:
+    expressible = {name: unit for name, unit in units.items() if UNIT_DEFINITIONS[unit] is not None}
+    for name, value in values.items():
         element = ET.SubElement(parameters, f"{{{ssv}}}Parameter", name=name)
-        real = ET.SubElement(element, f"{{{ssv}}}Real", value=repr(values[name]))
+        real = ET.SubElement(element, f"{{{ssv}}}Real", value=repr(value))
         if name in expressible:
             real.set("unit", expressible[name])
     units = ET.SubElement(root, f"{{{ssv}}}Units")
@@ -205,3 +216,150 @@ def _write_ssv(path: Path, params: Mapping[str, float], model: BushingModel) -> 
         ET.SubElement(element, f"{{{ssc}}}BaseUnit", UNIT_DEFINITIONS[unit])
     ET.indent(root)
     ET.ElementTree(root).write(path, encoding="UTF-8", xml_declaration=True)
+
+
+# ---------------------------------------------------------------------------- six axes
+@dataclass
+class SixAxisSet:
+    """The six axes of a ``SixAxisBushing``: each axis's model (with the axis's units, see
+    ``axes.model_on_axis``) and parameters, in the order x, y, z, rx, ry, rz."""
+    axes: dict[str, ParameterSet]
+    provenance: dict = field(default_factory=dict)
+
+    def flat(self) -> dict[str, float]:
+        """The FMU's parameter names and values: {"x.k0": ..., "rz.c": ...}."""
+        return {f"{axis}.{name}": value for axis, one in self.axes.items() for name, value in one.parameters.items()}
+
+    def units(self) -> dict[str, str]:
+        return {f"{axis}.{name}": unit for axis, one in self.axes.items() for name, unit in one.model.units.items()}
+
+
+def read_six_axis(path: str | Path) -> SixAxisSet:
+    """A six-axis parameter file (JSON or .ssv), every axis validated like a one-axis set;
+    ParameterError names the file and the axis."""
+    path = Path(path)
+    if not path.exists():
+        raise ParameterError(f"parameter file {path} does not exist")
+    if path.suffix.lower() == ".ssv":
+        return _read_six_axis_ssv(path)
+    document = _json_document(path)
+    if document.get("model") != SIX_AXIS_IDENTIFIER or not isinstance(document.get("axes"), dict):
+        raise ParameterError(f"parameter file {path} is not a six-axis file: it needs \"model\": "
+                             f"\"{SIX_AXIS_IDENTIFIER}\" and an \"axes\" object with {', '.join(SIX_AXIS_NAMES)}")
+    units = document.get("units", UNIT_SYSTEM)
+    if units != UNIT_SYSTEM:
+        raise ParameterError(f"parameter file {path} declares units {units!r}; only {UNIT_SYSTEM!r} is supported "
+                             "(rotational axes in N.mm, rad, s)")
+    found = document["axes"]
+    _check_axis_names(path, set(found))
+    axes = {}
+    for axis in SIX_AXES:
+        entry = found[axis.name]
+        if not isinstance(entry, dict) or not isinstance(entry.get("parameters"), dict) or "model" not in entry:
+            raise ParameterError(f"{path}, axis {axis.name}: needs a \"model\" (one of "
+                                 f"{', '.join(m.identifier for m in MODELS.values())}) and a \"parameters\" object")
+        try:
+            model = model_on_axis(get_model(entry["model"]), axis)
+            axes[axis.name] = ParameterSet(model, model.check(entry["parameters"]))
+        except ParameterError as exc:
+            raise ParameterError(f"{path}, axis {axis.name}: {exc}") from None
+    return SixAxisSet(axes, dict(document.get("fit", {})))
+
+
+def _check_axis_names(path: Path, names: set[str]) -> None:
+    missing = [name for name in SIX_AXIS_NAMES if name not in names]
+    unknown = sorted(names - set(SIX_AXIS_NAMES))
+    if missing or unknown:
+        raise ParameterError(f"{path}: " + "; ".join(
+            ([f"missing axes {', '.join(missing)}"] if missing else [])
+            + ([f"unknown axes {', '.join(unknown)}"] if unknown else []))
+            + f" (the six axes are {', '.join(SIX_AXIS_NAMES)})")
+
+
+def _read_six_axis_ssv(path: Path) -> SixAxisSet:
+    try:
+        root = ET.parse(path).getroot()
+    except ET.ParseError as exc:
+        raise ParameterError(f"parameter file {path} is not valid XML: {exc}") from None
+    grouped: dict[str, dict[str, tuple[str | None, str | None]]] = {}
+    for parameter in root.iterfind("ssv:Parameters/ssv:Parameter", SSV_NAMESPACES):
+        name = parameter.get("name") or ""
+        real = parameter.find("ssv:Real", SSV_NAMESPACES)
+        if real is None:
+            raise ParameterError(f"{path}: parameter {name!r} is not an ssv:Real")
+        axis, _, short = name.partition(".")
+        if not short:
+            raise ParameterError(f"{path}: parameter {name!r} is not named <axis>.<name> (x.k0, rz.c, ...)")
+        grouped.setdefault(axis, {})[short] = (real.get("value"), real.get("unit"))
+    _check_axis_names(path, set(grouped))
+    axes = {}
+    for axis in SIX_AXES:
+        raw = grouped[axis.name]
+        base = _model_of_ssv(None, set(raw))
+        if base is None:
+            raise ParameterError(f"{path}, axis {axis.name}: its parameters {', '.join(sorted(raw))} are not those of "
+                                 "any model (" + "; ".join(f"{m.name}: {', '.join(m.parameter_names)}"
+                                                            for m in MODELS.values()) + ")")
+        model = model_on_axis(base, axis)
+        values = {}
+        for name, (text, unit) in raw.items():
+            if unit is not None and unit != model.units[name]:
+                raise ParameterError(f"{path}, axis {axis.name}: parameter {name} has unit {unit!r}; expected "
+                                     f"{model.units[name]!r}")
+            try:
+                values[name] = float(text)
+            except (TypeError, ValueError):
+                raise ParameterError(f"{path}, axis {axis.name}: parameter {name} = {text!r} is not a number") from None
+        try:
+            axes[axis.name] = ParameterSet(model, model.check(values))
+        except ParameterError as exc:
+            raise ParameterError(f"{path}, axis {axis.name}: {exc}") from None
+    return SixAxisSet(axes, {})
+
+
+def six_axis_document(axes: Mapping[str, tuple[str, Mapping[str, float]]], provenance: Mapping | None = None) -> dict:
+    """The JSON document of six axes, ``axes`` = {axis: (model name or identifier, parameters)}
+    (validated, each in its axis's units)."""
+    path = Path("<six-axis set>")
+    _check_axis_names(path, set(axes))
+    document = {"model": SIX_AXIS_IDENTIFIER, "units": UNIT_SYSTEM, "axes": {}, "fit": dict(provenance or {})}
+    for axis in SIX_AXES:
+        name, params = axes[axis.name]
+        try:
+            model = model_on_axis(get_model(name), axis)
+            document["axes"][axis.name] = {"model": model.identifier, "parameters": model.check(params)}
+        except ParameterError as exc:
+            raise ParameterError(f"axis {axis.name}: {exc}") from None
+    return document
+
+
+def save_six_axis(path: str | Path, axes: Mapping[str, tuple[str, Mapping[str, float]]],
+                  provenance: Mapping | None = None) -> Path:
+    """Write six axes (see :func:`six_axis_document`): ``.ssv`` as SSP 1.0 ParameterValues with
+    the FMU's names (``x.k0``), else JSON."""
+    path = Path(path)
+    document = six_axis_document(axes, provenance)
+    if path.suffix.lower() == ".ssv":
+        values, units = {}, {}
+        for axis in SIX_AXES:
+            entry = document["axes"][axis.name]
+            model = model_on_axis(get_model(entry["model"]), axis)
+            for name, value in entry["parameters"].items():
+                values[f"{axis.name}.{name}"] = value
+                units[f"{axis.name}.{name}"] = model.units[name]
+        _write_ssv_values(path, SIX_AXIS_IDENTIFIER, values, units)
+    else:
+        path.write_text(json.dumps(document, indent=2) + "\n", encoding="utf-8")
+    return path
+
+
+def fmu_axes(path: str | Path) -> list:
+    """What an FMU built from the parameter file ``path`` runs: [(axes.Axis, model on that
+    axis, parameters)], one entry for a one-axis file, six for a six-axis file."""
+    path = Path(path)
+    if path.suffix.lower() != ".ssv" and _json_document(path).get("model") == SIX_AXIS_IDENTIFIER \
+            or path.suffix.lower() == ".ssv" and ET.parse(path).getroot().get("name") == SIX_AXIS_IDENTIFIER:
+        six = read_six_axis(path)
+        return [(axis, six.axes[axis.name].model, six.axes[axis.name].parameters) for axis in SIX_AXES]
+    one = read_parameter_set(path)
+    return [(ONE_AXIS, one.model, one.parameters)]

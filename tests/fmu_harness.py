@@ -19,7 +19,10 @@ STATUS_NAMES = ["ok", "warning", "discard", "error", "fatal", "pending"]
 class BushingFmu:
     """One FMU instance, initialised and ready to step."""
 
-    def __init__(self, fmu_path, instance_name="bushing", start_values=None, x0_m=0.0, v0_m_s=0.0):
+    def __init__(self, fmu_path, instance_name="bushing", start_values=None, x0_m=0.0, v0_m_s=0.0,
+                 initial_inputs=None):
+        """``initial_inputs``: {port: value} set before initialisation ends (default: x and v of a
+        one-axis FMU from ``x0_m``, ``v0_m_s``)."""
         self.description = read_model_description(fmu_path)
         self.refs = {v.name: v.valueReference for v in self.description.modelVariables}
         self.messages: list[tuple[str, str, str]] = []  # (status, category, message)
@@ -36,8 +39,8 @@ class BushingFmu:
         self.fmu.enterInitializationMode()
         for name, value in (start_values or {}).items():
             self.set(name, value)
-        self.set("x", x0_m)
-        self.set("v", v0_m_s)
+        for name, value in (initial_inputs if initial_inputs is not None else {"x": x0_m, "v": v0_m_s}).items():
+            self.set(name, value)
         self.fmu.exitInitializationMode()
         self.time = 0.0
 

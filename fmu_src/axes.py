@@ -1,0 +1,119 @@
+"""The axes of a bushing FMU: their ports, units, and how their values reach a model's kernels.
+
+A one-axis FMU has one axis: ports ``x`` [m], ``v`` [m/s], ``F`` [N], parameters named as the
+model names them. The six-axis FMU (``SixAxisBushing``) joins two markers I and J of a
+multibody model: three translational axes x, y, z and three rotational axes rx, ry, rz, all in
+the axes of marker J, each one of the four models and uncoupled from the others (the diagonal
+bushing of MSC Adams' BUSHING, Project Chrono's ``ChLoadBodyBodyBushing*``, Simbody's
+``LinearBushing``). Its parameters and locals are named ``<axis>.<name>`` (``x.k0``, ``rz.c``).
+
+Units. Every port is SI. A translational axis works in the paper's N-mm-s units (the kernels
+see mm and mm/s; the force is in N). A rotational axis reads an angle where a translational one
+reads millimetres: the kernels see rad and rad/s and return N.mm, which the port gives as N.m;
+its parameters are the translational ones with mm replaced by rad and N by N.mm (k in
+N.mm/rad, c in N.mm.s/rad, z in N.mm, beta and gamma in (N.mm)^(1-n)/rad, x0 in rad, preload
+in N.mm), so a one-axis parameter set typed for a torsion test reads the same.
+
+Small rotations. ``rx, ry, rz`` is the rotation vector (axis times angle) of I relative to J;
+as in Adams and Chrono, each component is taken as the angle about its own axis, which holds
+for small angles only: above ``SMALL_ANGLE_RAD`` (0.35 rad, 20 degrees) the components of a
+rotation depend on the order of rotations by more than a few per cent, and the FMU warns.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+from .model_definition import BushingModel
+
+SMALL_ANGLE_RAD = 0.35
+"""Above this rotation the small-angle bushing is an approximation worth a warning."""
+PLAUSIBLE_TRAVEL_M = 0.1
+"""|x| beyond this is far outside any rubber bushing's travel: most likely millimetres entered
+where metres are expected. Warned about, not refused."""
+PLAUSIBLE_ANGULAR_VELOCITY_RAD_S = 50.0
+"""The rotational counterpart of model_definition.PLAUSIBLE_VELOCITY_MM_S (for the force bound)."""
+
+ROTATIONAL_UNITS = {
+    "N/mm": "N.mm/rad", "N.s/mm": "N.mm.s/rad", "mm": "rad", "N": "N.mm", "1": "1",
+    "N^(1-n)/mm": "(N.mm)^(1-n)/rad", "N^(1-n1)/mm": "(N.mm)^(1-n1)/rad", "N^(1-n2)/mm": "(N.mm)^(1-n2)/rad",
+}
+"""A translational parameter's unit -> the same parameter's unit on a rotational axis."""
+
+
+@dataclass(frozen=True)
+class Axis:
+    """One axis of an FMU: its name (empty for a one-axis FMU) and port names."""
+    name: str
+    displacement: str
+    velocity: str
+    output: str
+    rotational: bool = False
+
+    @property
+    def prefix(self) -> str:
+        """What the axis's parameter and local names start with ("x." ...; "" for one axis)."""
+        return f"{self.name}." if self.name else ""
+
+    @property
+    def label(self) -> str:
+        """How messages name the axis ("axis rz: "; "" for one axis)."""
+        return f"axis {self.name}: " if self.name else ""
+
+    @property
+    def to_kernel(self) -> float:
+        """Port value -> kernel value: m -> mm (translational), rad -> rad (rotational)."""
+        return 1.0 if self.rotational else 1000.0
+
+    @property
+    def from_kernel(self) -> float:
+        """Kernel force -> port: N -> N (translational), N.mm -> N.m (rotational)."""
+        return 1e-3 if self.rotational else 1.0
+
+    @property
+    def displacement_unit(self) -> str:
+        return "rad" if self.rotational else "m"
+
+    @property
+    def velocity_unit(self) -> str:
+        return "rad/s" if self.rotational else "m/s"
+
+    @property
+    def output_unit(self) -> str:
+        return "N.m" if self.rotational else "N"
+
+    @property
+    def plausible_travel(self) -> float:
+        """Port displacement above which the FMU warns (once)."""
+        return SMALL_ANGLE_RAD if self.rotational else PLAUSIBLE_TRAVEL_M
+
+    def state_port(self, unit: str) -> tuple[str, float]:
+        """(FMU unit, kernel -> port factor) of a state declared in "N" or "m" (model_definition)."""
+        if unit == "N":
+            return ("N.m", 1e-3) if self.rotational else ("N", 1.0)
+        return ("rad", 1.0) if self.rotational else ("m", 1e-3)
+
+
+ONE_AXIS = Axis("", "x", "v", "F")
+SIX_AXES = (
+    Axis("x", "dx", "vx", "Fx"), Axis("y", "dy", "vy", "Fy"), Axis("z", "dz", "vz", "Fz"),
+    Axis("rx", "rx", "wx", "Mx", rotational=True), Axis("ry", "ry", "wy", "My", rotational=True),
+    Axis("rz", "rz", "wz", "Mz", rotational=True),
+)
+SIX_AXIS_NAMES = tuple(axis.name for axis in SIX_AXES)
+SIX_AXIS_IDENTIFIER = "SixAxisBushing"
+
+
+def model_on_axis(model: BushingModel, axis: Axis) -> BushingModel:
+    """``model`` with the parameter units of ``axis`` (the same kernels and checks)."""
+    if not axis.rotational:
+        return model
+    specs = tuple(replace(spec, unit=ROTATIONAL_UNITS[spec.unit]) for spec in model.specs)
+    return replace(model, specs=specs, title=f"{model.title}, rotational")
+
+
+def six_axis(name: str) -> Axis:
+    """The axis called ``name`` (x, y, z, rx, ry, rz)."""
+    for axis in SIX_AXES:
+        if axis.name == name:
+            return axis
+    raise ValueError(f"unknown axis {name!r}; the six axes are {', '.join(SIX_AXIS_NAMES)}")
