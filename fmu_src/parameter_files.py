@@ -147,16 +147,23 @@ def _read_ssv(path: Path, expected: BushingModel | None):
             raise ParameterError(f"{path}: parameter {name!r} is not an ssv:Real")
         raw[name] = (real.get("value"), real.get("unit"))
     model = _model_of_ssv(root.get("name"), set(raw)) or expected or MODELS["proposed"]
+    return model, _ssv_values(raw, model, f"{path}", " (the paper's N-mm-s units)"), {}
+
+
+def _ssv_values(raw: Mapping[str, tuple[str | None, str | None]], model: BushingModel, where: str,
+                units_note: str = "") -> dict[str, float]:
+    """{name: (value text, unit or None)} as floats, each unit checked against ``model``'s;
+    ParameterError starts with ``where`` (the file, and the axis)."""
     values = {}
     for name, (text, unit) in raw.items():
         if unit is not None and name in model.units and unit != model.units[name]:
-            raise ParameterError(f"{path}: parameter {name} has unit {unit!r}; expected "
-                                 f"{model.units[name]!r} (the paper's N-mm-s units)")
+            raise ParameterError(f"{where}: parameter {name} has unit {unit!r}; expected "
+                                 f"{model.units[name]!r}{units_note}")
         try:
             values[name] = float(text)
         except (TypeError, ValueError):
-            raise ParameterError(f"{path}: parameter {name} = {text!r} is not a number") from None
-    return model, values, {}
+            raise ParameterError(f"{where}: parameter {name} = {text!r} is not a number") from None
+    return values
 
 
 def _model_of_ssv(set_name: str | None, names: set[str]) -> BushingModel | None:
@@ -301,15 +308,7 @@ def _read_six_axis_ssv(path: Path) -> SixAxisSet:
                                  "any model (" + "; ".join(f"{m.name}: {', '.join(m.parameter_names)}"
                                                             for m in MODELS.values()) + ")")
         model = model_on_axis(base, axis)
-        values = {}
-        for name, (text, unit) in raw.items():
-            if unit is not None and unit != model.units[name]:
-                raise ParameterError(f"{path}, axis {axis.name}: parameter {name} has unit {unit!r}; expected "
-                                     f"{model.units[name]!r}")
-            try:
-                values[name] = float(text)
-            except (TypeError, ValueError):
-                raise ParameterError(f"{path}, axis {axis.name}: parameter {name} = {text!r} is not a number") from None
+        values = _ssv_values(raw, model, f"{path}, axis {axis.name}")
         try:
             axes[axis.name] = ParameterSet(model, model.check(values))
         except ParameterError as exc:
