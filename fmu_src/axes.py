@@ -23,6 +23,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
+from .bushing_params import ParameterError
 from .model_definition import BushingModel
 
 SMALL_ANGLE_RAD = 0.35
@@ -116,4 +117,4 @@ def six_axis(name: str) -> Axis:
     for axis in SIX_AXES:
         if axis.name == name:
             return axis
-    raise ValueError(f"unknown axis {name!r}; the six axes are {', '.join(SIX_AXIS_NAMES)}")
+    raise ParameterError(f"unknown axis {name!r}; the six axes are {', '.join(SIX_AXIS_NAMES)}")

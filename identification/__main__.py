@@ -121,6 +121,18 @@ def main(argv: list[str] | None = None) -> int:
     fleet_parser.add_argument("--out", type=Path, required=True, help="directory for <name>.json and summary.csv")
     _add_search_arguments(fleet_parser)
 
+    assemble_parser = commands.add_parser(
+        "assemble", help="build a six-axis parameter file (SixAxisBushing) from one fit per axis")
+    assemble_parser.add_argument("--axis", action="append", default=[], metavar="NAME=FILE",
+                                 help="an axis (x, y, z, rx, ry, rz) and its one-axis parameter or fit file; "
+                                      "repeat for each axis. Rotational axes (rx, ry, rz) read in N.mm, rad, s")
+    assemble_parser.add_argument("--out", type=Path, required=True, help="six-axis file to write (.json or .ssv)")
+    missing = assemble_parser.add_mutually_exclusive_group()
+    missing.add_argument("--rigid-missing", action="store_true",
+                         help="an axis without a file becomes a stiff Kelvin-Voigt spring")
+    missing.add_argument("--default", type=Path, metavar="SIX.json",
+                         help="an axis without a file takes its set from this six-axis file")
+
     args = parser.parse_args(argv)
     with warnings.catch_warnings():
         # A user reads the warning, not where in our code it was raised.
@@ -128,7 +140,7 @@ def main(argv: list[str] | None = None) -> int:
                                                                                   file=sys.stderr)
         try:
             handler = {"sensitivity": _sensitivity, "report": _report, "compare": _compare, "predict": _predict,
-                       "design": _design, "fit-many": _fit_many}.get(args.command, _fit)
+                       "design": _design, "fit-many": _fit_many, "assemble": _assemble}.get(args.command, _fit)
             return handler(args)
         except (IdentificationError, ParameterError, EngineError, UsageError) as exc:
             print(f"error: {exc}", file=sys.stderr)
@@ -327,6 +339,22 @@ def _design(args) -> int:
     from identification.design import design
     result = design(read_ensemble(args.ensemble), noise_N=args.noise, progress=not args.json)
     print(json.dumps(result.as_json(args.top), indent=2) if args.json else result.format(args.top))
+    return 0
+
+
+def _assemble(args) -> int:
+    from identification.six_axis import assemble
+    check_output(args.out, "--out", suffixes=(".json", ".ssv"))
+    files = {}
+    for item in args.axis:
+        name, separator, file = item.partition("=")
+        if not separator or not file:
+            raise UsageError(f"--axis {item}: give NAME=FILE, e.g. --axis rz=fit_torsion.json")
+        if name in files:
+            raise UsageError(f"--axis {name} is given twice")
+        files[name] = Path(file)
+    path = assemble(files, args.out, rigid_missing=args.rigid_missing, default=args.default)
+    print(f"wrote {path}")
     return 0
 
 

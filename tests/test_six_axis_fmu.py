@@ -203,3 +203,32 @@ def test_six_axis_parameter_file_errors_name_the_axis(tmp_path):
     ssv.write_text(ssv.read_text().replace('unit="N.mm/rad"', 'unit="N/mm"', 1))
     with pytest.raises(ParameterError, match="axis rx: parameter k has unit 'N/mm'; expected 'N.mm/rad'"):
         read_six_axis(ssv)
+
+
+def test_assemble_builds_the_six_axis_file_from_one_file_per_axis(tmp_path):
+    from identification.__main__ import main
+    files = {"x": DATA / "params_table5_combined.json", "y": DATA / "params_table2_sine.json",
+             "z": DATA / "params_spencer_fit_synthetic_table5.json", "rx": DATA / "params_kelvin_voigt_fit_synthetic_table5.json",
+             "ry": DATA / "params_bouc_wen_fit_synthetic_table5.json", "rz": DATA / "params_table4_step.ssv"}
+    out = tmp_path / "six.json"
+    assert main(["assemble", *(f"--axis={name}={path}" for name, path in files.items()), "--out", str(out)]) == 0
+    six = read_six_axis(out)
+    from fmu_src.parameter_files import read_parameter_set
+    for name, path in files.items():
+        one = read_parameter_set(path)
+        assert (six.axes[name].model.name, six.axes[name].parameters) == (one.model.name, one.parameters)
+    assert six.axes["rz"].model.units["k0"] == "N.mm/rad"       # read as a rotational axis
+    assert json.loads(out.read_text())["fit"]["assembled_from"]["rz"] == str(files["rz"])
+
+
+def test_assemble_refuses_a_missing_axis_unless_told_how_to_fill_it(tmp_path, capsys):
+    from identification.__main__ import main
+    only_x = ["assemble", "--axis", f"x={DATA / 'params_table5_combined.json'}"]
+    assert main([*only_x, "--out", str(tmp_path / "a.json")]) == 2
+    assert "no parameter file for the axes y, z, rx, ry, rz" in capsys.readouterr().err
+    assert main([*only_x, "--rigid-missing", "--out", str(tmp_path / "b.json")]) == 0
+    assert read_six_axis(tmp_path / "b.json").axes["rz"].parameters == {"k": 1e7, "c": 0.0, "preload": 0.0}
+    assert main([*only_x, "--default", str(DEFAULT), "--out", str(tmp_path / "c.ssv")]) == 0
+    assert read_six_axis(tmp_path / "c.ssv").axes["z"].parameters == read_six_axis(DEFAULT).axes["z"].parameters
+    assert main(["assemble", "--axis", "q=x.json", "--out", str(tmp_path / "d.json")]) == 2
+    assert "unknown axis 'q'" in capsys.readouterr().err
