@@ -232,3 +232,23 @@ def test_assemble_refuses_a_missing_axis_unless_told_how_to_fill_it(tmp_path, ca
     assert read_six_axis(tmp_path / "c.ssv").axes["z"].parameters == read_six_axis(DEFAULT).axes["z"].parameters
     assert main(["assemble", "--axis", "q=x.json", "--out", str(tmp_path / "d.json")]) == 2
     assert "unknown axis 'q'" in capsys.readouterr().err
+
+
+def test_six_axis_ssv_reads_in_fmpy_with_the_fmus_names(tmp_path):
+    from fmpy.ssp.ssd import read_ssv
+    six = read_six_axis(DEFAULT)
+    path = save_six_axis(tmp_path / "six.ssv", {n: (o.model.name, o.parameters) for n, o in six.axes.items()})
+    assert {p.name: float(p.value) for p in read_ssv(str(path)).parameters} == six.flat()
+
+
+def test_a_kelvin_voigt_axis_is_k_d_plus_c_v_plus_preload_in_si(six_axis_fmu):
+    # rx is Kelvin-Voigt: M = (k*theta + c*omega + preload) N.mm -> N.m, exactly (no state)
+    fmu = BushingFmu(six_axis_fmu, start_values={"rx.preload": 50.0}, initial_inputs={})
+    p = dict(read_six_axis(DEFAULT).axes["rx"].parameters, preload=50.0)
+    for theta, omega in ((0.01, 0.3), (-0.02, 1.5), (0.0, -2.0)):
+        fmu.set("rx", theta)
+        fmu.set("wx", omega)
+        assert fmu.do_step(1e-3) == "ok"
+        end = theta + omega * 1e-3      # the step's input path: rx + wx*t
+        assert fmu.get("Mx") == pytest.approx((p["k"] * end + p["c"] * omega + p["preload"]) * 1e-3, rel=1e-15)
+    fmu.free()
