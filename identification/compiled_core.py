@@ -1,11 +1,9 @@
 """The bushing models compiled with numba, for simulating whole populations of parameter sets.
 
-One definition. For each model, the source of its module (``fmu_src/<name>_model.py``) is
-written, with the population loop below appended, into a generated module in the cache folder
-(:func:`cache_directory`), where its kernels are replaced by numba-compiled versions of
-themselves; its imports of the shared machinery (``fmu_src/integration.py``) are pointed at a
-generated module of that machinery, compiled the same way, so that every kernel calls the
-others compiled. The FMU runs the same functions as plain Python;
+One definition. Each model's own source (``fmu_src/<name>_model.py``) is compiled by
+``fmu_src/compiled_kernels.py`` (a generated module named after its content, in the cache
+folder, its kernels and the shared machinery compiled), with the population loop below
+appended. The FMU runs the same functions, as plain Python or compiled the same way;
 ``tests/test_compiled_core.py`` checks the two agree bitwise for every model. Compilation
 takes a few seconds on a model's first use; numba caches the machine code on disk, so later
 processes load it.
@@ -15,24 +13,19 @@ own in its spec order (``parameter_matrix``).
 """
 from __future__ import annotations
 
-import hashlib
-import importlib.util
 import inspect
-import os
-import sys
 import types
-import warnings
 from pathlib import Path
 from typing import Mapping
 
 import numba
 import numpy as np
 
-from fmu_src import integration
+from fmu_src import compiled_kernels as _kernels, integration
 from fmu_src.bushing_models import get_model
 from fmu_src.proposed_model import PARAMETER_NAMES  # noqa: F401  (the proposed model's order, for callers)
 
-CACHE_ENVIRONMENT = "BUSHING_CACHE_DIR"
+CACHE_ENVIRONMENT = _kernels.CACHE_ENVIRONMENT
 _MAX_SUBSTEPS = integration.DEFAULT_MAX_SUBSTEPS
 
 
@@ -43,7 +36,7 @@ def _population_forces(matrix, t, x, v, out_index, out_velocity, max_substeps):
     direct feedthrough of the velocity set at that instant).
 
     Written here, never called here: its source is compiled in each model's generated module
-    (see :func:`_model_source`), where ``prepare`` ... ``force`` are that model's compiled
+    (see :func:`_population_appendix`), where ``prepare`` ... ``force`` are that model's compiled
     kernels and ``_VALUES(row)`` the row's values as the tuple ``prepare`` takes."""
     count, samples, outputs = matrix.shape[0], t.size, out_index.size
     forces = np.full((count, outputs), np.nan)
@@ -74,30 +67,11 @@ def _population_forces(matrix, t, x, v, out_index, out_velocity, max_substeps):
     return forces
 
 
-_JIT_KERNELS = (
-    # error_model="numpy": a division by zero gives inf/nan (caught as NOT_FINITE) instead of an
-    # exception that would abort the whole population.
-    "for _name in KERNELS:\n"
-    "    globals()[_name] = numba.njit(error_model='numpy', cache=True)(globals()[_name])\n")
-
-
-def _integration_source() -> str:
-    """The shared machinery, its kernels compiled."""
-    return inspect.getsource(integration) + "\n\n# ---- appended by identification/compiled_core.py ----\n" \
-        + "import numba\n\n" + _JIT_KERNELS
-
-
-def _model_source(model_name: str, integration_module: str) -> str:
-    """One model's module, its kernels compiled, and the population loop. Its relative imports
-    point at the package (plain Python: specs, checks) and at the compiled machinery."""
-    bushing = get_model(model_name)
-    source = inspect.getsource(sys.modules[bushing.kernel_module])
-    source = source.replace("from .integration import", f"from {integration_module} import")
-    source = source.replace("from .", "from fmu_src.")
-    values = ", ".join(f"row[{i}]" for i in range(len(bushing.specs)))
-    return (source + "\n\n# ---- appended by identification/compiled_core.py ----\n"
-            + f"import numba\nimport numpy as np\nfrom {integration_module} import OK as _OK\n\n"
-            + _JIT_KERNELS + "\n\n"
+def _population_appendix(model) -> str:
+    """The population loop for ``model``: ``_VALUES(row)`` (the row's values as the tuple its
+    ``prepare`` takes) and ``_simulate_population``."""
+    values = ", ".join(f"row[{i}]" for i in range(len(model.specs)))
+    return ("\n\nimport numpy as np\nfrom " + _kernels.integration_module() + " import OK as _OK\n\n"
             + f"@numba.njit(cache=True)\ndef _VALUES(row):\n    return ({values},)\n\n\n"
             + inspect.getsource(_population_forces)
             + "\n\n_simulate_population = numba.njit(error_model='numpy', parallel=True, cache=True)"
@@ -105,60 +79,19 @@ def _model_source(model_name: str, integration_module: str) -> str:
 
 
 def cache_directory() -> Path:
-    """Where the generated modules and numba's cache live: $BUSHING_CACHE_DIR, else
-    $XDG_CACHE_HOME/boucwen-bushing, else ~/.cache/boucwen-bushing."""
-    if os.environ.get(CACHE_ENVIRONMENT):
-        return Path(os.environ[CACHE_ENVIRONMENT])
-    return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "boucwen-bushing"
-
-
-def _module_name(prefix: str, source: str) -> str:
-    """Named after a hash of the content, so that a change to a model, to the machinery or to
-    the loop compiles afresh (numba's cache checks only the file's own time stamp, not the
-    sources of the functions a kernel calls; a model's source names the machinery's hash)."""
-    return f"{prefix}_{hashlib.sha256(source.encode()).hexdigest()[:16]}"
-
-
-def _load_generated(name: str, source: str):
-    if name in sys.modules:
-        return sys.modules[name]
-    try:
-        folder = cache_directory()
-        folder.mkdir(parents=True, exist_ok=True)
-        path = folder / f"{name}.py"
-        if not path.is_file() or path.read_text() != source:
-            # Written whole and renamed: worker processes start at once and must never read half a file.
-            partial = path.with_suffix(f".{os.getpid()}.tmp")
-            partial.write_text(source)
-            os.replace(partial, path)
-    except OSError as exc:
-        warnings.warn(f"cannot write the compiled model's cache in {cache_directory()} ({exc}); compiling "
-                      f"in memory at every start (set {CACHE_ENVIRONMENT} to a writable folder)", stacklevel=4)
-        module = types.ModuleType(name)
-        sys.modules[name] = module
-        exec(compile(source.replace(", cache=True", "").replace("(cache=True)", "()"), f"<{name}>", "exec"),
-             module.__dict__)
-        return module
-    spec = importlib.util.spec_from_file_location(name, path)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module
-    spec.loader.exec_module(module)
-    return module
+    """Where the generated modules and numba's cache live (``fmu_src.compiled_kernels``)."""
+    return _kernels.cache_directory()
 
 
 _compiled_models: dict[str, types.ModuleType] = {}
 
 
 def compiled_model(model: str = "proposed") -> types.ModuleType:
-    """The generated, compiled module of ``model`` (loaded on first use)."""
-    name = get_model(model).name
-    if name not in _compiled_models:
-        machinery_source = _integration_source()
-        machinery = _module_name("bushing_integration", machinery_source)
-        _load_generated(machinery, machinery_source)
-        source = _model_source(name, machinery)
-        _compiled_models[name] = _load_generated(_module_name(f"bushing_{name}", source), source)
-    return _compiled_models[name]
+    """The generated, compiled module of ``model`` with the population loop (loaded on first use)."""
+    bushing = get_model(model)
+    if bushing.name not in _compiled_models:
+        _compiled_models[bushing.name] = _kernels.compiled_module(bushing, _population_appendix(bushing))
+    return _compiled_models[bushing.name]
 
 
 def simulate_population_held(parameter_sets, time_s, displacement_mm, velocity_mm_s,

@@ -1,0 +1,126 @@
+"""The models' kernels compiled with numba from their own source, cached on disk.
+
+One definition, two ways to run it. For a model, the source of its module (``proposed_model``
+...) is written into a generated module in the cache folder (:func:`cache_directory`), where
+its kernels (``KERNELS``) are replaced by numba-compiled versions of themselves; its imports of
+the shared machinery (``integration``) are pointed at a generated module of that machinery,
+compiled the same way, so that every kernel calls the others compiled. Generated modules are
+named after a hash of their content: a changed model or machinery compiles afresh (numba's cache
+checks only a file's own time stamp, not the sources of the functions a kernel calls), and
+numba's on-disk cache lets the next process load the machine code instead of compiling.
+
+Users: the FMU (:func:`compiled_model`, when numba is importable in the host's Python; the slave
+falls back to the plain-Python kernels otherwise) and the identification
+(``identification/compiled_core.py``, which appends its population loop). Numba is optional
+here: nothing imports it until a model is compiled.
+"""
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import importlib.util
+import inspect
+import os
+import sys
+import time
+import types
+import warnings
+from pathlib import Path
+
+from . import integration
+
+CACHE_ENVIRONMENT = "BUSHING_CACHE_DIR"
+
+_JIT_KERNELS = (
+    # error_model="numpy": a division by zero gives inf/nan (caught as NOT_FINITE) instead of an
+    # exception that would abort a whole population.
+    "for _name in KERNELS:\n"
+    "    globals()[_name] = numba.njit(error_model='numpy', cache=True)(globals()[_name])\n")
+
+
+def cache_directory() -> Path:
+    """Where the generated modules and numba's cache live: $BUSHING_CACHE_DIR, else
+    $XDG_CACHE_HOME/boucwen-bushing, else ~/.cache/boucwen-bushing."""
+    if os.environ.get(CACHE_ENVIRONMENT):
+        return Path(os.environ[CACHE_ENVIRONMENT])
+    return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "boucwen-bushing"
+
+
+def module_name(prefix: str, source: str) -> str:
+    """``prefix`` and a hash of ``source``."""
+    return f"{prefix}_{hashlib.sha256(source.encode()).hexdigest()[:16]}"
+
+
+def load_generated(name: str, source: str) -> types.ModuleType:
+    """The module ``name`` with ``source``, written to the cache folder and imported (once per
+    process); in memory, uncached, if the folder cannot be written."""
+    if name in sys.modules:
+        return sys.modules[name]
+    try:
+        folder = cache_directory()
+        folder.mkdir(parents=True, exist_ok=True)
+        path = folder / f"{name}.py"
+        if not path.is_file() or path.read_text() != source:
+            # Written whole and renamed: worker processes start at once and must never read half a file.
+            partial = path.with_suffix(f".{os.getpid()}.tmp")
+            partial.write_text(source)
+            os.replace(partial, path)
+    except OSError as exc:
+        warnings.warn(f"cannot write the compiled model's cache in {cache_directory()} ({exc}); compiling "
+                      f"in memory at every start (set {CACHE_ENVIRONMENT} to a writable folder)", stacklevel=4)
+        module = types.ModuleType(name)
+        sys.modules[name] = module
+        exec(compile(source.replace(", cache=True", "").replace("(cache=True)", "()"), f"<{name}>", "exec"),
+             module.__dict__)
+        return module
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+def integration_module() -> str:
+    """The name of the compiled copy of the shared machinery (generated and loaded)."""
+    source = (inspect.getsource(integration) + "\n\n# ---- appended by fmu_src/compiled_kernels.py ----\n"
+              + "import numba\n\n" + _JIT_KERNELS)
+    name = module_name("bushing_integration", source)
+    load_generated(name, source)
+    return name
+
+
+def model_source(model, machinery: str, appendix: str = "") -> str:
+    """``model``'s module (a ``BushingModel``'s kernel module), its kernels compiled, and
+    ``appendix``. Its relative imports point at its own package (plain Python: specs, checks)
+    and at the compiled machinery ``machinery``."""
+    module = sys.modules[model.kernel_module]
+    source = inspect.getsource(module)
+    source = source.replace("from .integration import", f"from {machinery} import")
+    source = source.replace("from .", f"from {module.__package__}.")
+    return (source + "\n\n# ---- appended by fmu_src/compiled_kernels.py ----\nimport numba\n\n" + _JIT_KERNELS
+            + appendix)
+
+
+def compiled_module(model, appendix: str = "", prefix: str = "bushing") -> types.ModuleType:
+    """The generated, compiled module of ``model`` with ``appendix`` (loaded once per process)."""
+    source = model_source(model, integration_module(), appendix)
+    return load_generated(module_name(f"{prefix}_{model.name}", source), source)
+
+
+def compiled_model(model):
+    """(``model`` with its five kernels compiled, seconds it took) — compiling now, or loading
+    numba's cached machine code — or (None, why not) if numba cannot be imported."""
+    try:
+        import numba  # noqa: F401
+    except Exception as exc:   # not installed, or broken in this host's Python
+        return None, f"numba is not importable here ({type(exc).__name__}: {exc})"
+    started = time.perf_counter()
+    module = compiled_module(model, prefix="bushing_fmu")
+    kernels = {name: getattr(module, name) for name in ("prepare", "initial_state", "jump", "integrate", "force")}
+    compiled = dataclasses.replace(model, **kernels)
+    constants = compiled.prepare(model.values({s.name: 1.0 for s in model.specs}))   # compile (or load) now:
+    state = compiled.initial_state(constants, 0.0)                                  # a first step must not wait
+    state, _ = compiled.jump(constants, state, 1e-3)
+    compiled.integrate(constants, state, 1e-3, 0.0, 1e-3, 10)
+    compiled.force(constants, state, 0.0, 0.0)
+    return compiled, time.perf_counter() - started
