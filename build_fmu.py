@@ -36,7 +36,8 @@ from xml.dom.minidom import parseString
 from xml.etree import ElementTree as ET
 
 REPO = Path(__file__).resolve().parent
-LIBRARY_MODULES = ("bushing_params.py", "model_definition.py", "integration.py", "axes.py", "proposed_model.py",
+LIBRARY_MODULES = ("bushing_params.py", "model_definition.py", "integration.py", "compiled_kernels.py", "axes.py",
+                   "proposed_model.py",
                    "spencer_model.py", "bouc_wen_model.py", "kelvin_voigt_model.py", "bushing_models.py",
                    "parameter_files.py")
 SLAVE_MODULE = "bushing_slave.py"
@@ -52,9 +53,12 @@ from fmu_src.parameter_files import (fmu_axes, parameter_document, read_paramete
 PACKED_LIBRARY_INIT = '''"""Packed library of the bushing FMU (written by build_fmu.py)."""
 from pathlib import Path
 
-from . import axes, bushing_models, integration, model_definition, parameter_files
+from . import axes, bushing_models, compiled_kernels, integration, model_definition, parameter_files
 
-AXES = parameter_files.fmu_axes(Path(__file__).with_name("default_parameters.json"))
+# Compiled here, once per process, while the extracted files surely exist (a host may delete them
+# after the first instance); STEP says which step runs (logged by every instance).
+AXES, STEP = compiled_kernels.compile_axes(
+    parameter_files.fmu_axes(Path(__file__).with_name("default_parameters.json")))
 '''
 SIX_AXIS = "six_axis"
 SIX_AXIS_DEFAULT_FILE = "params_six_axis_illustrative.json"

@@ -4,6 +4,10 @@
 
 Both FMUs are driven the same way through fmpy's FMI 2.0 API: set x and v, doStep(1 ms),
 get F, on the paper's identification sine (2 mm, 10 Hz). The trivial FMU computes F = 2*x.
+The six-axis FMU (all six axes the proposed model with Table 5) is measured against a trivial
+six-axis pythonfmu FMU with the same 12 inputs and 6 outputs. Everything is measured twice: with
+the compiled step (numba, the default where importable) and, in a second process, with the
+pure-Python step (BUSHING_FMU_STEP=python).
 Runs alternate between the two FMUs and the median of the repeats is reported, so both
 see the same machine state. Also printed: the model core alone (no FMI), and the real-time
 factor (simulated time / wall time) of one bushing.
@@ -11,9 +15,12 @@ factor (simulated time / wall time) of one bushing.
 from __future__ import annotations
 
 import argparse
+import json
 import math
+import os
 import platform
 import statistics
+import subprocess
 import sys
 import tempfile
 import time
@@ -41,10 +48,36 @@ class TrivialGain(Fmi2Slave):
         return True
 '''
 
+TRIVIAL_SIX_AXIS_SLAVE = '''
+from pythonfmu import Fmi2Causality, Fmi2Slave, Real
+
+PORTS = (("dx", "vx", "Fx"), ("dy", "vy", "Fy"), ("dz", "vz", "Fz"), ("rx", "wx", "Mx"), ("ry", "wy", "My"),
+         ("rz", "wz", "Mz"))
+
+
+class TrivialSixAxis(Fmi2Slave):
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        for x, v, f in PORTS:
+            for name in (x, v, f):
+                setattr(self, name, 0.0)
+            self.register_variable(Real(x, causality=Fmi2Causality.input))
+            self.register_variable(Real(v, causality=Fmi2Causality.input))
+            self.register_variable(Real(f, causality=Fmi2Causality.output))
+
+    def do_step(self, current_time, step_size):
+        for x, v, f in PORTS:
+            setattr(self, f, 2.0 * getattr(self, x))
+        return True
+'''
+
 STEP_S = 1e-3
+ONE_AXIS_PORTS = (("x", "v"), ("F",))
+SIX_AXIS_PORTS = (("dx", "vx", "dy", "vy", "dz", "vz", "rx", "wx", "ry", "wy", "rz", "wz"),
+                  ("Fx", "Fy", "Fz", "Mx", "My", "Mz"))
 
 
-def open_instance(fmu_path):
+def open_instance(fmu_path, ports):
     from fmpy import extract, read_model_description
     from fmpy.fmi2 import FMU2Slave
     description = read_model_description(fmu_path)
@@ -55,17 +88,18 @@ def open_instance(fmu_path):
     fmu.setupExperiment(startTime=0.0)
     fmu.enterInitializationMode()
     fmu.exitInitializationMode()
-    return fmu, [refs["x"], refs["v"]], [refs["F"]]
+    inputs, outputs = ports
+    return fmu, [refs[n] for n in inputs], [refs[n] for n in outputs]
 
 
-def time_fmu(fmu_path, inputs):
-    """Seconds per step (set x, v; doStep; get F) over the given input samples [m, m/s]."""
-    fmu, input_refs, output_refs = open_instance(fmu_path)
+def time_fmu(fmu_path, inputs, ports=ONE_AXIS_PORTS):
+    """Seconds per step (set the inputs; doStep; get the outputs) over the given input rows."""
+    fmu, input_refs, output_refs = open_instance(fmu_path, ports)
     set_real, get_real, do_step = fmu.setReal, fmu.getReal, fmu.doStep
     started = time.perf_counter()
     t = 0.0
-    for x, v in inputs:
-        set_real(input_refs, [x, v])
+    for row in inputs:
+        set_real(input_refs, row)
         do_step(t, STEP_S)
         get_real(output_refs)
         t += STEP_S
@@ -92,45 +126,80 @@ def time_core(inputs_mm):
     return (time.perf_counter() - started) / len(inputs_mm), substeps / len(inputs_mm)
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--steps", type=int, default=5000, help="steps per run (default 5000 = 5 s)")
-    parser.add_argument("--repeats", type=int, default=5)
-    args = parser.parse_args()
-
+def measure(steps: int, repeats: int) -> dict:
+    """Median seconds per step of each FMU, in this process (whose step, compiled or pure
+    Python, $BUSHING_FMU_STEP chooses), the FMUs alternating run by run."""
     import build_fmu
+    from fmu_src.parameter_files import load_parameters, save_six_axis
     from pythonfmu.builder import FmuBuilder
 
     with tempfile.TemporaryDirectory() as work:
         work = Path(work)
         bushing = build_fmu.build_fmu(out_dir=work)
-        script = work / "trivial_gain_bench.py"
-        script.write_text(TRIVIAL_SLAVE)
-        trivial = FmuBuilder.build_FMU(script, dest=work)
+        table5 = load_parameters(REPO / "data" / "params_table5_combined.json")
+        all_proposed = save_six_axis(work / "six_proposed.json", {a: ("proposed", table5) for a in
+                                                                 ("x", "y", "z", "rx", "ry", "rz")})
+        six = build_fmu.build_fmu(all_proposed, work, model="six_axis")
+        trivial, trivial_six = [], []
+        for name, text in (("trivial_gain_bench.py", TRIVIAL_SLAVE), ("trivial_six_axis_bench.py", TRIVIAL_SIX_AXIS_SLAVE)):
+            script = work / name
+            script.write_text(text)
+            (trivial if name.startswith("trivial_gain") else trivial_six).append(FmuBuilder.build_FMU(script, dest=work))
 
         omega = 2 * math.pi * 10.0
         inputs_mm = [(2.0 * math.sin(omega * k * STEP_S), 2.0 * omega * math.cos(omega * k * STEP_S))
-                     for k in range(args.steps)]
-        inputs_m = [(x * 1e-3, v * 1e-3) for x, v in inputs_mm]
+                     for k in range(steps)]
+        inputs_m = [[x * 1e-3, v * 1e-3] for x, v in inputs_mm]
+        # six axes: 2 mm / 10 Hz on x, y, z; 0.02 rad / 10 Hz on rx, ry, rz
+        inputs_six = [[x * 1e-3, v * 1e-3] * 3 + [x * 1e-2, v * 1e-2] * 3 for x, v in inputs_mm]
 
-        trivial_runs, bushing_runs, core_runs = [], [], []
-        for _ in range(args.repeats):
-            trivial_runs.append(time_fmu(trivial, inputs_m))
-            bushing_runs.append(time_fmu(bushing, inputs_m))
+        runs = {key: [] for key in ("trivial", "bushing", "core", "trivial_six", "six")}
+        for _ in range(repeats):
+            runs["trivial"].append(time_fmu(trivial[0], inputs_m))
+            runs["bushing"].append(time_fmu(bushing, inputs_m))
+            runs["trivial_six"].append(time_fmu(trivial_six[0], inputs_six, SIX_AXIS_PORTS))
+            runs["six"].append(time_fmu(six, inputs_six, SIX_AXIS_PORTS))
             core_time, substeps = time_core(inputs_mm)
-            core_runs.append(core_time)
+            runs["core"].append(core_time)
+    result = {key: statistics.median(values) for key, values in runs.items()}
+    result["substeps"] = substeps
+    return result
 
-    trivial_step = statistics.median(trivial_runs)
-    bushing_step = statistics.median(bushing_runs)
-    core_step = statistics.median(core_runs)
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--steps", type=int, default=5000, help="steps per run (default 5000 = 5 s)")
+    parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.child:
+        print(json.dumps(measure(args.steps, args.repeats)))
+        return
+
+    # The compiled step here; the pure-Python step in a process started with BUSHING_FMU_STEP=python
+    # (an FMU decides which it runs when its library is first imported).
+    compiled = measure(args.steps, args.repeats)
+    environment = dict(os.environ, BUSHING_FMU_STEP="python")
+    child = subprocess.run([sys.executable, __file__, "--child", "--steps", str(args.steps), "--repeats",
+                            str(args.repeats)], env=environment, capture_output=True, text=True, check=True)
+    plain = json.loads(child.stdout.strip().splitlines()[-1])
+
     print(f"machine: {platform.machine()}, {platform.processor() or 'cpu'}, Python {platform.python_version()}, "
-          f"{args.steps} steps x {args.repeats} repeats, sine 2 mm / 10 Hz, step {STEP_S * 1e3:g} ms")
-    print(f"{'what':42s} {'us/step':>9s} {'ratio':>7s}")
-    print(f"{'trivial pythonfmu FMU (F = 2x)':42s} {trivial_step * 1e6:9.1f} {1.0:7.2f}")
-    print(f"{'bushing FMU (set x,v; doStep; get F)':42s} {bushing_step * 1e6:9.1f} {bushing_step / trivial_step:7.2f}")
-    print(f"{'bushing model core alone (no FMI)':42s} {core_step * 1e6:9.1f} {core_step / trivial_step:7.2f}")
-    print(f"substeps per 1 ms step (core): {substeps:.2f}")
-    print(f"real-time factor of one bushing FMU at 1 ms: {STEP_S / bushing_step:.0f}x faster than real time")
+          f"{args.steps} steps x {args.repeats} repeats, sine 2 mm (0.02 rad) / 10 Hz, step {STEP_S * 1e3:g} ms")
+    print(f"{'what':46s} {'compiled':>9s} {'ratio':>6s} {'pure Py':>9s} {'ratio':>6s}   (us/step; ratio to "
+          "its trivial FMU in the same process)")
+    for key, label, base in (("trivial", "trivial pythonfmu FMU (F = 2x)", "trivial"),
+                             ("bushing", "bushing FMU, one axis (target <= 1.5x)", "trivial"),
+                             ("core", "bushing model core alone, pure Python", "trivial"),
+                             ("trivial_six", "trivial six-axis pythonfmu FMU (F = 2x)", "trivial_six"),
+                             ("six", "six-axis FMU, six proposed axes (<= 2x)", "trivial_six")):
+        print(f"{label:46s} {compiled[key] * 1e6:9.1f} {compiled[key] / compiled[base]:6.2f} "
+              f"{plain[key] * 1e6:9.1f} {plain[key] / plain[base]:6.2f}")
+    print(f"six-axis FMU against the one-port trivial FMU: {compiled['six'] / compiled['trivial']:.2f} (compiled), "
+          f"{plain['six'] / plain['trivial']:.2f} (pure Python)")
+    print(f"substeps per 1 ms step (core): {compiled['substeps']:.2f}")
+    print(f"real-time factor of one bushing FMU at 1 ms: {STEP_S / compiled['bushing']:.0f}x (compiled), "
+          f"{STEP_S / plain['bushing']:.0f}x (pure Python) faster than real time")
 
 
 if __name__ == "__main__":

@@ -45,11 +45,13 @@ from pythonfmu.enums import Fmi2Status
 if __package__:
     from . import axes, integration
     AXES = None   # only an FMU built by build_fmu.py has axes, models and defaults
+    STEP = None
 else:
     _library = importlib.import_module(__name__ + "_lib")
     axes = _library.axes
     integration = _library.integration
     AXES = _library.AXES   # [(axes.Axis, BushingModel on that axis, default parameters)]
+    STEP = _library.STEP   # which step runs: compiled (numba) or pure Python, and why
 
 
 class InitializationError(RuntimeError):
@@ -108,6 +110,7 @@ class BushingSlave(Fmi2Slave):
         self._initial_state_pending = True  # set at exit of initialization, or first valid step
         for a in self._axes:
             self._register_axis(a)
+        self.log(STEP, Fmi2Status.ok, "logAll")
 
     def _register_axis(self, a):
         axis, model = a.axis, a.model

@@ -124,3 +124,48 @@ def compiled_model(model):
     compiled.integrate(constants, state, 1e-3, 0.0, 1e-3, 10)
     compiled.force(constants, state, 0.0, 0.0)
     return compiled, time.perf_counter() - started
+
+
+STEP_ENVIRONMENT = "BUSHING_FMU_STEP"
+""""python": an FMU runs its plain-Python kernels although numba is importable; "compiled": it
+compiles them in any host (default: only where the host process is a Python interpreter)."""
+
+
+def _python_host() -> bool:
+    """Whether this process's executable is a Python interpreter (fmpy, libcosimpy, ...), not a
+    C/C++ tool that embeds Python (measured 2026-11-23: numba-compiled kernels in a C host that
+    embeds libpython, tests/c_host, end in heap corruption; in Python hosts they run clean)."""
+    try:
+        executable = os.path.basename(os.path.realpath("/proc/self/exe"))
+    except OSError:
+        return False
+    return executable.startswith("python")
+
+
+def compile_axes(axes) -> tuple[list, str]:
+    """An FMU's axes [(axis, model, parameters)] with each model's kernels compiled, and a
+    sentence saying which step runs; the axes unchanged (the plain-Python step) if numba is not
+    importable or fails, if the host is not a Python interpreter, or if $BUSHING_FMU_STEP is
+    "python". The compiled and the plain-Python
+    kernels give the same forces (tests/test_fmu_compiled_step.py)."""
+    choice = os.environ.get(STEP_ENVIRONMENT, "").lower()
+    if choice == "python":
+        return list(axes), f"pure-Python step ({STEP_ENVIRONMENT}=python)"
+    if choice != "compiled" and not _python_host():
+        return list(axes), ("pure-Python step: the host is not a Python interpreter, where numba-compiled "
+                            f"kernels have corrupted the heap ({STEP_ENVIRONMENT}=compiled forces them)")
+    compiled, seconds = {}, 0.0
+    try:
+        for _, model, _ in axes:
+            if model.name not in compiled:
+                kernels, info = compiled_model(model)
+                if kernels is None:
+                    return list(axes), f"pure-Python step: {info}"
+                compiled[model.name], seconds = kernels, seconds + info
+    except Exception as exc:   # a broken numba or an unwritable cache must not stop the FMU
+        return list(axes), f"pure-Python step: compiling the kernels failed ({type(exc).__name__}: {exc})"
+    names = ("prepare", "initial_state", "jump", "integrate", "force")
+    out = [(axis, dataclasses.replace(model, **{n: getattr(compiled[model.name], n) for n in names}), parameters)
+           for axis, model, parameters in axes]
+    return out, (f"compiled step (numba): {seconds:.2f} s to compile the kernels or load them from "
+                 f"{cache_directory()}")
