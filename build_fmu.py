@@ -45,9 +45,9 @@ SLAVE_MODULE = "bushing_slave.py"
 sys.path.insert(0, str(REPO))
 import fmu_src  # noqa: E402
 from fmu_src import __version__, bushing_params  # noqa: E402
-from fmu_src.axes import SIX_AXIS_IDENTIFIER  # noqa: E402
+from fmu_src.axes import ONE_AXIS, SIX_AXIS_IDENTIFIER  # noqa: E402
 from fmu_src.bushing_models import MODEL_NAMES, get_model  # noqa: E402
-from fmu_src.parameter_files import (fmu_axes, parameter_document, read_parameter_set, read_six_axis,  # noqa: E402
+from fmu_src.parameter_files import (parameter_document, read_parameter_set, read_six_axis,  # noqa: E402
                                      six_axis_document)
 
 PACKED_LIBRARY_INIT = '''"""Packed library of the bushing FMU (written by build_fmu.py)."""
@@ -96,14 +96,17 @@ def build_fmu(params_file: str | Path | None = None, out_dir: str | Path = "dist
     params_file = Path(params_file) if params_file is not None else default_parameter_file(name)
     source = {"source": f"build_fmu.py --model {name} --params {params_file.name}"}
     if six:
-        axes = read_six_axis(params_file).axes
-        defaults_json = six_axis_document({axis: (one.model.identifier, one.parameters) for axis, one in axes.items()},
-                                          source)
+        six_axes = read_six_axis(params_file)
+        defaults_json = six_axis_document({axis: (one.model.identifier, one.parameters)
+                                           for axis, one in six_axes.axes.items()}, source)
         identifier, title = SIX_AXIS_IDENTIFIER, "six-axis bushing"
+        axes = six_axes.fmu_axes()
     else:
         bushing = get_model(name)
-        defaults_json = parameter_document(read_parameter_set(params_file, name).parameters, name, source)
+        parameters = read_parameter_set(params_file, name).parameters
+        defaults_json = parameter_document(parameters, name, source)
         identifier, title = bushing.identifier, f"{bushing.title} model"
+        axes = [(ONE_AXIS, bushing, parameters)]
     defaults_text = json.dumps(defaults_json, indent=2) + "\n"
     slave_text = ((SOURCE_DIR / SLAVE_MODULE).read_text()
                   + f"\n\nclass {identifier}(BushingSlave):\n"
@@ -139,7 +142,7 @@ def build_fmu(params_file: str | Path | None = None, out_dir: str | Path = "dist
             for loaded in [m for m in sys.modules if m.startswith(module_name)]:
                 del sys.modules[loaded]
 
-    _rewrite_model_description(fmu_path, _axes_of_document(defaults_text))
+    _rewrite_model_description(fmu_path, axes)
     from fmpy.validation import validate_fmu
     problems = validate_fmu(str(fmu_path))
     if problems:
@@ -147,16 +150,9 @@ def build_fmu(params_file: str | Path | None = None, out_dir: str | Path = "dist
     return fmu_path
 
 
-def _axes_of_document(text: str) -> list:
-    """parameter_files.fmu_axes of a parameter document (what the packed library will read)."""
-    with tempfile.TemporaryDirectory(prefix="bushing_defaults_") as folder:
-        path = Path(folder) / "default_parameters.json"
-        path.write_text(text)
-        return fmu_axes(path)
-
-
 def _rewrite_model_description(fmu_path: Path, axes: list) -> None:
-    """``axes``: [(axes.Axis, model on it, parameters)] as the FMU's library builds them."""
+    """``axes``: [(axes.Axis, model on it, parameters)], what the packed library reads back from
+    the defaults it is given (parameter_files.fmu_axes)."""
     with zipfile.ZipFile(fmu_path) as archive:
         entries = {info.filename: archive.read(info.filename) for info in archive.infolist()}
     root = ET.fromstring(entries["modelDescription.xml"])

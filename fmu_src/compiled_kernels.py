@@ -107,23 +107,28 @@ def compiled_module(model, appendix: str = "", prefix: str = "bushing") -> types
     return load_generated(module_name(f"{prefix}_{model.name}", source), source)
 
 
+COMPILED_IN_FMU = ("jump", "integrate")
+"""The kernels an FMU runs compiled. Only the integration is worth a call into numba: force() is a
+few multiplications, which plain Python does in 0.44 us against 1.2 us for numba's dispatch
+(Table 5, measured 2026-11-23); prepare() and initial_state() run once."""
+
+
 def compiled_model(model):
-    """(``model`` with its five kernels compiled, seconds it took) — compiling now, or loading
-    numba's cached machine code — or (None, why not) if numba cannot be imported."""
+    """({name: compiled kernel} for COMPILED_IN_FMU, seconds it took) — compiling now, or
+    loading numba's cached machine code — or (None, why not) if numba cannot be imported."""
     try:
         import numba  # noqa: F401
     except Exception as exc:   # not installed, or broken in this host's Python
         return None, f"numba is not importable here ({type(exc).__name__}: {exc})"
     started = time.perf_counter()
     module = compiled_module(model, prefix="bushing_fmu")
-    kernels = {name: getattr(module, name) for name in ("prepare", "initial_state", "jump", "integrate", "force")}
-    compiled = dataclasses.replace(model, **kernels)
-    constants = compiled.prepare(model.values({s.name: 1.0 for s in model.specs}))   # compile (or load) now:
-    state = compiled.initial_state(constants, 0.0)                                  # a first step must not wait
-    state, _ = compiled.jump(constants, state, 1e-3)
-    compiled.integrate(constants, state, 1e-3, 0.0, 1e-3, 10)
-    compiled.force(constants, state, 0.0, 0.0)
-    return compiled, time.perf_counter() - started
+    kernels = {name: getattr(module, name) for name in COMPILED_IN_FMU}
+    # compile (or load) now, so that a first step does not wait: the constants and state the
+    # plain-Python kernels make are what the FMU passes
+    constants = model.prepare(model.values({s.name: 1.0 for s in model.specs}))
+    state, _ = kernels["jump"](constants, model.initial_state(constants, 0.0), 1e-3)
+    kernels["integrate"](constants, state, 1e-3, 0.0, 1e-3, 10)
+    return kernels, time.perf_counter() - started
 
 
 STEP_ENVIRONMENT = "BUSHING_FMU_STEP"
@@ -143,7 +148,7 @@ def _python_host() -> bool:
 
 
 def compile_axes(axes) -> tuple[list, str]:
-    """An FMU's axes [(axis, model, parameters)] with each model's kernels compiled, and a
+    """An FMU's axes [(axis, model, parameters)] with each model's COMPILED_IN_FMU kernels compiled, and a
     sentence saying which step runs; the axes unchanged (the plain-Python step) if numba is not
     importable or fails, if the host is not a Python interpreter, or if $BUSHING_FMU_STEP is
     "python". The compiled and the plain-Python
@@ -164,10 +169,6 @@ def compile_axes(axes) -> tuple[list, str]:
                 compiled[model.name], seconds = kernels, seconds + info
     except Exception as exc:   # a broken numba or an unwritable cache must not stop the FMU
         return list(axes), f"pure-Python step: compiling the kernels failed ({type(exc).__name__}: {exc})"
-    # Only the integration is worth a call into numba: force() is a few multiplications, which
-    # plain Python does in 0.44 us against 1.2 us for numba's dispatch (Table 5, measured 2026-11-23).
-    names = ("jump", "integrate")
-    out = [(axis, dataclasses.replace(model, **{n: getattr(compiled[model.name], n) for n in names}), parameters)
-           for axis, model, parameters in axes]
+    out = [(axis, dataclasses.replace(model, **compiled[model.name]), parameters) for axis, model, parameters in axes]
     return out, (f"compiled step (numba): {seconds:.2f} s to compile the kernels or load them from "
                  f"{cache_directory()}")

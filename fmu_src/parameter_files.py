@@ -237,8 +237,9 @@ class SixAxisSet:
         """The FMU's parameter names and values: {"x.k0": ..., "rz.c": ...}."""
         return {f"{axis}.{name}": value for axis, one in self.axes.items() for name, value in one.parameters.items()}
 
-    def units(self) -> dict[str, str]:
-        return {f"{axis}.{name}": unit for axis, one in self.axes.items() for name, unit in one.model.units.items()}
+    def fmu_axes(self) -> list:
+        """[(axes.Axis, model on that axis, parameters)] in the order x, y, z, rx, ry, rz."""
+        return [(axis, self.axes[axis.name].model, self.axes[axis.name].parameters) for axis in SIX_AXES]
 
 
 def read_six_axis(path: str | Path) -> SixAxisSet:
@@ -353,12 +354,10 @@ def save_six_axis(path: str | Path, axes: Mapping[str, tuple[str, Mapping[str, f
 
 
 def fmu_axes(path: str | Path) -> list:
-    """What an FMU built from the parameter file ``path`` runs: [(axes.Axis, model on that
-    axis, parameters)], one entry for a one-axis file, six for a six-axis file."""
-    path = Path(path)
-    if path.suffix.lower() != ".ssv" and _json_document(path).get("model") == SIX_AXIS_IDENTIFIER \
-            or path.suffix.lower() == ".ssv" and ET.parse(path).getroot().get("name") == SIX_AXIS_IDENTIFIER:
-        six = read_six_axis(path)
-        return [(axis, six.axes[axis.name].model, six.axes[axis.name].parameters) for axis in SIX_AXES]
+    """What an FMU runs with the JSON parameter file ``path`` (its packed defaults):
+    [(axes.Axis, model on that axis, parameters)], one entry for a one-axis file, six for a
+    six-axis file."""
+    if _json_document(Path(path)).get("model") == SIX_AXIS_IDENTIFIER:
+        return read_six_axis(path).fmu_axes()
     one = read_parameter_set(path)
     return [(ONE_AXIS, one.model, one.parameters)]

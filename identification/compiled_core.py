@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import inspect
 import types
-from pathlib import Path
 from typing import Mapping
 
 import numba
@@ -25,7 +24,6 @@ from fmu_src import compiled_kernels as _kernels, integration
 from fmu_src.bushing_models import get_model
 from fmu_src.proposed_model import PARAMETER_NAMES  # noqa: F401  (the proposed model's order, for callers)
 
-CACHE_ENVIRONMENT = _kernels.CACHE_ENVIRONMENT
 _MAX_SUBSTEPS = integration.DEFAULT_MAX_SUBSTEPS
 
 
@@ -76,11 +74,6 @@ def _population_appendix(model) -> str:
             + inspect.getsource(_population_forces)
             + "\n\n_simulate_population = numba.njit(error_model='numpy', parallel=True, cache=True)"
               "(_population_forces)\n")
-
-
-def cache_directory() -> Path:
-    """Where the generated modules and numba's cache live (``fmu_src.compiled_kernels``)."""
-    return _kernels.cache_directory()
 
 
 _compiled_models: dict[str, types.ModuleType] = {}
