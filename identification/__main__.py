@@ -13,6 +13,7 @@ from fmu_src import __version__
 from fmu_src.bushing_models import MODEL_NAMES
 from fmu_src.bushing_params import ParameterError
 from fmu_src.parameter_files import read_parameter_set
+from identification.dynamic_stiffness import DEFAULT_AMPLITUDES_MM, DEFAULT_FREQUENCIES_HZ
 from identification.engine import EngineError
 from identification.errors import IdentificationError
 from identification.measurements import load_measurement
@@ -49,6 +50,14 @@ def fraction(text: str) -> float:
     if not 0.0 < value < 1.0:
         raise argparse.ArgumentTypeError(f"{value} is not allowed: give a number between 0 and 1")
     return value
+
+
+def number_list(text: str) -> list[float]:
+    """'0.1,0.5,1' -> [0.1, 0.5, 1.0]."""
+    try:
+        return [float(part) for part in text.split(",") if part.strip()]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: give numbers separated by commas, e.g. 0.5,1,2") from None
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -133,6 +142,23 @@ def main(argv: list[str] | None = None) -> int:
     missing.add_argument("--default", type=Path, metavar="SIX.json",
                          help="an axis without a file takes its set from this six-axis file")
 
+    characterise_parser = commands.add_parser(
+        "characterise", help="dynamic stiffness |K*| and loss angle over amplitudes and frequencies (data sheet)")
+    characterise_parser.add_argument("--params", type=Path, required=True,
+                                     help="parameter file (.json, .ssv) or ensemble file (then with min/max columns)")
+    characterise_parser.add_argument("--model", choices=MODEL_NAMES, help="check the file is for this model")
+    characterise_parser.add_argument("--amplitudes-mm", type=number_list, metavar="LIST",
+                                     default=",".join(map(str, DEFAULT_AMPLITUDES_MM)),
+                                     help="sine amplitudes [mm], comma-separated (default %(default)s)")
+    characterise_parser.add_argument("--frequencies-hz", type=number_list, metavar="LIST",
+                                     default=",".join(map(str, DEFAULT_FREQUENCIES_HZ)),
+                                     help="frequencies [Hz], comma-separated (default %(default)s)")
+    characterise_parser.add_argument("--preload-mm", type=float, default=0.0, metavar="P",
+                                     help="static displacement the sines are about [mm] (default 0)")
+    characterise_parser.add_argument("--out", type=Path, required=True, help="table to write (CSV)")
+    characterise_parser.add_argument("--plots", type=Path, help="directory for the data-sheet plots (PNG)")
+    characterise_parser.add_argument("--json", action="store_true", help="print a summary as JSON")
+
     args = parser.parse_args(argv)
     with warnings.catch_warnings():
         # A user reads the warning, not where in our code it was raised.
@@ -140,7 +166,8 @@ def main(argv: list[str] | None = None) -> int:
                                                                                   file=sys.stderr)
         try:
             handler = {"sensitivity": _sensitivity, "report": _report, "compare": _compare, "predict": _predict,
-                       "design": _design, "fit-many": _fit_many, "assemble": _assemble}.get(args.command, _fit)
+                       "design": _design, "fit-many": _fit_many, "assemble": _assemble,
+                       "characterise": _characterise}.get(args.command, _fit)
             return handler(args)
         except (IdentificationError, ParameterError, EngineError, UsageError) as exc:
             print(f"error: {exc}", file=sys.stderr)
@@ -329,6 +356,33 @@ def _predict(args) -> int:
     print(f"{prediction.members} parameter set(s); rms force {np.sqrt(np.mean(prediction.force_N ** 2)):.1f} N"
           + (f"; band width: mean {np.mean(width):.1f} N, largest {np.max(width):.1f} N" if prediction.members > 1
              else ""))
+    print("wrote " + ", ".join(map(str, written)))
+    return 0
+
+
+def _characterise(args) -> int:
+    import json
+    from fmu_src.parameter_files import read_ensemble
+    from identification.dynamic_stiffness import characterise
+    check_output(args.out, "--out", suffixes=(".csv",))
+    check_output(args.plots, "--plots", directory=True)
+    ensemble = read_ensemble(args.params, args.model)
+    table = characterise(ensemble, args.amplitudes_mm, args.frequencies_hz, preload_mm=args.preload_mm)
+    written = [table.to_csv(args.out)]
+    if args.plots:
+        from identification.plots import plot_dynamic_stiffness
+        args.plots.mkdir(exist_ok=True)
+        written += plot_dynamic_stiffness(table, args.plots)
+    if args.json:
+        summary = table.summary()
+        summary["written"] = [str(path) for path in written]
+        print(json.dumps(summary, indent=1))
+        return 0
+    print(f"{ensemble.model.name} model, {table.members} parameter set(s), preload {args.preload_mm:g} mm:")
+    print(table.format())
+    summary = table.summary()
+    print(f"loop area against pi*K''*X^2: largest difference {100 * summary['largest_energy_difference_relative']:.2g} % "
+          "(only the first harmonic does work under a sine: the difference is quadrature error)")
     print("wrote " + ", ".join(map(str, written)))
     return 0
 

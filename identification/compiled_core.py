@@ -23,6 +23,7 @@ import numpy as np
 from fmu_src import compiled_kernels as _kernels, integration
 from fmu_src.bushing_models import get_model
 from fmu_src.proposed_model import PARAMETER_NAMES  # noqa: F401  (the proposed model's order, for callers)
+from identification import steady_state
 
 _MAX_SUBSTEPS = integration.DEFAULT_MAX_SUBSTEPS
 
@@ -66,14 +67,19 @@ def _population_forces(matrix, t, x, v, out_index, out_velocity, max_substeps):
 
 
 def _population_appendix(model) -> str:
-    """The population loop for ``model``: ``_VALUES(row)`` (the row's values as the tuple its
-    ``prepare`` takes) and ``_simulate_population``."""
+    """The population loops for ``model``: ``_VALUES(row)`` (the row's values as the tuple its
+    ``prepare`` takes), ``_simulate_population`` and ``_sine_steady_state``
+    (``identification.steady_state``)."""
     values = ", ".join(f"row[{i}]" for i in range(len(model.specs)))
-    return ("\n\nimport numpy as np\nfrom " + _kernels.integration_module() + " import OK as _OK\n\n"
+    return ("\n\nimport math\nimport numpy as np\nfrom " + _kernels.integration_module() + " import OK as _OK\n\n"
             + f"@numba.njit(cache=True)\ndef _VALUES(row):\n    return ({values},)\n\n\n"
             + inspect.getsource(_population_forces)
             + "\n\n_simulate_population = numba.njit(error_model='numpy', parallel=True, cache=True)"
-              "(_population_forces)\n")
+              "(_population_forces)\n\n\n"
+            + f"ROUNDING = {steady_state.ROUNDING!r}\n\n\n"
+            + inspect.getsource(steady_state._sine_steady_state)
+            + "\n\n_sine_steady_state = numba.njit(error_model='numpy', parallel=True, cache=True)"
+              "(_sine_steady_state)\n")
 
 
 _compiled_models: dict[str, types.ModuleType] = {}

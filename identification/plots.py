@@ -82,3 +82,57 @@ def plot_waterfall(misfits: Sequence[float], stages: Sequence[int], best: float,
     axes.legend(fontsize=8)
     figure.tight_layout()
     return _save(figure, path)
+
+
+def plot_dynamic_stiffness(table, folder: Path) -> list[Path]:
+    """A bushing data sheet of a ``dynamic_stiffness.DynamicStiffness``: |K*| and the loss angle
+    against frequency (log axis, one curve per amplitude), against amplitude (one curve per
+    frequency), each with an ensemble's min-max shaded; and the steady-state loops of the
+    smallest and largest amplitude at the lowest and highest frequency. Returns the three PNGs."""
+    plt = _pyplot()
+    folder = Path(folder)
+    amplitudes = np.unique(table.amplitude_mm)
+    frequencies = np.unique(table.frequency_hz)
+    written = []
+    for along, curves, across, label, name, log in (
+            (table.frequency_hz, table.amplitude_mm, frequencies, "frequency [Hz]", "kdyn_vs_frequency.png", True),
+            (table.amplitude_mm, table.frequency_hz, amplitudes, "amplitude [mm]", "kdyn_vs_amplitude.png", False)):
+        figure, (stiffness, angle) = plt.subplots(1, 2, figsize=(12, 4.4))
+        for index, value in enumerate(np.unique(curves)):
+            chosen = np.flatnonzero(curves == value)
+            chosen = chosen[np.argsort(along[chosen])]
+            unit = "mm" if curves is table.amplitude_mm else "Hz"
+            for axes, column in ((stiffness, "kdyn_N_per_mm"), (angle, "loss_angle_deg")):
+                axes.plot(along[chosen], table.column(column)[chosen], "o-", color=f"C{index % 10}", ms=3.5, lw=1.2,
+                          label=f"{value:g} {unit}")
+                if table.minimum:
+                    axes.fill_between(along[chosen], table.minimum[column][chosen], table.maximum[column][chosen],
+                                      color=f"C{index % 10}", alpha=0.2, lw=0)
+        stiffness.set(xlabel=label, ylabel="dynamic stiffness |K*| [N/mm]")
+        angle.set(xlabel=label, ylabel="loss angle [deg]")
+        for axes in (stiffness, angle):
+            if log:
+                axes.set_xscale("log")
+            axes.grid(alpha=0.3, which="both")
+        stiffness.legend(fontsize=8, title="amplitude" if curves is table.amplitude_mm else "frequency")
+        shaded = ", ensemble min-max shaded" if table.minimum else ""
+        figure.suptitle(f"{get_model(table.model).title}: dynamic stiffness and loss angle{shaded}", fontsize=10)
+        figure.tight_layout()
+        written.append(_save(figure, folder / name))
+    figure, axes = plt.subplots(figsize=(7, 5))
+    corners = {(a, f) for a in (amplitudes[0], amplitudes[-1]) for f in (frequencies[0], frequencies[-1])}
+    for index, case in enumerate(i for i in range(len(table))
+                                 if (table.amplitude_mm[i], table.frequency_hz[i]) in corners):
+        # normalised, so that a 0.1 mm loop shows beside a 3 mm one
+        x = (table.loop_displacement_mm(case) - table.preload_mm[case]) / table.amplitude_mm[case]
+        force = table.loop_force_N[case] / table.peak_force_N[case]
+        axes.plot(np.append(x, x[:1]), np.append(force, force[:1]), color=f"C{index}", lw=1.2,
+                  label=f"{table.amplitude_mm[case]:g} mm, {table.frequency_hz[case]:g} Hz: peak "
+                        f"{table.peak_force_N[case]:.0f} N, |K*| {table.kdyn_N_per_mm[case]:.0f} N/mm, "
+                        f"{table.loss_angle_deg[case]:.1f} deg")
+    axes.set(xlabel="displacement / amplitude", ylabel="force / peak force", title="steady-state loops (normalised)")
+    axes.grid(alpha=0.3)
+    axes.legend(fontsize=8)
+    figure.tight_layout()
+    written.append(_save(figure, folder / "steady_state_loops.png"))
+    return written

@@ -1,0 +1,230 @@
+"""Dynamic stiffness and loss angle: a parameter set described the way a bushing data sheet is.
+
+For each case of a grid of amplitudes X [mm] and frequencies f [Hz] (about a preload P [mm]),
+the bushing, relaxed at P, is driven by x = P + X*sin(2*pi*f*t) until its force is periodic
+(criterion: ``identification.steady_state``), and the first harmonic of the force over the
+last cycle gives, as in ISO 4664-1's forced-vibration tests,
+
+    K* = F1/X1 [N/mm],  |K*| the dynamic stiffness,  delta = arg K* the loss angle [deg],
+    K' = |K*|*cos(delta) the storage stiffness,  K'' = |K*|*sin(delta) the loss stiffness,
+
+plus the energy dissipated per cycle, the loop's area: the integral of F dx over the last cycle
+(trapezoids between its samples) [N.mm = mJ]. Under a pure sine only the force's first
+harmonic does work over a cycle, so the area equals pi*K''*X^2 for any periodic force, linear
+or hysteretic (``energy_from_loss_stiffness_mJ`` gives it beside the area; the two are
+computed independently, and their difference is quadrature error, about 1e-4 at 256 steps).
+Peak force: the largest |F| over the last cycle [N], preload included.
+
+Each sine runs ``steps_per_cycle`` communication steps per cycle on the compiled path (all cases
+in parallel on every core). With the default 256 steps the input's secant path carries a first
+harmonic (pi/N)^2/3 = 5e-5 smaller than the sine's, which bounds the accuracy of a linear
+model's K* (tests/test_dynamic_stiffness.py checks the closed forms).
+
+Units: mm, Hz, N/mm, degrees, mJ, N; parameters in the paper's N-mm-s units.
+"""
+from __future__ import annotations
+
+import csv
+import math
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+
+from identification.errors import IdentificationError
+
+DEFAULT_AMPLITUDES_MM = (0.1, 0.5, 1.0, 2.0, 3.0)
+DEFAULT_FREQUENCIES_HZ = (1.0, 2.0, 5.0, 10.0, 20.0, 30.0, 50.0)
+STEPS_PER_CYCLE = 256
+MIN_CYCLES = 3
+MAX_CYCLES = 2000
+TOLERANCE = 1e-5
+"""Steady state: the first harmonic changes by at most this (relative) from cycle to cycle, with
+what a geometric approach has left (``identification.steady_state``)."""
+MAX_SUBSTEPS = 20000
+PLAUSIBLE_AMPLITUDE_MM = 50.0
+PLAUSIBLE_FREQUENCY_HZ = 500.0
+COLUMNS = ("amplitude_mm", "frequency_hz", "preload_mm", "kdyn_N_per_mm", "loss_angle_deg", "storage_N_per_mm",
+           "loss_N_per_mm", "energy_per_cycle_mJ", "peak_force_N")
+RESULT_COLUMNS = COLUMNS[3:]
+"""The columns computed per case (the first three describe the case)."""
+
+
+class CharacterisationWarning(UserWarning):
+    """A case did not reach its steady state within the cycle cap (its numbers are the last cycle's)."""
+
+
+@dataclass
+class DynamicStiffness:
+    """One row per case (arrays of equal length, in COLUMNS' units) of the best parameter set;
+    for an ensemble, ``minimum`` and ``maximum`` of each result column over its members."""
+    amplitude_mm: np.ndarray
+    frequency_hz: np.ndarray
+    preload_mm: np.ndarray
+    kdyn_N_per_mm: np.ndarray
+    loss_angle_deg: np.ndarray
+    storage_N_per_mm: np.ndarray
+    loss_N_per_mm: np.ndarray
+    energy_per_cycle_mJ: np.ndarray
+    peak_force_N: np.ndarray
+    cycles: np.ndarray                      # cycles simulated per case
+    converged: np.ndarray                   # steady state reached per case
+    loop_force_N: np.ndarray                # (cases, steps_per_cycle): the last cycle's force
+    model: str = "proposed"
+    members: int = 1
+    minimum: dict[str, np.ndarray] = field(default_factory=dict)
+    maximum: dict[str, np.ndarray] = field(default_factory=dict)
+
+    def __len__(self) -> int:
+        return self.amplitude_mm.size
+
+    def column(self, name: str) -> np.ndarray:
+        return getattr(self, name)
+
+    @property
+    def energy_from_loss_stiffness_mJ(self) -> np.ndarray:
+        """pi*K''*X^2 [mJ]: the energy per cycle of a linear bushing with this loss stiffness."""
+        return math.pi * self.loss_N_per_mm * self.amplitude_mm ** 2
+
+    def loop_displacement_mm(self, case: int) -> np.ndarray:
+        """The displacement at the samples of ``loop_force_N[case]``."""
+        phase = 2.0 * math.pi * np.arange(self.loop_force_N.shape[1]) / self.loop_force_N.shape[1]
+        return self.preload_mm[case] + self.amplitude_mm[case] * np.sin(phase)
+
+    def to_csv(self, path: str | Path, comments: Sequence[str] = ()) -> Path:
+        """COLUMNS, one row per case; an ensemble adds ``<column>_min``, ``<column>_max``;
+        ``comments`` go first, as ``# `` lines."""
+        path = Path(path)
+        header = list(COLUMNS)
+        if self.minimum:
+            header += [f"{name}_{bound}" for name in RESULT_COLUMNS for bound in ("min", "max")]
+        with open(path, "w", newline="") as handle:
+            handle.writelines(f"# {line}\n" for line in comments)
+            writer = csv.writer(handle)
+            writer.writerow(header)
+            for i in range(len(self)):
+                row = [f"{self.column(name)[i]:.10g}" for name in COLUMNS]
+                if self.minimum:
+                    row += [f"{table[name][i]:.10g}" for name in RESULT_COLUMNS
+                            for table in (self.minimum, self.maximum)]
+                writer.writerow(row)
+        return path
+
+    def summary(self) -> dict:
+        """For ``--json``: the cases, their cycles and convergence, and how far the loop's area is
+        from pi*K''*X^2 (0 for a linear model)."""
+        energy_gap = self.energy_per_cycle_mJ - self.energy_from_loss_stiffness_mJ
+        cases = []
+        for i in range(len(self)):
+            case = {name: float(self.column(name)[i]) for name in COLUMNS}
+            case.update(cycles=int(self.cycles[i]), converged=bool(self.converged[i]),
+                        energy_from_loss_stiffness_mJ=float(self.energy_from_loss_stiffness_mJ[i]))
+            if self.minimum:
+                case["ensemble"] = {name: [float(self.minimum[name][i]), float(self.maximum[name][i])]
+                                    for name in RESULT_COLUMNS}
+            cases.append(case)
+        relative = np.abs(energy_gap) / np.maximum(np.abs(self.energy_per_cycle_mJ), 1e-300)
+        return {"model": self.model, "members": self.members, "cases": cases,
+                "all_converged": bool(np.all(self.converged)),
+                "largest_energy_difference_relative": float(np.max(relative))}
+
+    def format(self) -> str:
+        lines = [f"{'X mm':>6} {'f Hz':>7} {'|K*| N/mm':>10} {'delta deg':>9} {'K` N/mm':>9} {'K`` N/mm':>9} "
+                 f"{'E mJ':>9} {'peak N':>8} {'cycles':>6}"]
+        for i in range(len(self)):
+            lines.append(f"{self.amplitude_mm[i]:6.3g} {self.frequency_hz[i]:7.4g} {self.kdyn_N_per_mm[i]:10.1f} "
+                         f"{self.loss_angle_deg[i]:9.2f} {self.storage_N_per_mm[i]:9.1f} {self.loss_N_per_mm[i]:9.1f} "
+                         f"{self.energy_per_cycle_mJ[i]:9.4g} {self.peak_force_N[i]:8.1f} {int(self.cycles[i]):6d}"
+                         + ("" if self.converged[i] else "  not steady"))
+        return "\n".join(lines)
+
+
+def characterise(parameters, amplitudes_mm: Sequence[float] = DEFAULT_AMPLITUDES_MM,
+                 frequencies_hz: Sequence[float] = DEFAULT_FREQUENCIES_HZ, model: str | None = None,
+                 preload_mm: float = 0.0, steps_per_cycle: int = STEPS_PER_CYCLE, tolerance: float = TOLERANCE,
+                 max_cycles: int = MAX_CYCLES) -> DynamicStiffness:
+    """Dynamic stiffness and loss angle on the grid amplitudes x frequencies (every pair; see the
+    module docstring). ``parameters``: a mapping of ``model``'s parameters (paper units), a
+    ``ParameterSet``, a ``ParameterEnsemble`` or a fit result (then the best set's table with the
+    members' min/max). Cases are ordered amplitude-major. Warns (CharacterisationWarning) about
+    a case that reaches the cycle cap; raises IdentificationError for invalid input or a
+    simulation that fails."""
+    # here, not at the top: the command line imports this module for its defaults
+    from identification.compiled_core import compiled_model, parameter_matrix
+    from identification.predict import members_of
+    bushing, sets = members_of(parameters, model)
+    amplitudes = _grid_values(amplitudes_mm, "amplitude", "mm", PLAUSIBLE_AMPLITUDE_MM)
+    frequencies = _grid_values(frequencies_hz, "frequency", "Hz", PLAUSIBLE_FREQUENCY_HZ)
+    if not math.isfinite(preload_mm):
+        raise IdentificationError(f"preload = {preload_mm} mm: give a finite displacement")
+    if int(steps_per_cycle) != steps_per_cycle or steps_per_cycle < 16:
+        raise IdentificationError(f"steps_per_cycle = {steps_per_cycle}: give an integer >= 16")
+    if not (0.0 < tolerance < 1.0):
+        raise IdentificationError(f"tolerance = {tolerance}: give a relative change between 0 and 1")
+    if int(max_cycles) != max_cycles or max_cycles < MIN_CYCLES:
+        raise IdentificationError(f"max_cycles = {max_cycles}: give an integer >= {MIN_CYCLES}")
+    case_amplitude = np.repeat(amplitudes, frequencies.size)
+    case_frequency = np.tile(frequencies, amplitudes.size)
+    cases = case_amplitude.size
+    members = len(sets)
+    rows = np.repeat(np.arange(members, dtype=np.int64), cases)
+    result = np.zeros((rows.size, 4))
+    last = np.zeros((rows.size, int(steps_per_cycle)))
+    compiled_model(bushing.name)._sine_steady_state(
+        parameter_matrix(sets, bushing.name), rows, np.tile(case_amplitude, members),
+        np.tile(case_frequency, members), np.full(rows.size, float(preload_mm)), int(steps_per_cycle), MIN_CYCLES,
+        int(max_cycles), float(tolerance), MAX_SUBSTEPS, result, last)
+    failed = (result[:, 3] == 2) | ~np.all(np.isfinite(last), axis=1)
+    if failed[:cases].any():
+        i = int(np.argmax(failed[:cases]))
+        raise IdentificationError(f"the simulation of the {case_amplitude[i]:g} mm, {case_frequency[i]:g} Hz sine "
+                                  "fails (overflow or too many substeps): check the amplitude's unit (mm)")
+    tables = [_table(result[k * cases:(k + 1) * cases], last[k * cases:(k + 1) * cases], case_amplitude,
+                     case_frequency, float(preload_mm)) for k in range(members) if not failed[k * cases:(k + 1) * cases].any()]
+    best = tables[0]
+    not_steady = ~best["converged"]
+    if not_steady.any():
+        listed = ", ".join(f"{case_amplitude[i]:g} mm/{case_frequency[i]:g} Hz" for i in np.flatnonzero(not_steady))
+        warnings.warn(f"no steady state within {max_cycles} cycles for {listed}: the first harmonic still changes by "
+                      f"more than {tolerance:g} per cycle; these rows are the last cycle's (raise max_cycles)",
+                      CharacterisationWarning, stacklevel=2)
+    table = DynamicStiffness(case_amplitude, case_frequency, np.full(cases, float(preload_mm)),
+                             **{name: best[name] for name in RESULT_COLUMNS}, cycles=best["cycles"],
+                             converged=best["converged"], loop_force_N=best["loop"], model=bushing.name,
+                             members=len(tables))
+    if members > 1:
+        table.minimum = {name: np.min([t[name] for t in tables], axis=0) for name in RESULT_COLUMNS}
+        table.maximum = {name: np.max([t[name] for t in tables], axis=0) for name in RESULT_COLUMNS}
+    return table
+
+
+def _table(result: np.ndarray, last: np.ndarray, amplitude: np.ndarray, frequency: np.ndarray, preload: float) -> dict:
+    """The result columns of one parameter set from the kernel's first-harmonic sums and last cycles."""
+    cosine, sine = result[:, 0], result[:, 1]
+    storage = sine / amplitude
+    loss = cosine / amplitude
+    steps = last.shape[1]
+    x = preload + amplitude[:, None] * np.sin(2.0 * math.pi * np.arange(steps) / steps)[None, :]
+    # the closed loop's area by trapezoids, the last sample joined to the first
+    energy = np.sum(0.5 * (last + np.roll(last, -1, axis=1)) * (np.roll(x, -1, axis=1) - x), axis=1)
+    return {"kdyn_N_per_mm": np.hypot(storage, loss), "loss_angle_deg": np.degrees(np.arctan2(loss, storage)),
+            "storage_N_per_mm": storage, "loss_N_per_mm": loss, "energy_per_cycle_mJ": energy,
+            "peak_force_N": np.max(np.abs(last), axis=1), "cycles": result[:, 2].astype(int),
+            "converged": result[:, 3] == 0, "loop": last.copy()}
+
+
+def _grid_values(values, what: str, unit: str, plausible: float) -> np.ndarray:
+    array = np.atleast_1d(np.asarray(values, dtype=float))
+    if array.ndim != 1 or array.size == 0:
+        raise IdentificationError(f"give at least one {what} [{unit}]")
+    for value in array:
+        if not (math.isfinite(value) and value > 0.0):
+            raise IdentificationError(f"{what} = {value} {unit}: give a finite value > 0")
+    if len(set(array.tolist())) != array.size:
+        raise IdentificationError(f"{what}s {array.tolist()} {unit}: a value is repeated")
+    if np.any(array > plausible):
+        warnings.warn(f"{what} {float(np.max(array)):g} {unit} is above {plausible:g} {unit}, outside what bushing "
+                      "tests use: check the unit", CharacterisationWarning, stacklevel=3)
+    return array
