@@ -187,6 +187,9 @@ def _add_training_arguments(parser) -> None:
     group.add_argument("--tests", type=Path, metavar="MANIFEST",
                        help='tests.json: {"sine": [...], "step": [{"file": ..., "rise_time_s": ...}], '
                             '"random": [...], "model": ...}, paths relative to it')
+    group.add_argument("--kdyn", type=Path, metavar="TABLE",
+                       help="dynamic-stiffness table (CSV amplitude_mm,frequency_hz,kdyn_N_per_mm,loss_angle_deg"
+                            "[,preload_mm][,weight], as `characterise` writes), alone or with time series")
 
 
 def _add_search_arguments(parser) -> None:
@@ -209,8 +212,11 @@ def _add_search_arguments(parser) -> None:
 
 
 def _training_tests(args):
-    """The tests of --sine/--step/--rise-time/--random or --tests, and the manifest's model."""
+    """The tests of --sine/--step/--rise-time/--random or --tests, and the manifest's model
+    (no tests at all where a --kdyn table is given alone)."""
     given = args.sine or args.step or args.random or args.rise_time
+    if not given and args.tests is None and getattr(args, "kdyn", None) is not None:
+        return [], None
     if args.tests is not None:
         if given:
             raise UsageError("give the tests either in --tests MANIFEST or as --sine/--step/--random, not both")
@@ -250,15 +256,21 @@ def _fit(args) -> int:
     model = args.model or manifest_model or "proposed"
     if model not in MODEL_NAMES:
         raise UsageError(f"the manifest's model {model!r} is not one of {', '.join(MODEL_NAMES)}")
+    table = None
+    if args.kdyn is not None:
+        from identification.kdyn_table import load_kdyn_table
+        table = load_kdyn_table(args.kdyn)
     counts = {kind: sum(t.kind == kind for t in tests) for kind in ("sine", "step", "random")}
     print(f"fitting the {model} model to {counts['sine']} sine, {counts['step']} step and {counts['random']} "
-          "random test(s)", file=sys.stderr)
+          "random test(s)" + (f" and a dynamic-stiffness table of {len(table)} rows" if table else ""),
+          file=sys.stderr)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", FitNotConvergedWarning)   # printed below as WARNING
         result = fit(tests, model=model, preset=args.preset, seed=args.seed, workers=args.workers,
                      scheduler=args.scheduler, progress=not args.quiet, screening=args.screening,
-                     starts=args.starts)
-    written = _save_or_rescue(result, args, [t.measurement.source for t in tests])
+                     starts=args.starts, kdyn=table)
+    written = _save_or_rescue(result, args, [t.measurement.source for t in tests]
+                              + ([str(args.kdyn)] if args.kdyn else []))
     print(result.summary())
     if args.plots:
         if result.records:
@@ -430,6 +442,8 @@ def _fit_many(args) -> int:
 
 def _compare(args) -> int:
     from identification.compare import compare_models
+    if args.kdyn is not None:
+        raise UsageError("--kdyn: compare fits and validates on time series; fit a table with `fit --kdyn`")
     tests, _ = _training_tests(args)
     models = [name.strip() for name in args.models.split(",") if name.strip()]
     unknown = [name for name in models if name not in MODEL_NAMES]

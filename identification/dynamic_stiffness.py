@@ -152,7 +152,7 @@ def characterise(parameters, amplitudes_mm: Sequence[float] = DEFAULT_AMPLITUDES
     a case that reaches the cycle cap; raises IdentificationError for invalid input or a
     simulation that fails."""
     # here, not at the top: the command line imports this module for its defaults
-    from identification.compiled_core import compiled_model, parameter_matrix
+    from identification.compiled_core import parameter_matrix
     from identification.predict import members_of
     bushing, sets = members_of(parameters, model)
     amplitudes = _grid_values(amplitudes_mm, "amplitude", "mm", PLAUSIBLE_AMPLITUDE_MM)
@@ -169,13 +169,8 @@ def characterise(parameters, amplitudes_mm: Sequence[float] = DEFAULT_AMPLITUDES
     case_frequency = np.tile(frequencies, amplitudes.size)
     cases = case_amplitude.size
     members = len(sets)
-    rows = np.repeat(np.arange(members, dtype=np.int64), cases)
-    result = np.zeros((rows.size, 4))
-    last = np.zeros((rows.size, int(steps_per_cycle)))
-    compiled_model(bushing.name)._sine_steady_state(
-        parameter_matrix(sets, bushing.name), rows, np.tile(case_amplitude, members),
-        np.tile(case_frequency, members), np.full(rows.size, float(preload_mm)), int(steps_per_cycle), MIN_CYCLES,
-        int(max_cycles), float(tolerance), MAX_SUBSTEPS, result, last)
+    result, last = run_sines(parameter_matrix(sets, bushing.name), bushing.name, case_amplitude, case_frequency,
+                             np.full(cases, float(preload_mm)), int(steps_per_cycle), int(max_cycles), tolerance)
     failed = (result[:, 3] == 2) | ~np.all(np.isfinite(last), axis=1)
     if failed[:cases].any():
         i = int(np.argmax(failed[:cases]))
@@ -198,6 +193,26 @@ def characterise(parameters, amplitudes_mm: Sequence[float] = DEFAULT_AMPLITUDES
         table.minimum = {name: np.min([t[name] for t in tables], axis=0) for name in RESULT_COLUMNS}
         table.maximum = {name: np.max([t[name] for t in tables], axis=0) for name in RESULT_COLUMNS}
     return table
+
+
+def run_sines(matrix: np.ndarray, model: str, amplitude_mm: np.ndarray, frequency_hz: np.ndarray,
+              preload_mm: np.ndarray, steps_per_cycle: int, max_cycles: int, tolerance: float,
+              max_substeps: int = MAX_SUBSTEPS):
+    """Every parameter set (rows of ``matrix``) on every case (equal-length arrays): the compiled
+    loop of ``identification.steady_state``, cases of all sets in parallel. Returns its
+    ``result`` (P*cases, 4: a, b, cycles, status; set-major) and ``last`` (P*cases, steps).
+    ``tolerance`` 0 runs exactly ``max_cycles`` cycles (a smooth function of the parameters,
+    as a fit needs; status 1 then means done). ``max_substeps`` per communication step before a
+    case fails (status 2)."""
+    from identification.compiled_core import compiled_model
+    members, cases = matrix.shape[0], amplitude_mm.size
+    rows = np.repeat(np.arange(members, dtype=np.int64), cases)
+    result = np.zeros((rows.size, 4))
+    last = np.zeros((rows.size, steps_per_cycle))
+    compiled_model(model)._sine_steady_state(
+        matrix, rows, np.tile(amplitude_mm, members), np.tile(frequency_hz, members), np.tile(preload_mm, members),
+        steps_per_cycle, min(MIN_CYCLES, max_cycles), max_cycles, tolerance, max_substeps, result, last)
+    return result, last
 
 
 def _table(result: np.ndarray, last: np.ndarray, amplitude: np.ndarray, frequency: np.ndarray, preload: float) -> dict:

@@ -40,6 +40,7 @@ from identification.ensemble import (PROBES, PROFILE_EVALUATIONS, PROFILE_ROUNDS
                                      Identifiability, SamplerReport, identifiability, misfit_threshold,
                                      posterior_samples, profile_extremes, push_to_boundary, select_members,
                                      threshold_scale)
+from identification.kdyn_table import FIT_CYCLES, KDYN_UNCERTAINTY, LOSS_ANGLE_UNCERTAINTY_DEG, KdynTable, load_kdyn_table
 from identification.measurements import Measurement
 from identification.multistart import (Problem, SearchSettings, StartRecord, first_records, jacobian, run_stages,
                                        screen)
@@ -97,6 +98,45 @@ class TestFit:
 
 
 @dataclass
+class TableFit:
+    """A dynamic-stiffness table at the fitted parameters: the converged characterisation
+    (``dynamic_stiffness.characterise``) against the table's rows of weight > 0."""
+    name: str
+    kdyn_errors: np.ndarray          # relative |K*| error per row
+    angle_errors_deg: np.ndarray     # loss-angle error per row [deg]
+    weight: np.ndarray
+    cycles_error: float              # largest |K*| difference of the fit's fixed-cycle loop from the converged one
+
+    @property
+    def ratio(self) -> float:
+        """The rms of the weighted errors in uncertainty units (KDYN_UNCERTAINTY,
+        LOSS_ANGLE_UNCERTAINTY_DEG): 1 where the fit matches the table to its uncertainty."""
+        scaled = np.concatenate([self.kdyn_errors / KDYN_UNCERTAINTY, self.angle_errors_deg / LOSS_ANGLE_UNCERTAINTY_DEG])
+        return float(np.sqrt(np.mean((np.tile(self.weight, 2) * scaled) ** 2)))
+
+    @property
+    def at_floor(self) -> bool:
+        return bool(self.ratio <= FLOOR_FACTOR)
+
+    def as_dict(self) -> dict:
+        return {"file": self.name, "kind": "kdyn", "rows": int(self.weight.size),
+                "rms_kdyn_error": _round(float(np.sqrt(np.mean(self.kdyn_errors ** 2)))),
+                "largest_kdyn_error": _round(float(np.max(np.abs(self.kdyn_errors)))),
+                "rms_loss_angle_error_deg": _round(float(np.sqrt(np.mean(self.angle_errors_deg ** 2)))),
+                "largest_loss_angle_error_deg": _round(float(np.max(np.abs(self.angle_errors_deg)))),
+                "uncertainty": {"kdyn": KDYN_UNCERTAINTY, "loss_angle_deg": LOSS_ANGLE_UNCERTAINTY_DEG},
+                "fit_loop_kdyn_difference": _round(self.cycles_error),
+                "error_over_uncertainty": _round(self.ratio), "at_floor": self.at_floor}
+
+    def format(self) -> str:
+        d = self.as_dict()
+        return (f"{self.name:44s} {'kdyn':7s} |K*| rms {d['rms_kdyn_error']:.2%} (largest {d['largest_kdyn_error']:.2%}), "
+                f"loss angle rms {d['rms_loss_angle_error_deg']:.2f} deg (largest {d['largest_loss_angle_error_deg']:.2f}); "
+                f"{self.ratio:.2f}x the uncertainty ({KDYN_UNCERTAINTY:.0%}, {LOSS_ANGLE_UNCERTAINTY_DEG:g} deg)  "
+                f"{'yes' if self.at_floor else 'NO'}")
+
+
+@dataclass
 class FitResult:
     parameters: ParameterSet               # the best fit, with its provenance
     misfit: float                          # chi^2/n, 1 at the noise floor
@@ -115,6 +155,7 @@ class FitResult:
     sampler: SamplerReport | None = None
     notes: list[str] = field(default_factory=list)
     steps_per_sample: list[int] = field(default_factory=list)   # the forward model's, per test
+    table: TableFit | None = None          # the dynamic-stiffness table, if one was fitted
 
     @property
     def model(self) -> str:
@@ -128,7 +169,7 @@ class FitResult:
 
     @property
     def at_floor(self) -> bool:
-        return all(t.at_floor for t in self.tests)
+        return all(t.at_floor for t in self.tests) and (self.table is None or self.table.at_floor)
 
     @property
     def converged(self) -> bool:
@@ -140,11 +181,15 @@ class FitResult:
         """The ``not converged`` message with its figures, or None."""
         if self.converged:
             return None
-        worst = max(self.tests, key=lambda t: t.ratio)
         reasons = []
-        if not self.at_floor:
+        worst = max(self.tests, key=lambda t: t.ratio) if self.tests else None
+        if worst is not None and not worst.at_floor:
             reasons.append(f"training NRMSE {worst.nrmse:.2%} on {worst.name} is {worst.ratio:.2f}x "
                            f"its noise level {worst.noise_fraction:.2%} (the floor is {FLOOR_FACTOR}x)")
+        if self.table is not None and not self.table.at_floor:
+            reasons.append(f"the table {self.table.name} is matched to {self.table.ratio:.2f}x its uncertainty "
+                           f"({KDYN_UNCERTAINTY:.0%} on |K*|, {LOSS_ANGLE_UNCERTAINTY_DEG:g} deg; the floor is "
+                           f"{FLOOR_FACTOR}x)")
         if self.space is not None and self.agreeing < MIN_AGREEING:
             reasons.append(f"only {self.agreeing} of {self.final_starts} final starts reach the best misfit")
         edges = self.at_box_edge()
@@ -178,7 +223,7 @@ class FitResult:
         that the same seed gives the same file on any engine."""
         out = {"method": self._method(), "preset": self.preset, "seed": self.seed,
                "converged": self.converged, "misfit_chi2_per_residual": _round(self.misfit),
-               "tests": [t.as_dict() for t in self.tests]}
+               "tests": [t.as_dict() for t in self.tests] + ([self.table.as_dict()] if self.table else [])}
         if self.space is not None:
             out.update({"starts_agreeing": self.agreeing, "final_starts": self.final_starts,
                         "agreement_threshold_misfit": _round(self.threshold),
@@ -210,13 +255,20 @@ class FitResult:
 
     def summary(self) -> str:
         """A report like lmfit's fit_report: figures first, then the warnings."""
-        lines = [f"{self.parameters.model.title} fitted to {len(self.tests)} test(s), preset {self.preset!r}, "
+        fitted = f"{len(self.tests)} test(s)" + (f" and the table {self.table.name}" if self.table else "")
+        lines = [f"{self.parameters.model.title} fitted to {fitted}, preset {self.preset!r}, "
                  f"seed {self.seed}, {self.evaluations} simulations in {self.seconds:.1f} s on {self.engine}",
                  f"misfit chi^2/n = {self.misfit:.4f} (1 = the noise floor)"]
         lines.append(f"{'test':44s} {'kind':7s} {'noise':>8s} {'NRMSE':>8s} {'ratio':>6s}  floor")
         for t in self.tests:
             lines.append(f"{t.name:44s} {t.kind:7s} {t.noise_fraction:8.2%} {t.nrmse:8.2%} "
                          f"{t.ratio:6.2f}  {'yes' if t.at_floor else 'NO'}")
+        if self.table is not None:
+            lines.append(self.table.format())
+            if self.table.cycles_error > 0.1 * KDYN_UNCERTAINTY:
+                lines.append(f"note: the fit's {FIT_CYCLES}-cycle loop differs from the steady state by up to "
+                             f"{self.table.cycles_error:.2%} in |K*| at the fitted set (a slow transient); more than "
+                             "a tenth of the table's uncertainty")
         if self.space is not None:
             lines.append(f"starts: {self.agreeing} of {self.final_starts} final starts agree (misfit within "
                          f"{self.threshold:.2e} of the best: delta chi^2 at 95 % for {len(self.space.names)} parameters); "
@@ -266,18 +318,22 @@ def as_tests(measurements) -> list[RigTest]:
 
 def fit(measurements, model: str = "proposed", preset: str = "default", seed: int = 0, workers: int | None = None,
         scheduler=None, engine=None, progress: bool = True, screening: int | None = None,
-        starts: int | None = None) -> FitResult:
+        starts: int | None = None, kdyn=None) -> FitResult:
     """Identify ``model``'s parameters from training tests (see the module docstring).
 
     ``measurements``: a ``rig_tests.Manifest``, ``RigTest``s, ``Measurement``s or CSV paths.
     ``workers``/``scheduler``: where the starts run (default: every local core); ``engine``: an
     engine to reuse (not closed). ``screening``, ``starts``: override the preset's number of
     Sobol points and of first-stage starts (later stages shrink in proportion, at least
-    MIN_FINAL_STARTS remain). Emits a ``FitNotConvergedWarning`` when the fit is not converged.
+    MIN_FINAL_STARTS remain). ``kdyn``: a dynamic-stiffness table (a CSV path or a
+    ``kdyn_table.KdynTable``) fitted with the tests, or alone (``measurements`` empty).
+    Emits a ``FitNotConvergedWarning`` when the fit is not converged.
     """
     from threadpoolctl import threadpool_limits
     started = time.perf_counter()
-    tests = as_tests(measurements)
+    table = kdyn if kdyn is None or isinstance(kdyn, KdynTable) else load_kdyn_table(kdyn)
+    empty = measurements is None or (isinstance(measurements, (list, tuple)) and not measurements)
+    tests = [] if (empty and table is not None) else as_tests(measurements)
     bushing = get_model(model)
     if seed < 0:
         raise IdentificationError(f"seed = {seed}: give an integer >= 0")
@@ -286,7 +342,7 @@ def fit(measurements, model: str = "proposed", preset: str = "default", seed: in
     # and the scales and the Jacobian's SVD computed here must not depend on the engine.
     with threadpool_limits(limits=1):
         if bushing.name == "kelvin_voigt":
-            result = _fit_kelvin_voigt(tests, noise, started)
+            result = _fit_kelvin_voigt(tests, noise, started, table)
         else:
             if preset not in PRESETS:
                 raise IdentificationError(f"unknown preset {preset!r}; choose one of {', '.join(PRESETS)}")
@@ -294,7 +350,7 @@ def fit(measurements, model: str = "proposed", preset: str = "default", seed: in
             owned = engine is None
             engine = engine or make_engine(workers, scheduler)
             try:
-                result = _search(tests, noise, bushing.name, preset, settings, seed, engine, progress, started)
+                result = _search(tests, noise, bushing.name, preset, settings, seed, engine, progress, started, table)
             finally:
                 if owned:
                     engine.close()
@@ -323,10 +379,10 @@ def _settings(base: SearchSettings, screening: int | None, starts: int | None) -
     return SearchSettings(base.screening, base.stages)   # validates
 
 
-def _search(tests, noise, model, preset, settings, seed, engine, progress, started) -> FitResult:
+def _search(tests, noise, model, preset, settings, seed, engine, progress, started, table=None) -> FitResult:
     measurements = [t.measurement for t in tests]
-    space = SearchSpace.from_measurements(measurements, model, steps=[t.kind == "step" for t in tests])
-    problem = Problem(Objective(tests, noise, model=space.model), space)
+    space = SearchSpace.from_measurements(measurements, model, steps=[t.kind == "step" for t in tests], table=table)
+    problem = Problem(Objective(tests, noise, model=space.model, table=table), space)
     ga_evaluations = PAPER_GA["population"] * PAPER_GA["generations"]
     bars = _Progress(progress, settings, ga_evaluations if preset == "paper" else settings.screening)
     if preset == "paper":
@@ -383,23 +439,38 @@ def _search(tests, noise, model, preset, settings, seed, engine, progress, start
     steps = problem.objective.steps_per_sample
     result = FitResult(parameters, float(best.misfit), _test_fits(tests, noise, parameters, steps), records, threshold,
                        ensemble, ident, preset, seed, evaluations, time.perf_counter() - started, engine.description,
-                       space, final_starts=len(final), sampler=sampler, notes=notes, steps_per_sample=steps)
+                       space, final_starts=len(final), sampler=sampler, notes=notes, steps_per_sample=steps,
+                       table=_table_fit(table, parameters))
     result.parameters.provenance = result.provenance()
     return result
 
 
-def _fit_kelvin_voigt(tests, noise, started) -> FitResult:
+def _fit_kelvin_voigt(tests, noise, started, table=None) -> FitResult:
     """F = k*x + c*v by linear least squares with k, c >= 0 on the tests other than steps (a
-    linear spring cannot show the step's relaxation; all tests if there are only steps)."""
+    linear spring cannot show the step's relaxation; all tests if there are only steps). With
+    a dynamic-stiffness table: scipy's bounded least squares on the whole objective (tests and
+    table), from that solution or, with a table alone, from the table's median K' and K''/omega."""
+    from scipy.optimize import least_squares
     bushing = get_model("kelvin_voigt")
-    linear = KelvinVoigtFit.fit([t.measurement for t in tests if t.kind != "step"]
-                                or [t.measurement for t in tests], nonnegative=True)
-    values = {"k": linear.k, "c": linear.c, "preload": 0.0}
+    if tests:
+        linear = KelvinVoigtFit.fit([t.measurement for t in tests if t.kind != "step"]
+                                    or [t.measurement for t in tests], nonnegative=True)
+        values = {"k": linear.k, "c": linear.c, "preload": 0.0}
+    else:
+        scales = SearchSpace.from_table(table)
+        values = {"k": scales.k_ref, "c": scales.c_ref, "preload": 0.0}
+    objective = Objective(tests, noise, model=bushing.name, table=table)
+    if table is not None:
+        def residuals(kc):
+            return objective.residual_matrix(parameter_matrix([{"k": kc[0], "c": kc[1], "preload": 0.0}],
+                                                              bushing.name))[0]
+        solution = least_squares(residuals, [values["k"], values["c"]], bounds=([0.0, 0.0], [np.inf, np.inf]),
+                                 x_scale="jac")
+        values = {"k": float(solution.x[0]), "c": float(solution.x[1]), "preload": 0.0}
     parameters = ParameterSet(bushing, values)
-    objective = Objective(tests, noise, model=bushing.name)
     misfit = float(objective(parameter_matrix([values], bushing.name))[0])
     result = FitResult(parameters, misfit, _test_fits(tests, noise, parameters), [], 0.0, [values], None,
-                       "linear", 0, 1, time.perf_counter() - started)
+                       "linear", 0, 1, time.perf_counter() - started, table=_table_fit(table, parameters))
     result.parameters.provenance = result.provenance()
     return result
 
@@ -422,6 +493,27 @@ def _test_fits(tests, noise, parameters: ParameterSet, steps=None) -> list[TestF
                              steps_per_sample=m_steps)
         fits.append(TestFit(test.name, test.kind, level, nrmse(predicted, m.force_N)))
     return fits
+
+
+def _table_fit(table: KdynTable | None, parameters: ParameterSet) -> TableFit | None:
+    """The table's rows (weight > 0) against the converged characterisation of ``parameters``,
+    and how far the fit's fixed-cycle loop is from it (its largest relative |K*| difference)."""
+    if table is None:
+        return None
+    from identification.dynamic_stiffness import MAX_CYCLES, STEPS_PER_CYCLE, TOLERANCE, CharacterisationWarning, run_sines
+    from identification.objectives import PreparedTable
+    prepared = PreparedTable.of(table)
+    matrix = parameter_matrix([parameters.parameters], parameters.model.name)
+    result, _ = run_sines(matrix, parameters.model.name, prepared.amplitude_mm, prepared.frequency_hz,
+                          prepared.preload_mm, STEPS_PER_CYCLE, MAX_CYCLES, TOLERANCE)
+    storage, loss = result[:, 1] / prepared.amplitude_mm, result[:, 0] / prepared.amplitude_mm
+    kdyn, angle = np.hypot(storage, loss), np.degrees(np.arctan2(loss, storage))
+    if np.any(result[:, 3] == 1):
+        warnings.warn(f"{table.name}: some cases of the fitted set reach no steady state within {MAX_CYCLES} cycles",
+                      CharacterisationWarning, stacklevel=3)
+    fixed, _ = prepared.stiffness(matrix, parameters.model.name)
+    return TableFit(table.name, kdyn / prepared.kdyn_N_per_mm - 1.0, angle - prepared.loss_angle_deg, prepared.weight,
+                    float(np.max(np.abs(fixed[0] / kdyn - 1.0))))
 
 
 def _round(value):

@@ -31,6 +31,8 @@ from typing import Sequence
 import numpy as np
 
 from identification.forward_model import DrivenInput, prepare_input
+from identification.kdyn_table import (FIT_CYCLES, FIT_STEPS_PER_CYCLE, KDYN_UNCERTAINTY, LOSS_ANGLE_UNCERTAINTY_DEG,
+                                       KdynTable)
 from identification.noise import NoiseEstimate, estimate_noise
 from identification.rig_tests import RigTest
 from identification.simulate import simulate_driven
@@ -53,17 +55,62 @@ class PreparedTest:
     sigma_N: float              # the noise level the residuals are divided by
 
 
+@dataclass(frozen=True)
+class PreparedTable:
+    """The rows of a dynamic-stiffness table the objective counts (weight > 0)."""
+    name: str
+    amplitude_mm: np.ndarray
+    frequency_hz: np.ndarray
+    preload_mm: np.ndarray
+    kdyn_N_per_mm: np.ndarray
+    loss_angle_deg: np.ndarray
+    weight: np.ndarray
+
+    @classmethod
+    def of(cls, table: KdynTable) -> "PreparedTable":
+        kept = table.weight > 0
+        return cls(table.name, *(np.ascontiguousarray(a[kept]) for a in (
+            table.amplitude_mm, table.frequency_hz, table.preload_mm, table.kdyn_N_per_mm, table.loss_angle_deg,
+            table.weight)))
+
+    @property
+    def size(self) -> int:
+        return 2 * self.amplitude_mm.size
+
+    def stiffness(self, matrix: np.ndarray, model: str) -> tuple[np.ndarray, np.ndarray]:
+        """|K*| [N/mm] and the loss angle [deg] of P candidates on every row, each (P, rows):
+        FIT_CYCLES cycles of FIT_STEPS_PER_CYCLE steps from rest (``identification.kdyn_table``)."""
+        from identification.dynamic_stiffness import run_sines
+        result, _ = run_sines(matrix, model, self.amplitude_mm, self.frequency_hz, self.preload_mm,
+                              FIT_STEPS_PER_CYCLE, FIT_CYCLES, 0.0, FIT_MAX_SUBSTEPS)
+        shape = (matrix.shape[0], self.amplitude_mm.size)
+        failed = (result[:, 3] == 2).reshape(shape)
+        storage = result[:, 1].reshape(shape) / self.amplitude_mm
+        loss = result[:, 0].reshape(shape) / self.amplitude_mm
+        kdyn, angle = np.hypot(storage, loss), np.degrees(np.arctan2(loss, storage))
+        return np.where(failed, np.nan, kdyn), np.where(failed, np.nan, angle)
+
+    def residuals(self, matrix: np.ndarray, model: str) -> np.ndarray:
+        """(P, 2*rows): relative |K*| errors over KDYN_UNCERTAINTY, then loss-angle errors over
+        LOSS_ANGLE_UNCERTAINTY_DEG, each times its row's weight (NaN where a candidate fails)."""
+        kdyn, angle = self.stiffness(matrix, model)
+        with np.errstate(invalid="ignore", over="ignore"):
+            return np.hstack([(kdyn / self.kdyn_N_per_mm - 1.0) * (self.weight / KDYN_UNCERTAINTY),
+                              (angle - self.loss_angle_deg) * (self.weight / LOSS_ANGLE_UNCERTAINTY_DEG)])
+
+
 class Objective:
     """Misfit (chi^2/n) of candidate parameter sets of ``model``; see the module docstring."""
 
     def __init__(self, tests: Sequence[RigTest], noise: Sequence[NoiseEstimate] | None = None,
-                 steps: Sequence[int | None] | None = None, model: str = "proposed"):
+                 steps: Sequence[int | None] | None = None, model: str = "proposed", table: KdynTable | None = None):
         """``steps``: communication steps per sample of each test (None: chosen from the
         signal, ``forward_model.steps_per_sample``); ``identification.refinement`` raises them
-        where a candidate's response needs it. Candidates are (P, m) matrices of ``model``'s
-        parameters in its order (``compiled_core.parameter_matrix``)."""
-        if not tests:
-            raise ValueError("the objective needs at least one training test")
+        where a candidate's response needs it. ``table``: a dynamic-stiffness table whose rows
+        add two residuals each (``identification.kdyn_table``). Candidates are (P, m) matrices
+        of ``model``'s parameters in its order (``compiled_core.parameter_matrix``)."""
+        if not tests and table is None:
+            raise ValueError("the objective needs at least one training test or a dynamic-stiffness table")
         noise = list(noise) if noise is not None else [estimate_noise(t.measurement.force_N) for t in tests]
         if len(noise) != len(tests):
             raise ValueError(f"{len(noise)} noise levels for {len(tests)} tests")
@@ -79,7 +126,16 @@ class Objective:
                                    steps=m_steps)
             sigma = max(level.sigma_N, MIN_NOISE_FRACTION * level.rms_force_N)
             self.tests.append(PreparedTest(test.name, driven, m.force_N[driven.sample_index], sigma))
-        self.size = sum(t.measured_N.size for t in self.tests)
+        self.table = PreparedTable.of(table) if table is not None else None
+        self.size = sum(t.measured_N.size for t in self.tests) + (self.table.size if self.table else 0)
+
+    def with_steps(self, tests: Sequence[RigTest], steps: Sequence[int]) -> "Objective":
+        """The same objective (of ``tests``, the ones it was made of) with other steps per
+        sample; the table's part unchanged."""
+        refined = Objective(tests, self.noise, steps, self.model)
+        refined.table = self.table
+        refined.size = self.size
+        return refined
 
     @property
     def steps_per_sample(self) -> list[int]:
@@ -93,6 +149,8 @@ class Objective:
         for test in self.tests:
             predicted = simulate_driven(matrix, test.driven, FIT_MAX_SUBSTEPS, self.model)
             parts.append((predicted - test.measured_N) * (scale / test.sigma_N))
+        if self.table is not None:
+            parts.append(self.table.residuals(matrix, self.model) * scale)
         residual = np.concatenate(parts, axis=1)
         return np.where(np.isfinite(residual), residual, FAILED_RESIDUAL * scale)
 
@@ -101,9 +159,10 @@ class Objective:
         return np.sum(self.residual_matrix(np.atleast_2d(matrix)) ** 2, axis=1)
 
     def test_misfits(self, matrix: np.ndarray) -> np.ndarray:
-        """(NRMSE_i/noise_i)^2 on the residual samples of each test, shape (P, tests)."""
+        """(NRMSE_i/noise_i)^2 on the residual samples of each test, shape (P, tests); with a
+        table, a last column: its mean squared residual (in uncertainty units)."""
         residual = self.residual_matrix(np.atleast_2d(matrix)) * math.sqrt(self.size)
-        bounds = np.cumsum([0] + [t.measured_N.size for t in self.tests])
+        bounds = np.cumsum([0] + [t.measured_N.size for t in self.tests] + ([self.table.size] if self.table else []))
         return np.column_stack([np.mean(residual[:, a:b] ** 2, axis=1) for a, b in zip(bounds[:-1], bounds[1:])])
 
 

@@ -65,6 +65,8 @@ def refine_steps(objective: Objective, tests: Sequence[RigTest], row: np.ndarray
     if len(tests) != len(objective.tests):
         raise ValueError(f"{len(tests)} tests for an objective of {len(objective.tests)}")
     candidate = np.atleast_2d(row)
+    if not tests:      # a dynamic-stiffness table alone: its steps per cycle are fixed
+        return Refinement(objective, False, (), 0)
     budget = ERROR_BUDGET * delta_chi2 / len(tests)
     steps, errors, work = [], [], 0
     for test, prepared in zip(tests, objective.tests):
@@ -92,7 +94,7 @@ def refine_steps(objective: Objective, tests: Sequence[RigTest], row: np.ndarray
         steps.append(m)
         errors.append(error)
     changed = steps != objective.steps_per_sample
-    refined = Objective(tests, objective.noise, steps, objective.model) if changed else objective
+    refined = objective.with_steps(tests, steps) if changed else objective
     # cost in evaluations of every test at its signal's m (a simulation's cost grows with m)
     evaluations = math.ceil(work / max(1, sum(objective.steps_per_sample)))
     return Refinement(refined, changed, tuple(errors), evaluations)

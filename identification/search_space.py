@@ -128,14 +128,23 @@ class SearchSpace:
 
     @classmethod
     def from_measurements(cls, measurements: Sequence[Measurement], model: str = "proposed",
-                          steps: Sequence[bool] = ()) -> "SearchSpace":
+                          steps: Sequence[bool] = (), table=None) -> "SearchSpace":
         """The space for these tests; ``steps`` marks which are step tests (left out of the
-        scales unless all are)."""
+        scales unless all are). ``table``: a dynamic-stiffness table (``kdyn_table.KdynTable``),
+        which sets the scales when no test other than steps is given (:meth:`from_table`)."""
         if model not in MODEL_SPACES:
             raise ValueError(f"no search space for the {model!r} model; choose one of {', '.join(MODEL_SPACES)} "
                              "(kelvin_voigt is fitted by linear least squares)")
         steps = list(steps) or [False] * len(measurements)
-        scaling = [m for m, is_step in zip(measurements, steps) if not is_step] or list(measurements)
+        scaling = [m for m, is_step in zip(measurements, steps) if not is_step]
+        if table is not None:
+            from_table = cls.from_table(table, model)
+            if not scaling:
+                peak = max([from_table.F_ref] + [float(np.max(np.abs(m.force_N))) for m in measurements])
+                interval = min([from_table.sample_interval_s] + [float(np.median(np.diff(m.time_s)))
+                                                                 for m in measurements])
+                return cls(from_table.k_ref, from_table.c_ref, peak, interval, model)
+        scaling = scaling or list(measurements)
         kelvin_voigt = KelvinVoigtFit.fit(scaling)
         peak = max(float(np.max(np.abs(m.force_N))) for m in scaling)
         amplitude = max(float(np.max(np.abs(m.displacement_mm))) for m in scaling)
@@ -148,6 +157,24 @@ class SearchSpace:
         k_ref = abs(kelvin_voigt.k) if kelvin_voigt.k > 0 else peak / amplitude
         c_ref = abs(kelvin_voigt.c) if kelvin_voigt.c > 0 else k_ref * 0.01
         interval = min(float(np.median(np.diff(m.time_s))) for m in measurements)
+        if table is not None:
+            interval = min(interval, from_table.sample_interval_s)
+        return cls(k_ref, c_ref, peak, interval, model)
+
+    @classmethod
+    def from_table(cls, table, model: str = "proposed") -> "SearchSpace":
+        """Scales from a dynamic-stiffness table's rows of weight > 0: k_ref the median storage
+        stiffness K', c_ref the median K''/omega (the Kelvin-Voigt c of each row), F_ref the
+        largest |K*|*X, the interval that of the fit's sine loop at the highest frequency."""
+        from identification.kdyn_table import FIT_STEPS_PER_CYCLE
+        kept = table.weight > 0
+        angle = np.radians(table.loss_angle_deg[kept])
+        storage = table.kdyn_N_per_mm[kept] * np.cos(angle)
+        damping = table.kdyn_N_per_mm[kept] * np.sin(angle) / (2 * math.pi * table.frequency_hz[kept])
+        k_ref = float(np.median(storage)) if np.median(storage) > 0 else float(np.median(table.kdyn_N_per_mm[kept]))
+        c_ref = float(np.median(damping)) if np.median(damping) > 0 else k_ref * 0.01
+        peak = float(np.max(table.kdyn_N_per_mm[kept] * table.amplitude_mm[kept]))
+        interval = 1.0 / (FIT_STEPS_PER_CYCLE * float(np.max(table.frequency_hz[kept])))
         return cls(k_ref, c_ref, peak, interval, model)
 
     @property

@@ -15,7 +15,10 @@ from scipy.integrate import solve_ivp
 from fmu_src.parameter_files import load_parameters, read_ensemble, save_ensemble
 from identification.__main__ import main
 from identification.dynamic_stiffness import COLUMNS, CharacterisationWarning, characterise
+from identification.compiled_core import parameter_matrix
 from identification.errors import IdentificationError
+from identification.kdyn_table import KDYN_UNCERTAINTY, LOSS_ANGLE_UNCERTAINTY_DEG, KdynTable, load_kdyn_table
+from identification.objectives import Objective
 
 REPO = Path(__file__).resolve().parents[1]
 TABLE5 = load_parameters(REPO / "data" / "params_table5_combined.json")
@@ -177,3 +180,70 @@ def test_command_line(tmp_path, capsys):
     assert main(["characterise", "--params", str(REPO / "data" / "params_table5_combined.json"),
                  "--out", str(tmp_path / "kdyn.txt")]) == 2
     assert "--out" in capsys.readouterr().err
+
+
+# ---------------------------------------------------------------------------- tables as training data
+def _write_table(path, text):
+    path.write_text(text)
+    return path
+
+
+def test_a_written_table_reads_back(tmp_path):
+    table = characterise(TABLE5, [0.5, 2.0], [1.0, 10.0], preload_mm=0.5)
+    read = load_kdyn_table(table.to_csv(tmp_path / "k.csv", comments=("a comment",)))
+    np.testing.assert_allclose(read.kdyn_N_per_mm, table.kdyn_N_per_mm, rtol=1e-9)
+    np.testing.assert_allclose(read.loss_angle_deg, table.loss_angle_deg, rtol=1e-9)
+    assert np.all(read.preload_mm == 0.5) and np.all(read.weight == 1.0)
+
+
+@pytest.mark.parametrize("text, message", [
+    ("amplitude_mm,frequency_hz,kdyn_N_per_mm\n1,10,1000\n", "missing column.*loss_angle_deg"),
+    ("amplitude_mm,frequency_hz,kdyn_N_per_mm,loss_angle_deg\n1,10,1000,5\n0,10,1000,5\n",
+     "line 3, column amplitude_mm: 0 mm"),
+    ("amplitude_mm,frequency_hz,kdyn_N_per_mm,loss_angle_deg\n1,-10,1000,5\n", "line 2, column frequency_hz"),
+    ("amplitude_mm,frequency_hz,kdyn_N_per_mm,loss_angle_deg\n1,10,1000,95\n", "line 2, column loss_angle_deg: 95"),
+    ("amplitude_mm,frequency_hz,kdyn_N_per_mm,loss_angle_deg\n1,10,abc,5\n", "column kdyn_N_per_mm: 'abc'"),
+    ("amplitude_mm,frequency_hz,kdyn_N_per_mm,loss_angle_deg\n1,10,1000,5\n1,10,1100,6\n", "line 3.*twice.*line 2"),
+    ("amplitude_mm,frequency_hz,kdyn_N_per_mm,loss_angle_deg,weight\n1,10,1000,5,-1\n", "column weight: -1"),
+])
+def test_a_bad_table_names_line_and_column(tmp_path, text, message):
+    with pytest.raises(IdentificationError, match=message):
+        load_kdyn_table(_write_table(tmp_path / "bad.csv", text))
+
+
+def test_an_implausible_table_warns(tmp_path):
+    path = _write_table(tmp_path / "k.csv", "amplitude_mm,frequency_hz,kdyn_N_per_mm,loss_angle_deg\n60,10,1000,5\n")
+    with pytest.warns(CharacterisationWarning, match="amplitude 60 mm is above 50 mm"):
+        load_kdyn_table(path)
+
+
+def test_table_residuals_are_in_uncertainty_units():
+    """At the true parameters the objective's table residuals are the table's own errors over
+    KDYN_UNCERTAINTY and LOSS_ANGLE_UNCERTAINTY_DEG (up to the fit loop's 6-cycle error)."""
+    exact = characterise(TABLE5, [0.5, 2.0], [1.0, 10.0, 30.0])
+    shifted = KdynTable.from_characterisation(exact).with_values(exact.kdyn_N_per_mm * 1.02,
+                                                                 exact.loss_angle_deg - 0.4)
+    residuals = Objective([], table=shifted).residual_matrix(parameter_matrix([TABLE5]))[0] * math.sqrt(12)
+    np.testing.assert_allclose(residuals[:6], (1 / 1.02 - 1) / KDYN_UNCERTAINTY, atol=0.1)
+    np.testing.assert_allclose(residuals[6:], 0.4 / LOSS_ANGLE_UNCERTAINTY_DEG, atol=0.15)
+
+
+def test_kelvin_voigt_fit_from_a_table_recovers_k_and_c(tmp_path, capsys):
+    """A Kelvin-Voigt table (exact, from the closed form) fitted back by the command line."""
+    k, c = 900.0, 2.5
+    exact = characterise({"k": k, "c": c, "preload": 0.0}, [0.5, 2.0], [1.0, 10.0, 40.0], model="kelvin_voigt")
+    table = exact.to_csv(tmp_path / "kv.csv")
+    out = tmp_path / "kv_fit.json"
+    assert main(["fit", "--kdyn", str(table), "--model", "kelvin_voigt", "--out", str(out), "--quiet"]) == 0
+    fitted = load_parameters(out)
+    assert fitted["k"] == pytest.approx(k, rel=1e-6) and fitted["c"] == pytest.approx(c, rel=1e-6)
+    provenance = json.loads(out.read_text())["fit"]
+    assert provenance["tests"][-1]["kind"] == "kdyn" and provenance["tests"][-1]["at_floor"]
+    assert str(table) in provenance["data"]
+    assert "kv.csv" in capsys.readouterr().out
+
+
+def test_compare_refuses_a_table(tmp_path, capsys):
+    path = _write_table(tmp_path / "k.csv", "amplitude_mm,frequency_hz,kdyn_N_per_mm,loss_angle_deg\n1,10,1000,5\n")
+    assert main(["compare", "--kdyn", str(path), "--out", str(tmp_path / "c")]) == 2
+    assert "fit --kdyn" in capsys.readouterr().err

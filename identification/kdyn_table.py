@@ -1,0 +1,149 @@
+"""A dynamic-stiffness table as training data: what a supplier's data sheet gives.
+
+CSV columns ``amplitude_mm,frequency_hz,kdyn_N_per_mm,loss_angle_deg``, optionally
+``preload_mm`` (default 0) and ``weight`` (default 1; 0 leaves a row out), in any order, ``#``
+comment lines allowed: exactly what ``python -m identification characterise`` writes, so a
+computed table reads back. Each row is one sine of amplitude X about the preload P at frequency
+f, its dynamic stiffness |K*| [N/mm] and loss angle delta [deg] (first harmonic, steady state).
+
+Residuals (``identification.objectives``): per row, the relative |K*| error over
+KDYN_UNCERTAINTY and the loss-angle error over LOSS_ANGLE_UNCERTAINTY_DEG, each times the row's
+weight: the table's errors in units of a typical forced-vibration test's uncertainty (ISO
+4664-1 rigs quote about 1 % on |K*| and a few tenths of a degree on delta), as a time series's
+residuals are in units of its noise. A fit at the table's floor has an rms of both at most
+``fitting.FLOOR_FACTOR``.
+
+Model side: the compiled sine loop (``identification.steady_state``) with FIT_STEPS_PER_CYCLE
+steps per cycle for exactly FIT_CYCLES cycles from rest at the preload (a fixed count keeps the
+misfit a smooth function of the parameters; a steady-state test would make it jump from one
+candidate to the next). The fit checks, at its result, how far the last of these cycles is from
+the converged table (``FitResult.summary``).
+"""
+from __future__ import annotations
+
+import csv
+import math
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from identification.dynamic_stiffness import PLAUSIBLE_AMPLITUDE_MM, PLAUSIBLE_FREQUENCY_HZ, CharacterisationWarning
+from identification.errors import IdentificationError
+
+KDYN_UNCERTAINTY = 0.01
+LOSS_ANGLE_UNCERTAINTY_DEG = 0.2
+FIT_STEPS_PER_CYCLE = 64
+"""The secant path through 64 samples per cycle carries a first harmonic (pi/64)^2/3 = 8e-4
+smaller than the sine's: a tenth of KDYN_UNCERTAINTY."""
+FIT_CYCLES = 6
+"""From rest, the sixth cycle's first harmonic is within 8e-4 of the steady state's |K*| and 0.025 deg
+of its loss angle for the paper's Tables 2, 4, 5 on 0.5-3 mm, 1-30 Hz (64 steps per cycle,
+measured 2026-11-23): about a tenth of the uncertainties; twelve cycles would halve little."""
+REQUIRED = ("amplitude_mm", "frequency_hz", "kdyn_N_per_mm", "loss_angle_deg")
+OPTIONAL = {"preload_mm": 0.0, "weight": 1.0}
+
+
+@dataclass(frozen=True)
+class KdynTable:
+    """The rows of a dynamic-stiffness table (arrays of equal length; units in the names)."""
+    amplitude_mm: np.ndarray
+    frequency_hz: np.ndarray
+    preload_mm: np.ndarray
+    kdyn_N_per_mm: np.ndarray
+    loss_angle_deg: np.ndarray
+    weight: np.ndarray
+    source: str = "table"
+
+    @property
+    def name(self) -> str:
+        return Path(self.source).name
+
+    def __len__(self) -> int:
+        return self.amplitude_mm.size
+
+    @classmethod
+    def from_characterisation(cls, table, source: str = "computed table") -> "KdynTable":
+        """The rows of a ``dynamic_stiffness.DynamicStiffness``, weight 1."""
+        return cls(table.amplitude_mm.copy(), table.frequency_hz.copy(), table.preload_mm.copy(),
+                   table.kdyn_N_per_mm.copy(), table.loss_angle_deg.copy(), np.ones(len(table)), source)
+
+    def with_values(self, kdyn_N_per_mm, loss_angle_deg, source: str | None = None) -> "KdynTable":
+        return KdynTable(self.amplitude_mm, self.frequency_hz, self.preload_mm, np.asarray(kdyn_N_per_mm, float),
+                         np.asarray(loss_angle_deg, float), self.weight, source or self.source)
+
+
+def load_kdyn_table(path: str | Path) -> KdynTable:
+    """Read and check a table (see the module docstring). IdentificationError names the line
+    and column of what is wrong: a missing column, a value that is not a number, an amplitude
+    or frequency <= 0, |K*| <= 0, a loss angle outside 0-90 deg, a negative weight, a case
+    (amplitude, frequency, preload) given twice. Warns (CharacterisationWarning) about an
+    amplitude above 50 mm or a frequency above 500 Hz (a unit mistake, most likely)."""
+    path = Path(path)
+    try:
+        with open(path, newline="", encoding="utf-8") as handle:
+            lines = [(number, line) for number, line in enumerate(handle, start=1)
+                     if line.strip() and not line.lstrip().startswith("#")]
+    except FileNotFoundError:
+        raise IdentificationError(f"dynamic-stiffness table {path} does not exist") from None
+    except UnicodeDecodeError as exc:
+        raise IdentificationError(f"{path}: not a text CSV file ({exc})") from None
+    if not lines:
+        raise IdentificationError(f"{path}: no header and no rows")
+    header = [name.strip() for name in next(csv.reader([lines[0][1]]))]
+    missing = [name for name in REQUIRED if name not in header]
+    if missing:
+        raise IdentificationError(f"{path}: missing column(s) {', '.join(missing)}; a table needs "
+                                  f"{','.join(REQUIRED)} (optional: {', '.join(OPTIONAL)}), found {','.join(header)}")
+    if len(lines) < 2:
+        raise IdentificationError(f"{path}: a header but no rows")
+    columns = {name: [] for name in (*REQUIRED, *OPTIONAL)}
+    seen: dict[tuple, int] = {}
+    for number, line in lines[1:]:
+        cells = [cell.strip() for cell in next(csv.reader([line]))]
+        if len(cells) != len(header):
+            raise IdentificationError(f"{path}, line {number}: {len(cells)} values for {len(header)} columns")
+        row = dict(zip(header, cells))
+        values = {}
+        for name in columns:
+            text = row.get(name, "")
+            if name in OPTIONAL and text == "":
+                values[name] = OPTIONAL[name]
+                continue
+            try:
+                values[name] = float(text)
+            except ValueError:
+                raise IdentificationError(f"{path}, line {number}, column {name}: {text!r} is not a number") from None
+            if not math.isfinite(values[name]):
+                raise IdentificationError(f"{path}, line {number}, column {name}: {text} is not a finite number")
+        _check_row(path, number, values)
+        case = (values["amplitude_mm"], values["frequency_hz"], values["preload_mm"])
+        if case in seen:
+            raise IdentificationError(f"{path}, line {number}: the case {case[0]:g} mm, {case[1]:g} Hz, preload "
+                                      f"{case[2]:g} mm is given twice (also line {seen[case]})")
+        seen[case] = number
+        for name in columns:
+            columns[name].append(values[name])
+    table = KdynTable(*(np.array(columns[name]) for name in ("amplitude_mm", "frequency_hz", "preload_mm",
+                                                            "kdyn_N_per_mm", "loss_angle_deg", "weight")),
+                      source=str(path))
+    if not np.any(table.weight > 0):
+        raise IdentificationError(f"{path}: every row has weight 0; give at least one row a weight > 0")
+    for what, values, unit, plausible in (("amplitude", table.amplitude_mm, "mm", PLAUSIBLE_AMPLITUDE_MM),
+                                          ("frequency", table.frequency_hz, "Hz", PLAUSIBLE_FREQUENCY_HZ)):
+        if np.any(values > plausible):
+            warnings.warn(f"{path}: {what} {float(np.max(values)):g} {unit} is above {plausible:g} {unit}, outside "
+                          "what bushing tests use: check the unit", CharacterisationWarning, stacklevel=2)
+    return table
+
+
+def _check_row(path, number, values) -> None:
+    for name, unit in (("amplitude_mm", "mm"), ("frequency_hz", "Hz"), ("kdyn_N_per_mm", "N/mm")):
+        if values[name] <= 0:
+            raise IdentificationError(f"{path}, line {number}, column {name}: {values[name]:g} {unit}; it must be > 0")
+    if not 0.0 <= values["loss_angle_deg"] <= 90.0:
+        raise IdentificationError(f"{path}, line {number}, column loss_angle_deg: {values['loss_angle_deg']:g} deg; "
+                                  "a loss angle lies between 0 and 90 deg (a passive bushing)")
+    if values["weight"] < 0:
+        raise IdentificationError(f"{path}, line {number}, column weight: {values['weight']:g}; give a weight >= 0")
