@@ -382,7 +382,8 @@ def _settings(base: SearchSettings, screening: int | None, starts: int | None) -
 def _search(tests, noise, model, preset, settings, seed, engine, progress, started, table=None) -> FitResult:
     measurements = [t.measurement for t in tests]
     space = SearchSpace.from_measurements(measurements, model, steps=[t.kind == "step" for t in tests], table=table)
-    problem = Problem(Objective(tests, noise, model=space.model, table=table), space)
+    # with a table, the screening and the early stages run its coarser loop (kdyn_table)
+    problem = Problem(Objective(tests, noise, model=space.model, table=table, search=table is not None), space)
     ga_evaluations = PAPER_GA["population"] * PAPER_GA["generations"]
     bars = _Progress(progress, settings, ga_evaluations if preset == "paper" else settings.screening)
     if preset == "paper":
@@ -399,7 +400,8 @@ def _search(tests, noise, model, preset, settings, seed, engine, progress, start
     # runs once more, and a third check only reports (identification.refinement).
     notes = []
     refinement = _check_steps(problem, tests, records, n, d)
-    problem = Problem(refinement.objective, space)
+    problem = Problem(refinement.objective.with_steps(tests, refinement.objective.steps_per_sample, search=False)
+                      if table is not None else refinement.objective, space)
     records = run_stages(problem, engine, records, [last], bars.stage, first_stage=len(early))
     refinement_at_best = _check_steps(problem, tests, records, n, d)
     evaluations += refinement.evaluations + refinement_at_best.evaluations

@@ -32,7 +32,7 @@ import numpy as np
 
 from identification.forward_model import DrivenInput, prepare_input
 from identification.kdyn_table import (FIT_CYCLES, FIT_STEPS_PER_CYCLE, KDYN_UNCERTAINTY, LOSS_ANGLE_UNCERTAINTY_DEG,
-                                       KdynTable)
+                                       SEARCH_CYCLES, SEARCH_STEPS_PER_CYCLE, KdynTable)
 from identification.noise import NoiseEstimate, estimate_noise
 from identification.rig_tests import RigTest
 from identification.simulate import simulate_driven
@@ -65,13 +65,17 @@ class PreparedTable:
     kdyn_N_per_mm: np.ndarray
     loss_angle_deg: np.ndarray
     weight: np.ndarray
+    steps_per_cycle: int = FIT_STEPS_PER_CYCLE
+    cycles: int = FIT_CYCLES
 
     @classmethod
-    def of(cls, table: KdynTable) -> "PreparedTable":
+    def of(cls, table: KdynTable, search: bool = False) -> "PreparedTable":
+        """The rows of weight > 0, with the fit's loop, or the search's coarser one (``search``)."""
         kept = table.weight > 0
+        loop = (SEARCH_STEPS_PER_CYCLE, SEARCH_CYCLES) if search else (FIT_STEPS_PER_CYCLE, FIT_CYCLES)
         return cls(table.name, *(np.ascontiguousarray(a[kept]) for a in (
             table.amplitude_mm, table.frequency_hz, table.preload_mm, table.kdyn_N_per_mm, table.loss_angle_deg,
-            table.weight)))
+            table.weight)), *loop)
 
     @property
     def size(self) -> int:
@@ -79,10 +83,10 @@ class PreparedTable:
 
     def stiffness(self, matrix: np.ndarray, model: str) -> tuple[np.ndarray, np.ndarray]:
         """|K*| [N/mm] and the loss angle [deg] of P candidates on every row, each (P, rows):
-        FIT_CYCLES cycles of FIT_STEPS_PER_CYCLE steps from rest (``identification.kdyn_table``)."""
+        ``cycles`` cycles of ``steps_per_cycle`` steps from rest (``identification.kdyn_table``)."""
         from identification.dynamic_stiffness import run_sines
         result, _ = run_sines(matrix, model, self.amplitude_mm, self.frequency_hz, self.preload_mm,
-                              FIT_STEPS_PER_CYCLE, FIT_CYCLES, 0.0, FIT_MAX_SUBSTEPS)
+                              self.steps_per_cycle, self.cycles, 0.0, FIT_MAX_SUBSTEPS)
         shape = (matrix.shape[0], self.amplitude_mm.size)
         failed = (result[:, 3] == 2).reshape(shape)
         storage = result[:, 1].reshape(shape) / self.amplitude_mm
@@ -103,12 +107,14 @@ class Objective:
     """Misfit (chi^2/n) of candidate parameter sets of ``model``; see the module docstring."""
 
     def __init__(self, tests: Sequence[RigTest], noise: Sequence[NoiseEstimate] | None = None,
-                 steps: Sequence[int | None] | None = None, model: str = "proposed", table: KdynTable | None = None):
+                 steps: Sequence[int | None] | None = None, model: str = "proposed", table: KdynTable | None = None,
+                 search: bool = False):
         """``steps``: communication steps per sample of each test (None: chosen from the
         signal, ``forward_model.steps_per_sample``); ``identification.refinement`` raises them
         where a candidate's response needs it. ``table``: a dynamic-stiffness table whose rows
-        add two residuals each (``identification.kdyn_table``). Candidates are (P, m) matrices
-        of ``model``'s parameters in its order (``compiled_core.parameter_matrix``)."""
+        add two residuals each (``identification.kdyn_table``), with the search's coarser loop
+        if ``search``. Candidates are (P, m) matrices of ``model``'s parameters in its order
+        (``compiled_core.parameter_matrix``)."""
         if not tests and table is None:
             raise ValueError("the objective needs at least one training test or a dynamic-stiffness table")
         noise = list(noise) if noise is not None else [estimate_noise(t.measurement.force_N) for t in tests]
@@ -126,16 +132,18 @@ class Objective:
                                    steps=m_steps)
             sigma = max(level.sigma_N, MIN_NOISE_FRACTION * level.rms_force_N)
             self.tests.append(PreparedTest(test.name, driven, m.force_N[driven.sample_index], sigma))
-        self.table = PreparedTable.of(table) if table is not None else None
+        self._source_table = table
+        self.table = PreparedTable.of(table, search) if table is not None else None
         self.size = sum(t.measured_N.size for t in self.tests) + (self.table.size if self.table else 0)
 
-    def with_steps(self, tests: Sequence[RigTest], steps: Sequence[int]) -> "Objective":
+    def with_steps(self, tests: Sequence[RigTest], steps: Sequence[int], search: bool | None = None) -> "Objective":
         """The same objective (of ``tests``, the ones it was made of) with other steps per
-        sample; the table's part unchanged."""
-        refined = Objective(tests, self.noise, steps, self.model)
-        refined.table = self.table
-        refined.size = self.size
-        return refined
+        sample, and the table's search loop (``search``: True), its fit loop (False) or the
+        one it has (None)."""
+        if search is None:
+            search = self.table is not None and self.table.cycles == SEARCH_CYCLES \
+                and self.table.steps_per_cycle == SEARCH_STEPS_PER_CYCLE
+        return Objective(tests, self.noise, steps, self.model, self._source_table, search)
 
     @property
     def steps_per_sample(self) -> list[int]:
