@@ -505,16 +505,17 @@ def _table_fit(table: KdynTable | None, parameters: ParameterSet) -> TableFit | 
     from identification.dynamic_stiffness import MAX_CYCLES, STEPS_PER_CYCLE, TOLERANCE, CharacterisationWarning, run_sines
     from identification.objectives import PreparedTable
     prepared = PreparedTable.of(table)
+    rows = prepared.rows
     matrix = parameter_matrix([parameters.parameters], parameters.model.name)
-    result, _ = run_sines(matrix, parameters.model.name, prepared.amplitude_mm, prepared.frequency_hz,
-                          prepared.preload_mm, STEPS_PER_CYCLE, MAX_CYCLES, TOLERANCE)
-    storage, loss = result[:, 1] / prepared.amplitude_mm, result[:, 0] / prepared.amplitude_mm
+    result, _ = run_sines(matrix, parameters.model.name, rows.amplitude_mm, rows.frequency_hz, rows.preload_mm,
+                          STEPS_PER_CYCLE, MAX_CYCLES, TOLERANCE)
+    storage, loss = result[:, 1] / rows.amplitude_mm, result[:, 0] / rows.amplitude_mm
     kdyn, angle = np.hypot(storage, loss), np.degrees(np.arctan2(loss, storage))
     if np.any(result[:, 3] == 1):
         warnings.warn(f"{table.name}: some cases of the fitted set reach no steady state within {MAX_CYCLES} cycles",
                       CharacterisationWarning, stacklevel=3)
     fixed, _ = prepared.stiffness(matrix, parameters.model.name)
-    return TableFit(table.name, kdyn / prepared.kdyn_N_per_mm - 1.0, angle - prepared.loss_angle_deg, prepared.weight,
+    return TableFit(table.name, kdyn / rows.kdyn_N_per_mm - 1.0, angle - rows.loss_angle_deg, rows.weight,
                     float(np.max(np.abs(fixed[0] / kdyn - 1.0))))
 
 

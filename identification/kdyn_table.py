@@ -74,6 +74,13 @@ class KdynTable:
         return cls(table.amplitude_mm.copy(), table.frequency_hz.copy(), table.preload_mm.copy(),
                    table.kdyn_N_per_mm.copy(), table.loss_angle_deg.copy(), np.ones(len(table)), source)
 
+    def kept(self) -> "KdynTable":
+        """The rows of weight > 0 (contiguous arrays)."""
+        rows = self.weight > 0
+        return KdynTable(*(np.ascontiguousarray(a[rows]) for a in (
+            self.amplitude_mm, self.frequency_hz, self.preload_mm, self.kdyn_N_per_mm, self.loss_angle_deg,
+            self.weight)), self.source)
+
     def with_values(self, kdyn_N_per_mm, loss_angle_deg, source: str | None = None) -> "KdynTable":
         return KdynTable(self.amplitude_mm, self.frequency_hz, self.preload_mm, np.asarray(kdyn_N_per_mm, float),
                          np.asarray(loss_angle_deg, float), self.weight, source or self.source)

@@ -57,40 +57,32 @@ class PreparedTest:
 
 @dataclass(frozen=True)
 class PreparedTable:
-    """The rows of a dynamic-stiffness table the objective counts (weight > 0)."""
-    name: str
-    amplitude_mm: np.ndarray
-    frequency_hz: np.ndarray
-    preload_mm: np.ndarray
-    kdyn_N_per_mm: np.ndarray
-    loss_angle_deg: np.ndarray
-    weight: np.ndarray
+    """The rows of a dynamic-stiffness table the objective counts (weight > 0) and its loop."""
+    rows: KdynTable
     steps_per_cycle: int = FIT_STEPS_PER_CYCLE
     cycles: int = FIT_CYCLES
 
     @classmethod
     def of(cls, table: KdynTable, search: bool = False) -> "PreparedTable":
-        """The rows of weight > 0, with the fit's loop, or the search's coarser one (``search``)."""
-        kept = table.weight > 0
+        """With the fit's loop, or the search's coarser one (``search``)."""
         loop = (SEARCH_STEPS_PER_CYCLE, SEARCH_CYCLES) if search else (FIT_STEPS_PER_CYCLE, FIT_CYCLES)
-        return cls(table.name, *(np.ascontiguousarray(a[kept]) for a in (
-            table.amplitude_mm, table.frequency_hz, table.preload_mm, table.kdyn_N_per_mm, table.loss_angle_deg,
-            table.weight)), *loop)
+        return cls(table.kept(), *loop)
 
     @property
     def size(self) -> int:
-        return 2 * self.amplitude_mm.size
+        return 2 * len(self.rows)
 
     def stiffness(self, matrix: np.ndarray, model: str) -> tuple[np.ndarray, np.ndarray]:
         """|K*| [N/mm] and the loss angle [deg] of P candidates on every row, each (P, rows):
         ``cycles`` cycles of ``steps_per_cycle`` steps from rest (``identification.kdyn_table``)."""
         from identification.dynamic_stiffness import run_sines
-        result, _ = run_sines(matrix, model, self.amplitude_mm, self.frequency_hz, self.preload_mm,
+        rows = self.rows
+        result, _ = run_sines(matrix, model, rows.amplitude_mm, rows.frequency_hz, rows.preload_mm,
                               self.steps_per_cycle, self.cycles, 0.0, FIT_MAX_SUBSTEPS)
-        shape = (matrix.shape[0], self.amplitude_mm.size)
+        shape = (matrix.shape[0], len(rows))
         failed = (result[:, 3] == 2).reshape(shape)
-        storage = result[:, 1].reshape(shape) / self.amplitude_mm
-        loss = result[:, 0].reshape(shape) / self.amplitude_mm
+        storage = result[:, 1].reshape(shape) / rows.amplitude_mm
+        loss = result[:, 0].reshape(shape) / rows.amplitude_mm
         kdyn, angle = np.hypot(storage, loss), np.degrees(np.arctan2(loss, storage))
         return np.where(failed, np.nan, kdyn), np.where(failed, np.nan, angle)
 
@@ -98,9 +90,10 @@ class PreparedTable:
         """(P, 2*rows): relative |K*| errors over KDYN_UNCERTAINTY, then loss-angle errors over
         LOSS_ANGLE_UNCERTAINTY_DEG, each times its row's weight (NaN where a candidate fails)."""
         kdyn, angle = self.stiffness(matrix, model)
+        rows = self.rows
         with np.errstate(invalid="ignore", over="ignore"):
-            return np.hstack([(kdyn / self.kdyn_N_per_mm - 1.0) * (self.weight / KDYN_UNCERTAINTY),
-                              (angle - self.loss_angle_deg) * (self.weight / LOSS_ANGLE_UNCERTAINTY_DEG)])
+            return np.hstack([(kdyn / rows.kdyn_N_per_mm - 1.0) * (rows.weight / KDYN_UNCERTAINTY),
+                              (angle - rows.loss_angle_deg) * (rows.weight / LOSS_ANGLE_UNCERTAINTY_DEG)])
 
 
 class Objective:
