@@ -175,9 +175,14 @@ def characterise(parameters, amplitudes_mm: Sequence[float] = DEFAULT_AMPLITUDES
     if failed[:cases].any():
         i = int(np.argmax(failed[:cases]))
         raise IdentificationError(f"the simulation of the {case_amplitude[i]:g} mm, {case_frequency[i]:g} Hz sine "
-                                  "fails (overflow or too many substeps): check the amplitude's unit (mm)")
+                                  "fails (overflow or too many substeps): check the units of the amplitude (mm) and "
+                                  "the frequency (Hz)")
+    runs = [k for k in range(members) if not failed[k * cases:(k + 1) * cases].any()]
     tables = [_table(result[k * cases:(k + 1) * cases], last[k * cases:(k + 1) * cases], case_amplitude,
-                     case_frequency, float(preload_mm)) for k in range(members) if not failed[k * cases:(k + 1) * cases].any()]
+                     case_frequency, float(preload_mm)) for k in runs]
+    if len(runs) < members:
+        warnings.warn(f"{members - len(runs)} of the {members} ensemble members fail on some case (overflow or too many "
+                      "substeps) and are left out of the min/max columns", CharacterisationWarning, stacklevel=2)
     best = tables[0]
     not_steady = ~best["converged"]
     if not_steady.any():
@@ -185,6 +190,10 @@ def characterise(parameters, amplitudes_mm: Sequence[float] = DEFAULT_AMPLITUDES
         warnings.warn(f"no steady state within {max_cycles} cycles for {listed}: the first harmonic still changes by "
                       f"more than {tolerance:g} per cycle; these rows are the last cycle's (raise max_cycles)",
                       CharacterisationWarning, stacklevel=2)
+    unsteady_members = sum(not t["converged"].all() for t in tables[1:])
+    if unsteady_members:
+        warnings.warn(f"{unsteady_members} ensemble member(s) reach no steady state within {max_cycles} cycles on some "
+                      "case; their last cycle is in the min/max columns", CharacterisationWarning, stacklevel=2)
     table = DynamicStiffness(case_amplitude, case_frequency, np.full(cases, float(preload_mm)),
                              **{name: best[name] for name in RESULT_COLUMNS}, cycles=best["cycles"],
                              converged=best["converged"], loop_force_N=best["loop"], model=bushing.name,

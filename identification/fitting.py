@@ -105,7 +105,7 @@ class TableFit:
     kdyn_errors: np.ndarray          # relative |K*| error per row
     angle_errors_deg: np.ndarray     # loss-angle error per row [deg]
     weight: np.ndarray
-    cycles_error: float              # largest |K*| difference of the fit's fixed-cycle loop from the converged one
+    cycles_error: float              # largest |K*| difference of the fit's fixed-cycle loop from its steady state
 
     @property
     def ratio(self) -> float:
@@ -506,17 +506,27 @@ def _table_fit(table: KdynTable | None, parameters: ParameterSet) -> TableFit | 
     from identification.objectives import PreparedTable
     prepared = PreparedTable.of(table)
     rows = prepared.rows
-    matrix = parameter_matrix([parameters.parameters], parameters.model.name)
-    result, _ = run_sines(matrix, parameters.model.name, rows.amplitude_mm, rows.frequency_hz, rows.preload_mm,
-                          STEPS_PER_CYCLE, MAX_CYCLES, TOLERANCE)
-    storage, loss = result[:, 1] / rows.amplitude_mm, result[:, 0] / rows.amplitude_mm
-    kdyn, angle = np.hypot(storage, loss), np.degrees(np.arctan2(loss, storage))
-    if np.any(result[:, 3] == 1):
-        warnings.warn(f"{table.name}: some cases of the fitted set reach no steady state within {MAX_CYCLES} cycles",
-                      CharacterisationWarning, stacklevel=3)
-    fixed, _ = prepared.stiffness(matrix, parameters.model.name)
+    model = parameters.model.name
+    matrix = parameter_matrix([parameters.parameters], model)
+
+    def steady(steps):
+        result, _ = run_sines(matrix, model, rows.amplitude_mm, rows.frequency_hz, rows.preload_mm, steps, MAX_CYCLES,
+                              TOLERANCE)
+        if np.any(result[:, 3] == 1):
+            warnings.warn(f"{table.name}: some cases of the fitted set reach no steady state within {MAX_CYCLES} "
+                          "cycles", CharacterisationWarning, stacklevel=4)
+        if np.any(result[:, 3] == 2):
+            warnings.warn(f"{table.name}: the fitted set fails on some cases (overflow or too many substeps); their "
+                          "errors are NaN", CharacterisationWarning, stacklevel=4)
+        storage, loss = result[:, 1] / rows.amplitude_mm, result[:, 0] / rows.amplitude_mm
+        return np.hypot(storage, loss), np.degrees(np.arctan2(loss, storage))
+
+    kdyn, angle = steady(STEPS_PER_CYCLE)
+    # the fit loop against the steady state at the fit loop's own steps: what its few cycles leave
+    fixed, _ = prepared.stiffness(matrix, model)
+    converged_fit_steps, _ = steady(prepared.steps_per_cycle)
     return TableFit(table.name, kdyn / rows.kdyn_N_per_mm - 1.0, angle - rows.loss_angle_deg, rows.weight,
-                    float(np.max(np.abs(fixed[0] / kdyn - 1.0))))
+                    float(np.max(np.abs(fixed[0] / converged_fit_steps - 1.0))))
 
 
 def _round(value):

@@ -61,6 +61,23 @@ class KdynTable:
     weight: np.ndarray
     source: str = "table"
 
+    def __post_init__(self):
+        columns = (self.amplitude_mm, self.frequency_hz, self.preload_mm, self.kdyn_N_per_mm, self.loss_angle_deg,
+                   self.weight)
+        if len({np.shape(c) for c in columns}) != 1 or np.ndim(self.amplitude_mm) != 1:
+            raise IdentificationError(f"{self.source}: the table's columns must be 1-D arrays of equal length")
+        names = ("amplitude_mm", "frequency_hz", "preload_mm", "kdyn_N_per_mm", "loss_angle_deg", "weight")
+        for row in range(len(self.amplitude_mm)):
+            values = {name: float(column[row]) for name, column in zip(names, columns)}
+            for name, value in values.items():
+                if not math.isfinite(value):
+                    raise IdentificationError(f"{self.source}, row {row + 1}, column {name}: {value} is not a finite "
+                                              "number")
+            _check_row(self.source, f"row {row + 1}", values)
+        if not np.any(self.weight > 0):
+            raise IdentificationError(f"{self.source}: every row has weight 0 (or there are no rows); give at least "
+                                      "one row a weight > 0")
+
     @property
     def name(self) -> str:
         return Path(self.source).name
@@ -94,7 +111,7 @@ def load_kdyn_table(path: str | Path) -> KdynTable:
     amplitude above 50 mm or a frequency above 500 Hz (a unit mistake, most likely)."""
     path = Path(path)
     try:
-        with open(path, newline="", encoding="utf-8") as handle:
+        with open(path, newline="", encoding="utf-8-sig") as handle:   # -sig: a spreadsheet's BOM
             lines = [(number, line) for number, line in enumerate(handle, start=1)
                      if line.strip() and not line.lstrip().startswith("#")]
     except FileNotFoundError:
@@ -104,6 +121,9 @@ def load_kdyn_table(path: str | Path) -> KdynTable:
     if not lines:
         raise IdentificationError(f"{path}: no header and no rows")
     header = [name.strip() for name in next(csv.reader([lines[0][1]]))]
+    repeated = sorted({name for name in header if header.count(name) > 1})
+    if repeated:
+        raise IdentificationError(f"{path}, line {lines[0][0]}: the column(s) {', '.join(repeated)} appear more than once")
     missing = [name for name in REQUIRED if name not in header]
     if missing:
         raise IdentificationError(f"{path}: missing column(s) {', '.join(missing)}; a table needs "
@@ -129,7 +149,7 @@ def load_kdyn_table(path: str | Path) -> KdynTable:
                 raise IdentificationError(f"{path}, line {number}, column {name}: {text!r} is not a number") from None
             if not math.isfinite(values[name]):
                 raise IdentificationError(f"{path}, line {number}, column {name}: {text} is not a finite number")
-        _check_row(path, number, values)
+        _check_row(path, f"line {number}", values)
         case = (values["amplitude_mm"], values["frequency_hz"], values["preload_mm"])
         if case in seen:
             raise IdentificationError(f"{path}, line {number}: the case {case[0]:g} mm, {case[1]:g} Hz, preload "
@@ -140,8 +160,6 @@ def load_kdyn_table(path: str | Path) -> KdynTable:
     table = KdynTable(*(np.array(columns[name]) for name in ("amplitude_mm", "frequency_hz", "preload_mm",
                                                             "kdyn_N_per_mm", "loss_angle_deg", "weight")),
                       source=str(path))
-    if not np.any(table.weight > 0):
-        raise IdentificationError(f"{path}: every row has weight 0; give at least one row a weight > 0")
     for what, values, unit, plausible in (("amplitude", table.amplitude_mm, "mm", PLAUSIBLE_AMPLITUDE_MM),
                                           ("frequency", table.frequency_hz, "Hz", PLAUSIBLE_FREQUENCY_HZ)):
         if np.any(values > plausible):
@@ -150,12 +168,13 @@ def load_kdyn_table(path: str | Path) -> KdynTable:
     return table
 
 
-def _check_row(path, number, values) -> None:
+def _check_row(path, where: str, values) -> None:
+    """``where``: "line N" of a file or "row N" of a table made in Python."""
     for name, unit in (("amplitude_mm", "mm"), ("frequency_hz", "Hz"), ("kdyn_N_per_mm", "N/mm")):
         if values[name] <= 0:
-            raise IdentificationError(f"{path}, line {number}, column {name}: {values[name]:g} {unit}; it must be > 0")
+            raise IdentificationError(f"{path}, {where}, column {name}: {values[name]:g} {unit}; it must be > 0")
     if not 0.0 <= values["loss_angle_deg"] <= 90.0:
-        raise IdentificationError(f"{path}, line {number}, column loss_angle_deg: {values['loss_angle_deg']:g} deg; "
+        raise IdentificationError(f"{path}, {where}, column loss_angle_deg: {values['loss_angle_deg']:g} deg; "
                                   "a loss angle lies between 0 and 90 deg (a passive bushing)")
     if values["weight"] < 0:
-        raise IdentificationError(f"{path}, line {number}, column weight: {values['weight']:g}; give a weight >= 0")
+        raise IdentificationError(f"{path}, {where}, column weight: {values['weight']:g}; give a weight >= 0")

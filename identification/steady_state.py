@@ -22,7 +22,8 @@ unconverged (status 1). Rounding: the sums are of rectangle-rule quadrature over
 exact for a band-limited force.
 
 Results per item: ``result[i] = (a, b, cycles, status)`` (status 0 converged, 1 cycle cap, 2
-failed step) and ``last[i]`` the forces of the last cycle simulated.
+failed step or a non-finite force, then a = b = NaN) and ``last[i]`` the forces of the last cycle
+simulated.
 """
 from __future__ import annotations
 
@@ -66,12 +67,12 @@ def _sine_steady_state(matrix, rows, amplitude, frequency, preload, steps, min_c
                     break
                 state_x = x_next
             cycles += 1
-            if failed:
-                status = 2
-                break
             a *= 2.0 / steps
             b *= 2.0 / steps
             size = math.sqrt(a * a + b * b)
+            if failed or not math.isfinite(size):
+                status, a, b = 2, math.nan, math.nan
+                break
             change = math.sqrt((a - previous_re) ** 2 + (b - previous_im) ** 2) / size if size > 0.0 else 0.0
             if cycles >= min_cycles and change <= tolerance:
                 if change <= ROUNDING:
