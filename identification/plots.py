@@ -84,11 +84,13 @@ def plot_waterfall(misfits: Sequence[float], stages: Sequence[int], best: float,
     return _save(figure, path)
 
 
-def plot_dynamic_stiffness(table, folder: Path) -> list[Path]:
+def plot_dynamic_stiffness(table, folder: Path, measured=None) -> list[Path]:
     """A bushing data sheet of a ``dynamic_stiffness.DynamicStiffness``: |K*| and the loss angle
     against frequency (log axis, one curve per amplitude), against amplitude (one curve per
     frequency), each with an ensemble's min-max shaded; and the steady-state loops of the
-    smallest and largest amplitude at the lowest and highest frequency. Returns the three PNGs."""
+    smallest and largest amplitude at the lowest and highest frequency. ``measured``: a
+    ``kdyn_table.KdynTable`` drawn as crosses on its curves (a fit's training table). Returns
+    the three PNGs."""
     plt = _pyplot()
     folder = Path(folder)
     amplitudes = np.unique(table.amplitude_mm)
@@ -108,6 +110,11 @@ def plot_dynamic_stiffness(table, folder: Path) -> list[Path]:
                 if table.minimum:
                     axes.fill_between(along[chosen], table.minimum[column][chosen], table.maximum[column][chosen],
                                       color=f"C{index % 10}", alpha=0.2, lw=0)
+                if measured is not None:
+                    on_curve = np.isclose(measured.amplitude_mm if unit == "mm" else measured.frequency_hz, value)
+                    points = measured.frequency_hz if unit == "mm" else measured.amplitude_mm
+                    axes.plot(points[on_curve], getattr(measured, column)[on_curve], "x", color=f"C{index % 10}",
+                              ms=7, mew=1.5, label="table" if (index == 0 and column == "kdyn_N_per_mm") else None)
         stiffness.set(xlabel=label, ylabel="dynamic stiffness |K*| [N/mm]")
         angle.set(xlabel=label, ylabel="loss angle [deg]")
         for axes in (stiffness, angle):

@@ -275,7 +275,10 @@ def test_kelvin_voigt_fit_from_a_table_recovers_k_and_c(tmp_path, capsys):
     exact = characterise({"k": k, "c": c, "preload": 0.0}, [0.5, 2.0], [1.0, 10.0, 40.0], model="kelvin_voigt")
     table = exact.to_csv(tmp_path / "kv.csv")
     out = tmp_path / "kv_fit.json"
-    assert main(["fit", "--kdyn", str(table), "--model", "kelvin_voigt", "--out", str(out), "--quiet"]) == 0
+    assert main(["fit", "--kdyn", str(table), "--model", "kelvin_voigt", "--out", str(out), "--quiet",
+                 "--plots", str(tmp_path / "plots")]) == 0
+    assert sorted(p.name for p in (tmp_path / "plots" / "kdyn").iterdir()) == [
+        "kdyn_vs_amplitude.png", "kdyn_vs_frequency.png", "steady_state_loops.png"]
     fitted = load_parameters(out)
     assert fitted["k"] == pytest.approx(k, rel=1e-6) and fitted["c"] == pytest.approx(c, rel=1e-6)
     provenance = json.loads(out.read_text())["fit"]
