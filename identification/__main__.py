@@ -292,15 +292,10 @@ def _plot_table_fit(result, table, folder: Path) -> list[Path]:
     """The fitted set's (and ensemble's) data sheet on the table's amplitudes and frequencies,
     the table's rows as crosses; in ``folder``/kdyn (one plot set per preload: the first's)."""
     from identification.dynamic_stiffness import characterise
-    from identification.kdyn_table import KdynTable
     from identification.plots import plot_dynamic_stiffness
-    preload = float(table.preload_mm[0])
-    same = table.preload_mm == preload
-    sheet = characterise(result, np.unique(table.amplitude_mm[same]), np.unique(table.frequency_hz[same]),
-                         preload_mm=preload)
-    rows = KdynTable(*(column[same] for column in (table.amplitude_mm, table.frequency_hz, table.preload_mm,
-                                                   table.kdyn_N_per_mm, table.loss_angle_deg, table.weight)),
-                     table.source)
+    rows = table.subset(table.preload_mm == table.preload_mm[0])
+    sheet = characterise(result, np.unique(rows.amplitude_mm), np.unique(rows.frequency_hz),
+                         preload_mm=float(rows.preload_mm[0]))
     (folder / "kdyn").mkdir(parents=True, exist_ok=True)
     return plot_dynamic_stiffness(sheet, folder / "kdyn", measured=rows)
 

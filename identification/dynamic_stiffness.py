@@ -224,16 +224,23 @@ def run_sines(matrix: np.ndarray, model: str, amplitude_mm: np.ndarray, frequenc
     return result, last
 
 
+def stiffness_from_sums(result: np.ndarray, amplitude_mm: np.ndarray) -> tuple[np.ndarray, ...]:
+    """(K', K'', |K*|, delta) [N/mm, N/mm, N/mm, deg] from the kernel's first-harmonic sums
+    (``result[..., 0]`` = a, ``result[..., 1]`` = b of ``identification.steady_state``):
+    K* = (b + i*a)/X."""
+    storage = result[..., 1] / amplitude_mm
+    loss = result[..., 0] / amplitude_mm
+    return storage, loss, np.hypot(storage, loss), np.degrees(np.arctan2(loss, storage))
+
+
 def _table(result: np.ndarray, last: np.ndarray, amplitude: np.ndarray, frequency: np.ndarray, preload: float) -> dict:
     """The result columns of one parameter set from the kernel's first-harmonic sums and last cycles."""
-    cosine, sine = result[:, 0], result[:, 1]
-    storage = sine / amplitude
-    loss = cosine / amplitude
+    storage, loss, kdyn, angle = stiffness_from_sums(result, amplitude)
     steps = last.shape[1]
     x = preload + amplitude[:, None] * np.sin(2.0 * math.pi * np.arange(steps) / steps)[None, :]
     # the closed loop's area by trapezoids, the last sample joined to the first
     energy = np.sum(0.5 * (last + np.roll(last, -1, axis=1)) * (np.roll(x, -1, axis=1) - x), axis=1)
-    return {"kdyn_N_per_mm": np.hypot(storage, loss), "loss_angle_deg": np.degrees(np.arctan2(loss, storage)),
+    return {"kdyn_N_per_mm": kdyn, "loss_angle_deg": angle,
             "storage_N_per_mm": storage, "loss_N_per_mm": loss, "energy_per_cycle_mJ": energy,
             "peak_force_N": np.max(np.abs(last), axis=1), "cycles": result[:, 2].astype(int),
             "converged": result[:, 3] == 0, "loop": last.copy()}

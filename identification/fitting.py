@@ -400,8 +400,7 @@ def _search(tests, noise, model, preset, settings, seed, engine, progress, start
     # runs once more, and a third check only reports (identification.refinement).
     notes = []
     refinement = _check_steps(problem, tests, records, n, d)
-    problem = Problem(refinement.objective.with_steps(tests, refinement.objective.steps_per_sample, search=False)
-                      if table is not None else refinement.objective, space)
+    problem = Problem(refinement.objective.with_fit_loop(tests), space)
     records = run_stages(problem, engine, records, [last], bars.stage, first_stage=len(early))
     refinement_at_best = _check_steps(problem, tests, records, n, d)
     evaluations += refinement.evaluations + refinement_at_best.evaluations
@@ -502,7 +501,8 @@ def _table_fit(table: KdynTable | None, parameters: ParameterSet) -> TableFit | 
     and how far the fit's fixed-cycle loop is from it (its largest relative |K*| difference)."""
     if table is None:
         return None
-    from identification.dynamic_stiffness import MAX_CYCLES, STEPS_PER_CYCLE, TOLERANCE, CharacterisationWarning, run_sines
+    from identification.dynamic_stiffness import (MAX_CYCLES, STEPS_PER_CYCLE, TOLERANCE, CharacterisationWarning,
+                                                  run_sines, stiffness_from_sums)
     from identification.objectives import PreparedTable
     prepared = PreparedTable.of(table)
     rows = prepared.rows
@@ -518,8 +518,7 @@ def _table_fit(table: KdynTable | None, parameters: ParameterSet) -> TableFit | 
         if np.any(result[:, 3] == 2):
             warnings.warn(f"{table.name}: the fitted set fails on some cases (overflow or too many substeps); their "
                           "errors are NaN", CharacterisationWarning, stacklevel=4)
-        storage, loss = result[:, 1] / rows.amplitude_mm, result[:, 0] / rows.amplitude_mm
-        return np.hypot(storage, loss), np.degrees(np.arctan2(loss, storage))
+        return stiffness_from_sums(result, rows.amplitude_mm)[2:]
 
     kdyn, angle = steady(STEPS_PER_CYCLE)
     # the fit loop against the steady state at the fit loop's own steps: what its few cycles leave

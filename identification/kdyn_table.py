@@ -48,6 +48,8 @@ basins the last stage refines: a third of the cost, within 2.2e-3 of the steady 
 0.084 deg of its loss angle at the truth for Tables 2, 4, 5 (measured 2026-11-23)."""
 REQUIRED = ("amplitude_mm", "frequency_hz", "kdyn_N_per_mm", "loss_angle_deg")
 OPTIONAL = {"preload_mm": 0.0, "weight": 1.0}
+COLUMNS = ("amplitude_mm", "frequency_hz", "preload_mm", "kdyn_N_per_mm", "loss_angle_deg", "weight")
+"""KdynTable's columns, in its field order."""
 
 
 @dataclass(frozen=True)
@@ -62,13 +64,11 @@ class KdynTable:
     source: str = "table"
 
     def __post_init__(self):
-        columns = (self.amplitude_mm, self.frequency_hz, self.preload_mm, self.kdyn_N_per_mm, self.loss_angle_deg,
-                   self.weight)
+        columns = [getattr(self, name) for name in COLUMNS]
         if len({np.shape(c) for c in columns}) != 1 or np.ndim(self.amplitude_mm) != 1:
             raise IdentificationError(f"{self.source}: the table's columns must be 1-D arrays of equal length")
-        names = ("amplitude_mm", "frequency_hz", "preload_mm", "kdyn_N_per_mm", "loss_angle_deg", "weight")
         for row in range(len(self.amplitude_mm)):
-            values = {name: float(column[row]) for name, column in zip(names, columns)}
+            values = {name: float(column[row]) for name, column in zip(COLUMNS, columns)}
             for name, value in values.items():
                 if not math.isfinite(value):
                     raise IdentificationError(f"{self.source}, row {row + 1}, column {name}: {value} is not a finite "
@@ -91,12 +91,13 @@ class KdynTable:
         return cls(table.amplitude_mm.copy(), table.frequency_hz.copy(), table.preload_mm.copy(),
                    table.kdyn_N_per_mm.copy(), table.loss_angle_deg.copy(), np.ones(len(table)), source)
 
+    def subset(self, rows: np.ndarray) -> "KdynTable":
+        """The rows selected by the boolean mask ``rows`` (contiguous arrays)."""
+        return KdynTable(*(np.ascontiguousarray(getattr(self, name)[rows]) for name in COLUMNS), self.source)
+
     def kept(self) -> "KdynTable":
-        """The rows of weight > 0 (contiguous arrays)."""
-        rows = self.weight > 0
-        return KdynTable(*(np.ascontiguousarray(a[rows]) for a in (
-            self.amplitude_mm, self.frequency_hz, self.preload_mm, self.kdyn_N_per_mm, self.loss_angle_deg,
-            self.weight)), self.source)
+        """The rows of weight > 0."""
+        return self.subset(self.weight > 0)
 
     def with_values(self, kdyn_N_per_mm, loss_angle_deg, source: str | None = None) -> "KdynTable":
         return KdynTable(self.amplitude_mm, self.frequency_hz, self.preload_mm, np.asarray(kdyn_N_per_mm, float),
@@ -157,9 +158,7 @@ def load_kdyn_table(path: str | Path) -> KdynTable:
         seen[case] = number
         for name in columns:
             columns[name].append(values[name])
-    table = KdynTable(*(np.array(columns[name]) for name in ("amplitude_mm", "frequency_hz", "preload_mm",
-                                                            "kdyn_N_per_mm", "loss_angle_deg", "weight")),
-                      source=str(path))
+    table = KdynTable(*(np.array(columns[name]) for name in COLUMNS), source=str(path))
     for what, values, unit, plausible in (("amplitude", table.amplitude_mm, "mm", PLAUSIBLE_AMPLITUDE_MM),
                                           ("frequency", table.frequency_hz, "Hz", PLAUSIBLE_FREQUENCY_HZ)):
         if np.any(values > plausible):

@@ -75,15 +75,13 @@ class PreparedTable:
     def stiffness(self, matrix: np.ndarray, model: str) -> tuple[np.ndarray, np.ndarray]:
         """|K*| [N/mm] and the loss angle [deg] of P candidates on every row, each (P, rows):
         ``cycles`` cycles of ``steps_per_cycle`` steps from rest (``identification.kdyn_table``)."""
-        from identification.dynamic_stiffness import run_sines
+        from identification.dynamic_stiffness import run_sines, stiffness_from_sums
         rows = self.rows
         result, _ = run_sines(matrix, model, rows.amplitude_mm, rows.frequency_hz, rows.preload_mm,
                               self.steps_per_cycle, self.cycles, 0.0, FIT_MAX_SUBSTEPS)
-        shape = (matrix.shape[0], len(rows))
-        failed = (result[:, 3] == 2).reshape(shape)
-        storage = result[:, 1].reshape(shape) / rows.amplitude_mm
-        loss = result[:, 0].reshape(shape) / rows.amplitude_mm
-        kdyn, angle = np.hypot(storage, loss), np.degrees(np.arctan2(loss, storage))
+        result = result.reshape(matrix.shape[0], len(rows), 4)
+        _, _, kdyn, angle = stiffness_from_sums(result, rows.amplitude_mm)
+        failed = result[..., 3] == 2
         return np.where(failed, np.nan, kdyn), np.where(failed, np.nan, angle)
 
     def residuals(self, matrix: np.ndarray, model: str) -> np.ndarray:
@@ -126,17 +124,21 @@ class Objective:
             sigma = max(level.sigma_N, MIN_NOISE_FRACTION * level.rms_force_N)
             self.tests.append(PreparedTest(test.name, driven, m.force_N[driven.sample_index], sigma))
         self._source_table = table
+        self.search = search and table is not None
         self.table = PreparedTable.of(table, search) if table is not None else None
         self.size = sum(t.measured_N.size for t in self.tests) + (self.table.size if self.table else 0)
 
-    def with_steps(self, tests: Sequence[RigTest], steps: Sequence[int], search: bool | None = None) -> "Objective":
+    def with_steps(self, tests: Sequence[RigTest], steps: Sequence[int]) -> "Objective":
         """The same objective (of ``tests``, the ones it was made of) with other steps per
-        sample, and the table's search loop (``search``: True), its fit loop (False) or the
-        one it has (None)."""
-        if search is None:
-            search = self.table is not None and self.table.cycles == SEARCH_CYCLES \
-                and self.table.steps_per_cycle == SEARCH_STEPS_PER_CYCLE
-        return Objective(tests, self.noise, steps, self.model, self._source_table, search)
+        sample (the table's loop as it is)."""
+        return Objective(tests, self.noise, steps, self.model, self._source_table, self.search)
+
+    def with_fit_loop(self, tests: Sequence[RigTest]) -> "Objective":
+        """The same objective with the table's fit loop instead of its search loop (itself if it
+        has none)."""
+        if not self.search:
+            return self
+        return Objective(tests, self.noise, self.steps_per_sample, self.model, self._source_table, False)
 
     @property
     def steps_per_sample(self) -> list[int]:

@@ -96,14 +96,13 @@ def plot_dynamic_stiffness(table, folder: Path, measured=None) -> list[Path]:
     amplitudes = np.unique(table.amplitude_mm)
     frequencies = np.unique(table.frequency_hz)
     written = []
-    for along, curves, across, label, name, log in (
-            (table.frequency_hz, table.amplitude_mm, frequencies, "frequency [Hz]", "kdyn_vs_frequency.png", True),
-            (table.amplitude_mm, table.frequency_hz, amplitudes, "amplitude [mm]", "kdyn_vs_amplitude.png", False)):
+    for along, curves, unit, label, name, log in (
+            (table.frequency_hz, table.amplitude_mm, "mm", "frequency [Hz]", "kdyn_vs_frequency.png", True),
+            (table.amplitude_mm, table.frequency_hz, "Hz", "amplitude [mm]", "kdyn_vs_amplitude.png", False)):
         figure, (stiffness, angle) = plt.subplots(1, 2, figsize=(12, 4.4))
         for index, value in enumerate(np.unique(curves)):
             chosen = np.flatnonzero(curves == value)
             chosen = chosen[np.argsort(along[chosen])]
-            unit = "mm" if curves is table.amplitude_mm else "Hz"
             for axes, column in ((stiffness, "kdyn_N_per_mm"), (angle, "loss_angle_deg")):
                 axes.plot(along[chosen], table.column(column)[chosen], "o-", color=f"C{index % 10}", ms=3.5, lw=1.2,
                           label=f"{value:g} {unit}")
@@ -121,7 +120,7 @@ def plot_dynamic_stiffness(table, folder: Path, measured=None) -> list[Path]:
             if log:
                 axes.set_xscale("log")
             axes.grid(alpha=0.3, which="both")
-        stiffness.legend(fontsize=8, title="amplitude" if curves is table.amplitude_mm else "frequency")
+        stiffness.legend(fontsize=8, title="amplitude" if unit == "mm" else "frequency")
         shaded = ", ensemble min-max shaded" if table.minimum else ""
         figure.suptitle(f"{get_model(table.model).title}: dynamic stiffness and loss angle{shaded}", fontsize=10)
         figure.tight_layout()
