@@ -199,11 +199,12 @@ def save_parameters(path: str | Path, params: Mapping[str, float], model: str = 
 
 
 def _write_ssv(path: Path, params: Mapping[str, float], model: BushingModel) -> None:
-    _write_ssv_values(path, model.identifier, model.check(params), model.units)
+    write_ssv_values(path, model.identifier, model.check(params), model.units)
 
 
-def _write_ssv_values(path: Path, set_name: str, values: Mapping[str, float], units: Mapping[str, str]) -> None:
-    """One ssv:ParameterSet of ``values`` (names in order) with their ``units``."""
+def write_ssv_values(path: Path, set_name: str, values: Mapping[str, float], units: Mapping[str, str]) -> None:
+    """One ssv:ParameterSet of ``values`` (names in order) with their ``units`` (a unit that
+    ``UNIT_DEFINITIONS`` cannot express in SI base units is left out, never written wrong)."""
     ssv, ssc = SSV_NAMESPACES["ssv"], SSV_NAMESPACES["ssc"]
     ET.register_namespace("ssv", ssv)
     ET.register_namespace("ssc", ssc)
@@ -211,7 +212,7 @@ def _write_ssv_values(path: Path, set_name: str, values: Mapping[str, float], un
     parameters = ET.SubElement(root, f"{{{ssv}}}Parameters")
     # SSP requires a BaseUnit for every unit, which N^(1-n)/mm (beta, gamma) cannot have:
     # those values go without a unit attribute rather than with a false one.
-    expressible = {name: unit for name, unit in units.items() if UNIT_DEFINITIONS[unit] is not None}
+    expressible = {name: unit for name, unit in units.items() if UNIT_DEFINITIONS.get(unit) is not None}
     for name, value in values.items():
         element = ET.SubElement(parameters, f"{{{ssv}}}Parameter", name=name)
         real = ET.SubElement(element, f"{{{ssv}}}Real", value=repr(value))
@@ -347,7 +348,7 @@ def save_six_axis(path: str | Path, axes: Mapping[str, tuple[str, Mapping[str, f
             for name, value in entry["parameters"].items():
                 values[f"{axis.name}.{name}"] = value
                 units[f"{axis.name}.{name}"] = model.units[name]
-        _write_ssv_values(path, SIX_AXIS_IDENTIFIER, values, units)
+        write_ssv_values(path, SIX_AXIS_IDENTIFIER, values, units)
     else:
         path.write_text(json.dumps(document, indent=2) + "\n", encoding="utf-8")
     return path

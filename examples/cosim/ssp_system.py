@@ -9,7 +9,7 @@ and connections (output of one component -> input of another). From that:
 - :func:`run_libcosim` runs that directory in libcosim (Open Simulation Platform) through
   libcosimpy;
 - :func:`run_fmpy` runs the same components and connections in a plain fmpy master loop,
-  the start values from the same ``.ssv`` files.
+  the start values from the same ``.ssv`` files (read with fmpy's own ``read_ssv``).
 
 Both use one fixed communication step and the same exchange (Jacobi: every FMU steps from the
 outputs of the previous step), so they agree to rounding. Both return a dict of time series,
@@ -139,8 +139,7 @@ def run_fmpy(components: Sequence[Component], connections: Sequence[Connection],
     before it."""
     from fmpy import extract, read_model_description
     from fmpy.fmi2 import FMU2Slave
-
-    from fmu_src.parameter_files import load_parameters
+    from fmpy.ssp.ssd import read_ssv
     instances, refs, unzipped = {}, {}, {}
     for component in components:
         key = str(component.fmu)
@@ -154,7 +153,8 @@ def run_fmpy(components: Sequence[Component], connections: Sequence[Connection],
         instance.setupExperiment(startTime=0.0)
         instance.enterInitializationMode()
         if component.ssv is not None:
-            start_values = load_parameters(component.ssv)
+            start_values = {p.name: float(p.value) for p in read_ssv(str(component.ssv)).parameters
+                            if p.type == "Real"}
             instance.setReal([refs[component.name][n] for n in start_values], list(start_values.values()))
         instance.exitInitializationMode()
         instances[component.name] = instance
