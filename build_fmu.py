@@ -56,8 +56,9 @@ from pathlib import Path
 from . import axes, bushing_models, compiled_kernels, integration, model_definition, parameter_files
 
 # Compiled here, once per process, while the extracted files surely exist (a host may delete them
-# after the first instance); STEP says which step runs (logged by every instance).
-AXES, STEP = compiled_kernels.compile_axes(
+# after the first instance); STEP_AXES holds the compiled batched step of each model ({} for the
+# pure-Python step); STEP says which step runs (logged by every instance).
+AXES, STEP_AXES, STEP = compiled_kernels.compile_axes(
     parameter_files.fmu_axes(Path(__file__).with_name("default_parameters.json")))
 '''
 SIX_AXIS = "six_axis"

@@ -33,6 +33,7 @@ import ctypes
 import importlib
 import math
 import sys
+from functools import partial
 
 from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Real
 from pythonfmu.default_experiment import DefaultExperiment
@@ -45,13 +46,17 @@ from pythonfmu.enums import Fmi2Status
 if __package__:
     from . import axes, integration
     AXES = None   # only an FMU built by build_fmu.py has axes, models and defaults
+    STEP_AXES = {}
     STEP = None
 else:
     _library = importlib.import_module(__name__ + "_lib")
     axes = _library.axes
     integration = _library.integration
     AXES = _library.AXES   # [(axes.Axis, BushingModel on that axis, default parameters)]
+    STEP_AXES = _library.STEP_AXES   # {model name: compiled step of all its axes}; {} for pure Python
     STEP = _library.STEP   # which step runs: compiled (numba) or pure Python, and why
+# numpy only where the compiled step runs (numba needs it anyway); the plain-Python step needs none
+np = importlib.import_module("numpy") if STEP_AXES else None
 
 
 class InitializationError(RuntimeError):
@@ -78,6 +83,8 @@ class _AxisState:
     def __init__(self, axis, model, defaults):
         self.axis = axis
         self.model = model
+        # the axis's unit factors and travel limit, read at every step (plain attributes: fast)
+        self.to_kernel, self.from_kernel, self.travel_limit = axis.to_kernel, axis.from_kernel, axis.plausible_travel
         self.values = {name: float(defaults[name]) for name in model.parameter_names}
         self.x = 0.0                   # port displacement as set (m or rad)
         self.v = 0.0                   # port velocity as set (m/s or rad/s)
@@ -93,6 +100,8 @@ class _AxisState:
         self.output_warned = False
         self.stale_output_logged = False   # the stale-output error is given once per episode
         self.last_errors = []          # the parameter errors of the last validation
+        self.step_one = None           # the compiled step of this axis's model, if compiled
+        self.params_row = None         # the parameters in force as an array (for step_one)
 
 
 class BushingSlave(Fmi2Slave):
@@ -107,7 +116,21 @@ class BushingSlave(Fmi2Slave):
         if AXES is None:
             raise RuntimeError("the bushing slave runs inside an FMU built by build_fmu.py")
         self._axes = [_AxisState(axis, model, defaults) for axis, model, defaults in AXES]
+        # The compiled step of all axes of a model in one call, where a model has two or more:
+        # per model its step, axes and parameter rows (rebuilt on a change). For a single axis the
+        # arrays cost more than the two calls into numba they save (measured 2026-11-24).
+        groups = {}
+        for a in self._axes:
+            groups.setdefault(a.model.name, []).append(a)
+        self._batches = [[STEP_AXES[name][0], group, None] for name, group in groups.items()
+                         if name in STEP_AXES and len(group) > 1]
+        for a in self._axes:
+            a.step_one = STEP_AXES[a.model.name][1] if a.model.name in STEP_AXES else None
+        batched = {id(a) for _, group, _ in self._batches for a in group}
+        self._unbatched = [a for a in self._axes if id(a) not in batched]
         self._initial_state_pending = True  # set at exit of initialization, or first valid step
+        self._parameters_changed = True     # some axis's parameters were set since the last check
+        self._parameters_usable = False
         for a in self._axes:
             self._register_axis(a)
         self.log(STEP, Fmi2Status.ok, "logAll")
@@ -125,17 +148,17 @@ class BushingSlave(Fmi2Slave):
             description=(f"relative {what} of I with respect to J about/along {axis.name[-1]} "
                          f"[{axis.displacement_unit}]" if axis.name else
                          "relative displacement of the bushing (upper plate minus base) [m]"),
-            getter=lambda: a.x, setter=lambda value: self._set_displacement(a, value)))
+            getter=partial(getattr, a, "x"), setter=partial(self._set_displacement, a)))
         self.register_variable(Real(
             axis.velocity, causality=Fmi2Causality.input, variability=Fmi2Variability.continuous,
             description=f"relative velocity d{axis.displacement}/dt [{axis.velocity_unit}]",
-            getter=lambda: a.v, setter=lambda value: self._set_velocity(a, value)))
+            getter=partial(getattr, a, "v"), setter=partial(self._set_velocity, a)))
         self.register_variable(Real(
             axis.output, causality=Fmi2Causality.output, variability=Fmi2Variability.continuous,
             description=(f"{'moment' if axis.rotational else 'force'} on J along/about {axis.name[-1]}, positive "
                          f"for a positive {axis.displacement} [{axis.output_unit}]" if axis.name else
                          "bushing force, positive for positive x (force on the base) [N]"),
-            getter=lambda: self._output(a)))
+            getter=partial(self._output, a)))
         for state in model.states:
             unit, scale = axis.state_port(state.unit)
             index = state.index
@@ -152,7 +175,7 @@ class BushingSlave(Fmi2Slave):
     def _parameter_setter(self, a, name):
         def set_parameter(value):
             a.values[name] = value
-            a.parameters_changed = True
+            a.parameters_changed = self._parameters_changed = True
             a.output_is_current = False
             if not math.isfinite(value):
                 self._error(f"{a.axis.label}parameter {name} = {value} [{a.model.units[name]}] is not "
@@ -162,12 +185,12 @@ class BushingSlave(Fmi2Slave):
     def _set_displacement(self, a, value):
         axis = a.axis
         a.x = value
-        a.x_now = value * axis.to_kernel
+        a.x_now = value * a.to_kernel
         a.output_is_current = False
         if not math.isfinite(value):
             self._error(f"input {axis.displacement} = {value} {axis.displacement_unit} is not a finite number; "
                         "the next doStep will be refused")
-        elif abs(value) > axis.plausible_travel and not a.travel_warned:
+        elif abs(value) > a.travel_limit and not a.travel_warned:
             a.travel_warned = True
             if axis.rotational:
                 message = (f"input {axis.displacement} = {value} rad exceeds {axis.plausible_travel} rad: the "
@@ -196,7 +219,7 @@ class BushingSlave(Fmi2Slave):
                 state = a.state
                 if a.x_now != a.state_x:
                     state = integration.apply_displacement_jump(a.model, a.constants, state, a.x_now - a.state_x)
-                output = a.model.force(a.constants, state, a.x_now, a.v * a.axis.to_kernel) * a.axis.from_kernel
+                output = a.model.force(a.constants, state, a.x_now, a.v * a.to_kernel) * a.from_kernel
             except (ArithmeticError, ValueError):
                 output = math.nan
             if math.isfinite(output):
@@ -253,52 +276,92 @@ class BushingSlave(Fmi2Slave):
     def do_step(self, current_time, step_size):
         if not 0.0 < step_size < math.inf:
             return self._refuse(f"communication step size {step_size} s must be a finite number > 0")
-        if not all([self._refresh_parameters(a) for a in self._axes]):
+        if self._parameters_changed or not self._parameters_usable:
+            self._parameters_changed = False
+            self._parameters_usable = all([self._refresh_parameters(a) for a in self._axes])
+        if not self._parameters_usable:
             if self._initial_state_pending:   # never started: nothing a master can do in the run
                 self._fail_to_start()
             return self._refuse("doStep refused: the parameters are invalid (see the errors above)")
-        for a in self._axes:
-            axis = a.axis
-            if not (math.isfinite(a.x) and math.isfinite(a.v)):
-                name, value, unit = ((axis.displacement, a.x, axis.displacement_unit) if not math.isfinite(a.x)
-                                     else (axis.velocity, a.v, axis.velocity_unit))
-                return self._refuse(f"doStep refused: input {name} = {value} {unit} is not a finite number")
+        # one sum is finite if every input is (and a huge but finite sum just takes the long way)
+        if not math.isfinite(sum([a.x for a in self._axes] + [a.v for a in self._axes])):
+            for a in self._axes:
+                axis = a.axis
+                if not (math.isfinite(a.x) and math.isfinite(a.v)):
+                    name, value, unit = ((axis.displacement, a.x, axis.displacement_unit) if not math.isfinite(a.x)
+                                         else (axis.velocity, a.v, axis.velocity_unit))
+                    return self._refuse(f"doStep refused: input {name} = {value} {unit} is not a finite number")
         if self._initial_state_pending:  # the values at initialization could not be used
             self._set_initial_state()
-        steps = []     # every axis first, then commit all: a refusal leaves every axis as it was
-        for a in self._axes:
-            axis = a.axis
-            x, v = a.x_now, a.v * axis.to_kernel
-            try:
-                state, _ = integration.advance(a.model, a.constants, a.state, a.state_x, x, v, step_size)
-            except integration.StepError as exc:
-                return self._refuse(f"doStep at t = {current_time} s refused: {axis.label}{exc}")
-            x_end = x + v * step_size
-            output = a.model.force(a.constants, state, x_end, v) * axis.from_kernel
-            if not math.isfinite(output):
-                return self._refuse(f"doStep at t = {current_time} s refused: {axis.output} would be {output} "
-                                    f"{axis.output_unit} ({axis.displacement} = {a.x} {axis.displacement_unit}, "
-                                    f"{axis.velocity} = {a.v} {axis.velocity_unit}); check the units of the inputs")
-            steps.append((a, state, x_end, output))
+        # every axis first, then commit all: a refusal leaves every axis as it was
+        compiled = self._step_compiled(step_size) if self._batches else None
+        # None: no compiled call, or an axis failed in it: every axis one by one (for the message)
+        steps = compiled if compiled is not None else []
+        for a in (self._unbatched if compiled is not None else self._axes):
+            step = self._step_axis(a, current_time, step_size)
+            if step is None:
+                return False
+            steps.append(step)
         for a, state, x_end, output in steps:
-            self._warn_if_implausible(a, output, current_time + step_size)
+            if abs(output) > a.output_bound and not a.output_warned:
+                self._warn_implausible(a, output, current_time + step_size)
             a.state = state
             a.state_x = a.x_now = x_end
             a.last_output = output
             a.output_is_current = True
         return True
 
-    def _warn_if_implausible(self, a, output, time):
-        if abs(output) > a.output_bound and not a.output_warned:
-            a.output_warned = True
-            axis = a.axis
-            speed = ("rotation and angular velocity" if axis.rotational else "travel and speed")
-            self.log(f"{axis.output} = {output:.4g} {axis.output_unit} at t = {time} s exceeds "
-                     f"{a.output_bound:.3g} {axis.output_unit}, the {'moment' if axis.rotational else 'force'} of "
-                     f"all the bushing's springs and dashpots at the largest plausible {speed}: check the units of "
-                     f"the inputs ({axis.displacement} = {a.x} {axis.displacement_unit}, {axis.velocity} = {a.v} "
-                     f"{axis.velocity_unit}; the FMU takes {'radians' if axis.rotational else 'metres'})",
-                     Fmi2Status.warning, "logStatusWarning")
+    def _step_axis(self, a, current_time, step_size):
+        """(axis, new state, displacement at the end, output) of one axis's step, or None after
+        logging why it cannot be taken."""
+        axis = a.axis
+        x, v = a.x_now, a.v * a.to_kernel
+        if a.step_one is not None:   # compiled: one call (the same kernels as advance and force)
+            state, output, x_end, status = a.step_one(a.params_row, a.state, a.state_x, x, v, step_size,
+                                                      integration.DEFAULT_MAX_SUBSTEPS)
+            output *= a.from_kernel
+            if status == integration.OK and math.isfinite(output):
+                return a, state, x_end, output
+        try:
+            state, _ = integration.advance(a.model, a.constants, a.state, a.state_x, x, v, step_size)
+        except integration.StepError as exc:
+            return self._refuse(f"doStep at t = {current_time} s refused: {axis.label}{exc}") or None
+        x_end = x + v * step_size
+        output = a.model.force(a.constants, state, x_end, v) * a.from_kernel
+        if not math.isfinite(output):
+            return self._refuse(f"doStep at t = {current_time} s refused: {axis.output} would be {output} "
+                                f"{axis.output_unit} ({axis.displacement} = {a.x} {axis.displacement_unit}, "
+                                f"{axis.velocity} = {a.v} {axis.velocity_unit}); check the units of the inputs") or None
+        return a, state, x_end, output
+
+    def _step_compiled(self, step_size):
+        """Every axis's step in one compiled call per model (``compiled_kernels._step_axes``, the
+        same kernels and arithmetic as :meth:`_step_axis`); None if any axis's step fails, so that
+        the axis-by-axis step redoes it and words the refusal."""
+        steps = []
+        for batch in self._batches:
+            step_axes, group, params = batch
+            if params is None:
+                params = batch[2] = np.array([a.model.values(a.values) for a in group])
+            rows = np.array([(a.x_now, a.v * a.to_kernel, a.state_x, *a.state) for a in group])
+            out, failures = step_axes(params, rows, step_size, integration.DEFAULT_MAX_SUBSTEPS)
+            if failures:
+                return None
+            for a, row in zip(group, out.tolist()):   # (*state, force, x + v*h)
+                steps.append((a, tuple(row[:-2]), row[-1], row[-2] * a.from_kernel))
+        return steps
+
+    def _warn_implausible(self, a, output, time):
+        """Warn, once per axis, of an output above the plausible bound (units most likely wrong)."""
+        a.output_warned = True
+        axis = a.axis
+        speed = ("rotation and angular velocity" if axis.rotational else "travel and speed")
+        self.log(f"{axis.output} = {output:.4g} {axis.output_unit} at t = {time} s exceeds "
+                 f"{a.output_bound:.3g} {axis.output_unit}, the {'moment' if axis.rotational else 'force'} of "
+                 f"all the bushing's springs and dashpots at the largest plausible {speed}: check the units of "
+                 f"the inputs ({axis.displacement} = {a.x} {axis.displacement_unit}, {axis.velocity} = {a.v} "
+                 f"{axis.velocity_unit}; the FMU takes {'radians' if axis.rotational else 'metres'})",
+                 Fmi2Status.warning, "logStatusWarning")
 
     def _refresh_parameters(self, a) -> bool:
         """Validate and prepare an axis's parameters once after they change, logging errors and
@@ -320,6 +383,10 @@ class BushingSlave(Fmi2Slave):
                     bound = a.model.plausible_force_bound(a.values)
                 a.output_bound = bound * a.axis.from_kernel
                 a.constants = a.model.constants(a.values)
+                if np is not None:
+                    a.params_row = np.array(a.model.values(a.values))
+            for batch in self._batches:
+                batch[2] = None
         return a.constants is not None
 
     def _error(self, message):
@@ -350,5 +417,6 @@ class BushingSlave(Fmi2Slave):
             a.output_is_current = False
             a.parameters_changed = True
             self._refresh_parameters(a)
+        self._parameters_changed = True
         self._initial_state_pending = state["initial_state_pending"]
 

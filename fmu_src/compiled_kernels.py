@@ -108,26 +108,98 @@ def compiled_module(model, appendix: str = "", prefix: str = "bushing") -> types
 
 
 COMPILED_IN_FMU = ("jump", "integrate")
-"""The kernels an FMU runs compiled. Only the integration is worth a call into numba: force() is a
-few multiplications, which plain Python does in 0.44 us against 1.2 us for numba's dispatch
-(Table 5, measured 2026-11-23); prepare() and initial_state() run once."""
+"""The kernels an FMU runs compiled one axis at a time (the plain-Python step's fallback for the
+message of a failed step). force() is a few multiplications, which plain Python does in 0.44 us
+against 1.2 us for numba's dispatch (Table 5, measured 2026-11-23); prepare() and
+initial_state() run once."""
+
+
+def _step_axes(params, rows, h, max_substeps):
+    """One communication step of every axis of one model, in one compiled call: what the FMU's
+    ``integration.advance`` and ``force`` do axis by axis. ``params``: each axis's values in spec
+    order; ``rows``: each axis's step input and committed state, (x, v, state_x, *state) in the
+    kernels' units (mm or rad, per s; state_x the displacement the state belongs to); ``h`` [s].
+    Returns (rows of (*new state, force at x + v*h with velocity v, x + v*h), failures): where
+    any axis fails (a status other than OK, or a force that is not finite), the FMU redoes the
+    step one axis at a time, which words the refusal.
+
+    Written here, never called here: its source is compiled in the model's generated module
+    (:func:`_fmu_appendix`), where ``prepare`` ... ``force`` are that model's compiled kernels."""
+    count, width = rows.shape
+    out = np.empty((count, width - 1))
+    failures = 0
+    for i in range(count):
+        m = prepare(_VALUES(params[i]))
+        x, v, state_x = rows[i, 0], rows[i, 1], rows[i, 2]
+        state = _STATE(rows[i, 3:])
+        status = _OK
+        if x != state_x:
+            state, status = jump(m, state, x - state_x)
+        if status == _OK:
+            state, used, status = integrate(m, state, x, v, h, max_substeps)
+        _STORE(out, i, state)
+        x_end = x + v * h
+        out[i, width - 3] = force(m, state, x_end, v)
+        out[i, width - 2] = x_end
+        if status != _OK or not math.isfinite(out[i, width - 3]):
+            failures += 1
+    return out, failures
+
+
+def _step_one(params, state, state_x, x, v, h, max_substeps):
+    """One communication step of one axis in one compiled call, as :func:`_step_axes` does it
+    for a row: ``params`` its values in spec order, ``state`` its committed state (a tuple).
+    Returns (new state, force at x + v*h with velocity v, x + v*h, status)."""
+    m = prepare(_VALUES(params))
+    status = _OK
+    if x != state_x:
+        state, status = jump(m, state, x - state_x)
+    if status == _OK:
+        state, used, status = integrate(m, state, x, v, h, max_substeps)
+    x_end = x + v * h
+    return state, force(m, state, x_end, v), x_end, status
+
+
+def _row_tuple(name: str, size: int) -> str:
+    """A compiled function ``name(row)``: the first ``size`` entries of an array row as a tuple."""
+    values = "".join(f"row[{i}], " for i in range(size))
+    return f"@numba.njit(cache=True)\ndef {name}(row):\n    return ({values})\n\n\n"
+
+
+def _fmu_appendix(model) -> str:
+    """The FMU's batched step for ``model`` (:func:`_step_axes`) and its helpers."""
+    size = len(model.states)
+    stores = "".join(f"    out[i, {j}] = state[{j}]\n" for j in range(size)) or "    pass\n"
+    return ("\n\nimport math\nimport numpy as np\nfrom " + integration_module() + " import OK as _OK\n\n"
+            + _row_tuple("_VALUES", len(model.specs)) + _row_tuple("_STATE", size)
+            + "@numba.njit(cache=True)\ndef _STORE(out, i, state):\n" + stores + "\n\n"
+            + inspect.getsource(_step_axes)
+            + "\n\n_step_axes = numba.njit(error_model='numpy', cache=True)(_step_axes)\n\n\n"
+            + inspect.getsource(_step_one)
+            + "\n\n_step_one = numba.njit(error_model='numpy', cache=True)(_step_one)\n")
 
 
 def compiled_model(model):
-    """({name: compiled kernel} for COMPILED_IN_FMU, seconds it took) — compiling now, or
-    loading numba's cached machine code — or (None, why not) if numba cannot be imported."""
+    """({name: compiled kernel} for COMPILED_IN_FMU, "step_axes" and "step_one", seconds it took) —
+    compiling now, or loading numba's cached machine code — or (None, why not) if numba cannot
+    be imported."""
     try:
         import numba  # noqa: F401
     except Exception as exc:   # not installed, or broken in this host's Python
         return None, f"numba is not importable here ({type(exc).__name__}: {exc})"
+    import numpy as np
     started = time.perf_counter()
-    module = compiled_module(model, prefix="bushing_fmu")
+    module = compiled_module(model, _fmu_appendix(model), prefix="bushing_fmu")
     kernels = {name: getattr(module, name) for name in COMPILED_IN_FMU}
+    kernels["step_axes"], kernels["step_one"] = module._step_axes, module._step_one
     # compile (or load) now, so that a first step does not wait: the constants and state the
     # plain-Python kernels make are what the FMU passes
-    constants = model.prepare(model.values({s.name: 1.0 for s in model.specs}))
+    values = model.values({s.name: 1.0 for s in model.specs})
+    constants = model.prepare(values)
     state, _ = kernels["jump"](constants, model.initial_state(constants, 0.0), 1e-3)
     kernels["integrate"](constants, state, 1e-3, 0.0, 1e-3, 10)
+    kernels["step_axes"](np.array([values]), np.array([[1e-3, 0.0, 0.0, *state]]), 1e-3, 10)
+    kernels["step_one"](np.array(values), tuple(float(value) for value in state), 0.0, 1e-3, 0.0, 1e-3, 10)
     return kernels, time.perf_counter() - started
 
 
@@ -147,28 +219,32 @@ def _python_host() -> bool:
     return executable.startswith("python")
 
 
-def compile_axes(axes) -> tuple[list, str]:
-    """An FMU's axes [(axis, model, parameters)] with each model's COMPILED_IN_FMU kernels compiled, and a
-    sentence saying which step runs; the axes unchanged (the plain-Python step) if numba is not
+def compile_axes(axes) -> tuple[list, dict, str]:
+    """An FMU's axes [(axis, model, parameters)] with each model's COMPILED_IN_FMU kernels
+    compiled, {model name: its compiled steps (:func:`_step_axes` for several axes,
+    :func:`_step_one` for one)}, and a sentence saying which
+    step runs; the axes unchanged and no batched steps (the plain-Python step) if numba is not
     importable or fails, if the host is not a Python interpreter, or if $BUSHING_FMU_STEP is
-    "python". The compiled and the plain-Python
-    kernels give the same forces (tests/test_fmu_compiled_step.py)."""
+    "python". The compiled and the plain-Python steps give the same forces
+    (tests/test_fmu_compiled_step.py)."""
     choice = os.environ.get(STEP_ENVIRONMENT, "").lower()
     if choice == "python":
-        return list(axes), f"pure-Python step ({STEP_ENVIRONMENT}=python)"
+        return list(axes), {}, f"pure-Python step ({STEP_ENVIRONMENT}=python)"
     if choice != "compiled" and not _python_host():
-        return list(axes), ("pure-Python step: the host is not a Python interpreter, where numba-compiled "
-                            f"kernels have corrupted the heap ({STEP_ENVIRONMENT}=compiled forces them)")
+        return list(axes), {}, ("pure-Python step: the host is not a Python interpreter, where numba-compiled "
+                                f"kernels have corrupted the heap ({STEP_ENVIRONMENT}=compiled forces them)")
     compiled, seconds = {}, 0.0
     try:
         for _, model, _ in axes:
             if model.name not in compiled:
                 kernels, info = compiled_model(model)
                 if kernels is None:
-                    return list(axes), f"pure-Python step: {info}"
+                    return list(axes), {}, f"pure-Python step: {info}"
                 compiled[model.name], seconds = kernels, seconds + info
     except Exception as exc:   # a broken numba or an unwritable cache must not stop the FMU
-        return list(axes), f"pure-Python step: compiling the kernels failed ({type(exc).__name__}: {exc})"
-    out = [(axis, dataclasses.replace(model, **compiled[model.name]), parameters) for axis, model, parameters in axes]
-    return out, (f"compiled step (numba): {seconds:.2f} s to compile the kernels or load them from "
-                 f"{cache_directory()}")
+        return list(axes), {}, f"pure-Python step: compiling the kernels failed ({type(exc).__name__}: {exc})"
+    out = [(axis, dataclasses.replace(model, **{name: compiled[model.name][name] for name in COMPILED_IN_FMU}),
+            parameters) for axis, model, parameters in axes]
+    batched = {name: (kernels["step_axes"], kernels["step_one"]) for name, kernels in compiled.items()}
+    return out, batched, (f"compiled step (numba): one call per model for all its axes; {seconds:.2f} s to "
+                          f"compile the kernels or load them from {cache_directory()}")

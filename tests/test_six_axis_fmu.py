@@ -252,3 +252,22 @@ def test_a_kelvin_voigt_axis_is_k_d_plus_c_v_plus_preload_in_si(six_axis_fmu):
         end = theta + omega * 1e-3      # the step's input path: rx + wx*t
         assert fmu.get("Mx") == pytest.approx((p["k"] * end + p["c"] * omega + p["preload"]) * 1e-3, rel=1e-15)
     fmu.free()
+
+
+def test_a_step_that_fails_inside_the_compiled_call_is_refused_naming_its_axis(six_axis_fmu):
+    # x and y are both the proposed model, stepped together in one compiled call (the default
+    # step where numba runs); an overflow on y alone must still be refused naming axis y, with
+    # every axis's state kept, as the axis-by-axis step words it.
+    fmu = BushingFmu(six_axis_fmu, initial_inputs={})
+    fmu.set("dx", 1e-3)
+    fmu.set("vx", 0.1)
+    assert fmu.do_step(1e-3) == "ok"
+    before = [fmu.get(name) for name in ("x.y", "x.z1", "x.w", "x.z2", "y.z1", "y.z2")]
+    fmu.set("dy", 1e150)
+    assert fmu.do_step(1e-3) == "discard"
+    refusals = [m for m in fmu.messages_with("error") if "refused" in m]
+    assert refusals and "axis y:" in refusals[-1], refusals
+    assert [fmu.get(name) for name in ("x.y", "x.z1", "x.w", "x.z2", "y.z1", "y.z2")] == before
+    fmu.set("dy", 0.0)
+    assert fmu.do_step(1e-3) == "ok"
+    fmu.free()
