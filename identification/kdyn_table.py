@@ -42,10 +42,12 @@ FIT_CYCLES = 6
 """From rest, the sixth cycle's first harmonic is within 8e-4 of the steady state's |K*| and 0.025 deg
 of its loss angle for the paper's Tables 2, 4, 5 on 0.5-3 mm, 1-30 Hz (64 steps per cycle,
 measured 2026-11-23): about a tenth of the uncertainties; twelve cycles would halve little."""
-SEARCH_STEPS_PER_CYCLE, SEARCH_CYCLES = 32, 4
+SEARCH_STEPS_PER_CYCLE, SEARCH_CYCLES = 32, 3
 """The table's loop during the screening and the early least-squares stages, which only choose the
-basins the last stage refines: a third of the cost, within 2.2e-3 of the steady state's |K*| and
-0.084 deg of its loss angle at the truth for Tables 2, 4, 5 (measured 2026-11-23)."""
+basins the last stage refines: a quarter of the cost, within 6.9e-3 of the steady state's |K*| and
+0.096 deg of its loss angle at the truth for Tables 2, 4, 5 (measured 2026-11-24; 4 cycles gave
+2.2e-3 and 0.084 deg). The Table 4 round trip (benchmarks/bench_kdyn_fit.py) is as accurate with
+either, and 20 s faster with 3."""
 REQUIRED = ("amplitude_mm", "frequency_hz", "kdyn_N_per_mm", "loss_angle_deg")
 OPTIONAL = {"preload_mm": 0.0, "weight": 1.0}
 COLUMNS = ("amplitude_mm", "frequency_hz", "preload_mm", "kdyn_N_per_mm", "loss_angle_deg", "weight")

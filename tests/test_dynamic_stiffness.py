@@ -294,16 +294,18 @@ def test_compare_refuses_a_table(tmp_path, capsys):
 
 
 def test_the_search_loop_is_coarser_and_close_to_the_fit_loop():
-    """The screening's table loop (4 cycles of 32 steps) and the fit's (6 of 64) at the truth:
+    """The screening's table loop (3 cycles of 32 steps) and the fit's (6 of 64) at the truth:
     within a fraction of the table's uncertainty of each other (so the early stages find the
     basin the last one refines); switching keeps the table."""
     exact = characterise(TABLE5, [0.5, 2.0, 3.0], [1.0, 10.0, 30.0])
     table = KdynTable.from_characterisation(exact)
     search = Objective([], table=table, search=True)
     fit_loop = search.with_fit_loop([])
-    assert (search.table.cycles, search.table.steps_per_cycle) == (4, 32)
-    assert (search.with_steps([], []).table.cycles, fit_loop.with_fit_loop([]) is fit_loop) == (4, True)
+    assert (search.table.cycles, search.table.steps_per_cycle) == (3, 32)
+    assert (search.with_steps([], []).table.cycles, fit_loop.with_fit_loop([]) is fit_loop) == (3, True)
     assert (fit_loop.table.cycles, fit_loop.table.steps_per_cycle) == (6, 64)
     matrix = parameter_matrix([TABLE5])
     coarse, fine = (o.residual_matrix(matrix)[0] * math.sqrt(o.size) for o in (search, fit_loop))
-    assert np.max(np.abs(fine)) < 0.15 and np.max(np.abs(coarse)) < 0.5
+    # in units of the table's uncertainty: the fit loop a tenth of it, the search loop under one
+    # (0.69 for Table 5 at 3 cycles from rest: a bias the last stage, on the fit loop, removes)
+    assert np.max(np.abs(fine)) < 0.15 and np.max(np.abs(coarse)) < 1.0
