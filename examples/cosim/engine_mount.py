@@ -203,6 +203,7 @@ def spectral_peaks(run: dict, step_size: float, count: int = 6) -> np.ndarray:
 def free_decay(out_dir: Path, step_size: float, duration: float) -> tuple[np.ndarray, np.ndarray, dict]:
     """Kick the engine on Kelvin-Voigt mounts (base still) and return (measured, linearised)
     natural frequencies [Hz] and the run."""
+    out_dir.mkdir(parents=True, exist_ok=True)
     kv_params = save_six_axis(out_dir / "params_six_axis_kelvin_voigt.json", kelvin_voigt_axes(),
                               {"note": "Kelvin-Voigt on every axis, for the engine-mount frequency check"})
     bushing_fmu, body_fmu = build_fmus(out_dir / "fmus_kelvin_voigt", kv_params)
