@@ -33,6 +33,12 @@ from identification.objectives import Objective
 from identification.search_space import SearchSpace
 
 DIFFERENCE_STEP = 1e-6
+COST_TOLERANCE = 1e-6
+"""scipy's ``ftol``: a start ends when an accepted step lowers chi^2 by less than this fraction
+of itself. At the noise floor chi^2 is about n, so that is under 0.003 in chi^2 for the paper's
+tests, 1e-4 of the confidence region's delta chi^2 (23.7 for 14 parameters). scipy's default,
+1e-8, let the final starts crawl along flat valleys: on the reliability benchmark's random 1 the
+last stage took 6971 simulations with it and 1758 with this, ending 0.06 higher in chi^2."""
 
 
 @dataclass(frozen=True)
@@ -190,7 +196,7 @@ def _least_squares_task(problem: Problem, item) -> tuple[np.ndarray, float, int,
         with np.errstate(over="ignore", invalid="ignore"):   # failed candidates: huge residuals by design
             result = least_squares(fun, np.clip(theta0, bounds[:, 0], bounds[:, 1]), jac=jac,
                                    bounds=(bounds[:, 0], bounds[:, 1]), method="trf", x_scale="jac",
-                                   max_nfev=evaluations)
+                                   ftol=COST_TOLERANCE, max_nfev=evaluations)
     except (ValueError, np.linalg.LinAlgError) as exc:
         return np.asarray(theta0, dtype=float), float("inf"), used, f"failed: {exc}"
     return result.x, float(2.0 * result.cost), used, result.message
