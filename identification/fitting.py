@@ -410,11 +410,14 @@ def _search(tests, noise, model, preset, settings, seed, engine, progress, start
                              first_stage=len(early))
         final_check = _check_steps(problem, tests, records, n, d)
         evaluations += final_check.evaluations
-        if final_check.changed:
-            notes.append(f"note: at the best fit the forward model would need "
-                         f"{'/'.join(map(str, final_check.objective.steps_per_sample))} steps per sample (it ran "
-                         f"{'/'.join(map(str, problem.objective.steps_per_sample))}); its own error may take more "
-                         "than a tenth of the confidence region")
+        notes += _steps_note(final_check, problem)
+    records, extended = _extend_if_alone(problem, engine, records, last, len(early), n, d, bars)
+    if extended:
+        notes.append(f"note: only one of the {last[0]} final starts reached the best misfit, so the next {extended} "
+                     "starts of the stage before also ran the last stage")
+        extension_check = _check_steps(problem, tests, records, n, d)
+        evaluations += extension_check.evaluations
+        notes += _steps_note(extension_check, problem)
     bars.close()
     evaluations += sum(r.evaluations - 1 for r in records)
 
@@ -474,6 +477,35 @@ def _fit_kelvin_voigt(tests, noise, started, table=None) -> FitResult:
                        "linear", 0, 1, time.perf_counter() - started, table=_table_fit(table, parameters))
     result.parameters.provenance = result.provenance()
     return result
+
+
+def _extend_if_alone(problem: Problem, engine, records: list[StartRecord], last: tuple[int, int], stage: int,
+                     n: int, d: int, bars) -> tuple[list[StartRecord], int]:
+    """If fewer than MIN_AGREEING of the last stage's starts reach the best misfit within the
+    ensemble threshold, the next ``last[0]`` starts of the stage before run the last stage too
+    (once), so that a lone best start gets its chance to be confirmed, or a better optimum is
+    found, before the fit says it is not converged. Returns the records (sorted as
+    ``run_stages`` sorts them) and how many starts it added."""
+    final = [r for r in records if r.stage == stage]
+    best = min(r.misfit for r in final)
+    limit = best + misfit_threshold(best, n, d)
+    waiting = sorted((r for r in records if r.stage == stage - 1), key=lambda r: (r.misfit, r.start))[:last[0]]
+    if sum(r.misfit <= limit for r in final) >= MIN_AGREEING or not waiting:
+        return records, 0
+    run_stages(problem, engine, waiting, [last], lambda s, k: bars.stage(s, k, more=True), first_stage=stage)
+    records.sort(key=lambda r: (-r.stage, r.misfit, r.start))
+    return records, len(waiting)
+
+
+def _steps_note(check, problem: Problem) -> list[str]:
+    """A note if a last check of the steps per sample (``_check_steps``) would change those the
+    fit ran with (it only reports)."""
+    if not check.changed:
+        return []
+    return [f"note: at the best fit the forward model would need "
+            f"{'/'.join(map(str, check.objective.steps_per_sample))} steps per sample (it ran "
+            f"{'/'.join(map(str, problem.objective.steps_per_sample))}); its own error may take more "
+            "than a tenth of the confidence region"]
 
 
 def _check_steps(problem: Problem, tests, records, n: int, d: int):
@@ -546,10 +578,11 @@ class _Progress:
     def screening(self, count: int):
         self._advance("screening", self.screening_total, "points", count)
 
-    def stage(self, index: int, count: int, again: bool = False):
+    def stage(self, index: int, count: int, again: bool = False, more: bool = False):
         starts, evaluations = self.settings.stages[index]
         self._advance(f"stage {index + 1}/{len(self.settings.stages)} ({starts} starts x {evaluations})"
-                      + (" again, finer steps" if again else ""), starts, "starts", count)
+                      + (" again, finer steps" if again else "") + (" on more starts" if more else ""),
+                      starts, "starts", count)
 
     def _advance(self, name, total, unit, count):
         if not self.enabled:

@@ -1,0 +1,72 @@
+"""The search's last resort before a warning: a lone best start gets company (fitting._extend_if_alone).
+
+The problem is a one-coordinate double well, solved by the search's own least-squares task:
+residuals (theta^2 - 1, sqrt(1 + (1 + theta)/8)) have local minima near theta = -1 (misfit 1)
+and theta = +1 (misfit about 1.25), so which basin a start ends in is known in advance."""
+from dataclasses import dataclass
+
+import numpy as np
+
+from identification.engine import SerialEngine
+from identification.ensemble import misfit_threshold
+from identification.fitting import MIN_AGREEING, _extend_if_alone
+from identification.multistart import StartRecord
+
+RESIDUALS, COORDINATES = 100, 1      # the n and d the threshold is computed for
+
+
+@dataclass(frozen=True)
+class _Box:
+    def bounds(self):
+        return np.array([[-2.0, 2.0]])
+
+
+@dataclass(frozen=True)
+class DoubleWell:
+    space: _Box = _Box()
+
+    def residuals(self, theta):
+        theta = np.atleast_2d(theta)[:, 0]
+        return np.column_stack([theta ** 2 - 1.0, np.sqrt(1.0 + (1.0 + theta) / 8.0)])
+
+    def misfit(self, theta):
+        return np.sum(self.residuals(theta) ** 2, axis=1)
+
+
+class _Bars:
+    def stage(self, index, count, again=False, more=False):
+        pass
+
+
+def records(final_thetas, waiting_thetas):
+    problem = DoubleWell()
+    out = [StartRecord(i, np.array([t]), float(problem.misfit([[t]])[0]), 1, 1)
+           for i, t in enumerate(final_thetas)]
+    out += [StartRecord(len(final_thetas) + i, np.array([t]), float(problem.misfit([[t]])[0]), 0, 1)
+            for i, t in enumerate(waiting_thetas)]
+    return out
+
+
+def agreeing(found):
+    final = [r for r in found if r.stage == 1]
+    best = min(r.misfit for r in final)
+    return sum(r.misfit <= best + misfit_threshold(best, RESIDUALS, COORDINATES) for r in final)
+
+
+def test_a_lone_best_start_makes_the_next_starts_run_the_last_stage():
+    # one final start in the deep well, two in the shallow one; of the waiting starts two lie in the deep well
+    found = records([-1.0, 1.0, 1.0], [-0.6, -1.4, 0.7])
+    assert agreeing(found) == 1
+    found, added = _extend_if_alone(DoubleWell(), SerialEngine(), found, (3, 50), 1, RESIDUALS, COORDINATES, _Bars())
+    assert added == 3 and all(r.stage == 1 for r in found)
+    assert agreeing(found) == 3 >= MIN_AGREEING
+    ends = sorted(float(r.theta[0]) for r in found if r.start >= 3)
+    assert ends[0] < -0.9 and ends[1] < -0.9 and ends[2] > 0.9     # each went to its own well's bottom
+    assert [r.misfit for r in found] == sorted(r.misfit for r in found)
+
+
+def test_starts_that_already_agree_are_left_alone():
+    found = records([-1.0, -1.0, 1.0], [-0.6])
+    before = [(r.start, r.stage, r.misfit) for r in found]
+    found, added = _extend_if_alone(DoubleWell(), SerialEngine(), found, (3, 50), 1, RESIDUALS, COORDINATES, _Bars())
+    assert added == 0 and [(r.start, r.stage, r.misfit) for r in found] == before
