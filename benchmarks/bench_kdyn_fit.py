@@ -3,6 +3,7 @@ reproduces |K*| within 2 % and the loss angle within 0.5 deg on every case of a 
 was not fitted on, and the step test within 2 % NRMSE).
 
     python benchmarks/bench_kdyn_fit.py [--truth data/params_table4_step.json] [--seed 0] [--no-step]
+                                        [--time-series-too]
 
 Truth: a parameter set the fit has never seen (default the paper's Table 4). Training data,
 SYNTHETIC: its table on 0.5-3 mm x 1-30 Hz (4 x 5 cases, ``characterise``) with 1 % noise on
@@ -10,7 +11,10 @@ SYNTHETIC: its table on 0.5-3 mm x 1-30 Hz (4 x 5 cases, ``characterise``) with 
 1 kHz, continuous-time truth, 1 % force noise). The fit: ``fit(step, kdyn=table)``, default
 preset. Prints the wall time, the fit's summary, the errors on every case of a 7 x 9 grid other
 than the training cases (|K*| relative, loss angle in deg) and the step's NRMSE against the
-noise-free truth.
+noise-free truth. ``--time-series-too`` then fits the same truth's time-series tests in the same
+run (the paper's sine 2 mm/10 Hz and the step above, 1 % force noise: what
+``bench_fit_reliability.py`` fits) and prints both wall times and their ratio: issue 14 asks
+for the table fit within the time-series fit's budget.
 """
 from __future__ import annotations
 
@@ -30,7 +34,7 @@ from identification.dynamic_stiffness import characterise  # noqa: E402
 from identification.kdyn_table import KdynTable  # noqa: E402
 from identification.measurements import Measurement  # noqa: E402
 from identification.objectives import nrmse  # noqa: E402
-from identification.protocols import Step, sample_times  # noqa: E402
+from identification.protocols import Sine, Step, sample_times  # noqa: E402
 from identification.rig_tests import RigTest  # noqa: E402
 from identification.simulate import simulate  # noqa: E402
 
@@ -45,6 +49,8 @@ def main() -> None:
     parser.add_argument("--truth", type=Path, default=REPO / "data" / "params_table4_step.json")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--no-step", action="store_true", help="fit the table alone")
+    parser.add_argument("--time-series-too", action="store_true",
+                        help="also fit the truth's sine and step tests, for the time side by side")
     args = parser.parse_args()
     from identification.fitting import fit
     truth = load_parameters(args.truth)
@@ -82,6 +88,23 @@ def main() -> None:
           f"(target 2 %), largest loss-angle error {np.max(np.abs(angle_error[unseen])):.2f} deg (target 0.5); "
           f"step NRMSE against the noise-free truth {nrmse(step_fit, step_truth):.2%} (target 2 %); "
           f"{seconds:.0f} s")
+    if args.time_series_too:
+        sine_t = sample_times(1.0, 1000.0)
+        sine_x, sine_v = Sine(2.0, 10.0, 1.0).signals(sine_t)
+        sine_truth = simulate(truth, sine_t, sine_x, sine_v, steps_per_sample=16)
+        sine = sine_truth + rng.normal(0.0, 0.01 * np.sqrt(np.mean(sine_truth ** 2)), sine_t.size)
+        series = [RigTest(Measurement(sine_t, sine_x, sine, np.gradient(sine_x, sine_t), velocity_derived=True,
+                                      source="synthetic_sine.csv"), "sine"),
+                  RigTest(Measurement(t, x, measured, np.gradient(x, t), velocity_derived=True,
+                                      source="synthetic_step.csv"), "step", 0.4)]
+        started = time.perf_counter()
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            series_result = fit(series, seed=args.seed, progress=False)
+        series_seconds = time.perf_counter() - started
+        print(f"side by side: the table fit {seconds:.0f} s, the time-series fit (sine 2 mm/10 Hz + step, "
+              f"{'converged' if series_result.converged else 'NOT converged'}) {series_seconds:.0f} s: "
+              f"ratio {seconds / series_seconds:.2f}")
 
 
 if __name__ == "__main__":
