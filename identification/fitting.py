@@ -156,6 +156,7 @@ class FitResult:
     notes: list[str] = field(default_factory=list)
     steps_per_sample: list[int] = field(default_factory=list)   # the forward model's, per test
     table: TableFit | None = None          # the dynamic-stiffness table, if one was fitted
+    added_starts: int = 0                  # starts that ran the last stage because one alone reached the best
 
     @property
     def model(self) -> str:
@@ -226,6 +227,7 @@ class FitResult:
                "tests": [t.as_dict() for t in self.tests] + ([self.table.as_dict()] if self.table else [])}
         if self.space is not None:
             out.update({"starts_agreeing": self.agreeing, "final_starts": self.final_starts,
+                        "starts_added_for_agreement": self.added_starts,
                         "agreement_threshold_misfit": _round(self.threshold),
                         "ensemble_members": len(self.ensemble),
                         "steps_per_sample": list(self.steps_per_sample),
@@ -397,27 +399,30 @@ def _search(tests, noise, model, preset, settings, seed, engine, progress, start
     records = run_stages(problem, engine, first_records(theta, misfits, settings.stages[0][0]), early, bars.stage)
     # The forward model's steps per sample, checked where the result is decided: at the best
     # start before the last stage, and at the best fit; if that changes them, the last stage
-    # runs once more, and a third check only reports (identification.refinement).
+    # runs once more, and a third check only reports (identification.refinement). A lone best
+    # start gets company before the check at the best fit (_extend_if_alone).
     notes = []
     refinement = _check_steps(problem, tests, records, n, d)
     problem = Problem(refinement.objective.with_fit_loop(tests), space)
     records = run_stages(problem, engine, records, [last], bars.stage, first_stage=len(early))
+    records, added, agreeing = _extend_if_alone(problem, engine, records, last, len(early), n, d, bars)
+    final_count = last[0] + added
+    if added:
+        notes.append(f"note: only {agreeing} of the {last[0]} final starts reached the best misfit, so {added} more "
+                     f"start{'s' if added > 1 else ''} of the earlier stages also ran the last stage")
     refinement_at_best = _check_steps(problem, tests, records, n, d)
     evaluations += refinement.evaluations + refinement_at_best.evaluations
     if refinement_at_best.changed:
         problem = Problem(refinement_at_best.objective, space)
-        records = run_stages(problem, engine, records, [last], lambda s, k: bars.stage(s, k, again=True),
-                             first_stage=len(early))
+        records = run_stages(problem, engine, records, [(final_count, last[1])],
+                             lambda s, k: bars.stage(s, k, again=True, total=final_count), first_stage=len(early))
         final_check = _check_steps(problem, tests, records, n, d)
         evaluations += final_check.evaluations
-        notes += _steps_note(final_check, problem)
-    records, extended = _extend_if_alone(problem, engine, records, last, len(early), n, d, bars)
-    if extended:
-        notes.append(f"note: only one of the {last[0]} final starts reached the best misfit, so the next {extended} "
-                     "starts of the stage before also ran the last stage")
-        extension_check = _check_steps(problem, tests, records, n, d)
-        evaluations += extension_check.evaluations
-        notes += _steps_note(extension_check, problem)
+        if final_check.changed:
+            notes.append(f"note: at the best fit the forward model would need "
+                         f"{'/'.join(map(str, final_check.objective.steps_per_sample))} steps per sample (it ran "
+                         f"{'/'.join(map(str, problem.objective.steps_per_sample))}); its own error may take more "
+                         "than a tenth of the confidence region")
     bars.close()
     evaluations += sum(r.evaluations - 1 for r in records)
 
@@ -444,7 +449,7 @@ def _search(tests, noise, model, preset, settings, seed, engine, progress, start
     result = FitResult(parameters, float(best.misfit), _test_fits(tests, noise, parameters, steps), records, threshold,
                        ensemble, ident, preset, seed, evaluations, time.perf_counter() - started, engine.description,
                        space, final_starts=len(final), sampler=sampler, notes=notes, steps_per_sample=steps,
-                       table=_table_fit(table, parameters))
+                       table=_table_fit(table, parameters), added_starts=added)
     result.parameters.provenance = result.provenance()
     return result
 
@@ -480,32 +485,24 @@ def _fit_kelvin_voigt(tests, noise, started, table=None) -> FitResult:
 
 
 def _extend_if_alone(problem: Problem, engine, records: list[StartRecord], last: tuple[int, int], stage: int,
-                     n: int, d: int, bars) -> tuple[list[StartRecord], int]:
+                     n: int, d: int, bars) -> tuple[list[StartRecord], int, int]:
     """If fewer than MIN_AGREEING of the last stage's starts reach the best misfit within the
-    ensemble threshold, the next ``last[0]`` starts of the stage before run the last stage too
-    (once), so that a lone best start gets its chance to be confirmed, or a better optimum is
-    found, before the fit says it is not converged. Returns the records (sorted as
-    ``run_stages`` sorts them) and how many starts it added."""
+    ensemble threshold, up to ``last[0]`` more starts run the last stage too (once): those that
+    stopped in the latest earlier stage first, each group by misfit. A lone best start thus
+    gets its chance to be confirmed, or a better optimum is found, before the fit says it is
+    not converged. Returns the records (sorted as ``run_stages`` sorts them), how many starts
+    were added and how many agreed before."""
     final = [r for r in records if r.stage == stage]
     best = min(r.misfit for r in final)
     limit = best + misfit_threshold(best, n, d)
-    waiting = sorted((r for r in records if r.stage == stage - 1), key=lambda r: (r.misfit, r.start))[:last[0]]
-    if sum(r.misfit <= limit for r in final) >= MIN_AGREEING or not waiting:
-        return records, 0
-    run_stages(problem, engine, waiting, [last], lambda s, k: bars.stage(s, k, more=True), first_stage=stage)
+    agreeing = sum(r.misfit <= limit for r in final)
+    waiting = sorted((r for r in records if r.stage < stage), key=lambda r: (-r.stage, r.misfit, r.start))[:last[0]]
+    if agreeing >= MIN_AGREEING or not waiting:
+        return records, 0, agreeing
+    run_stages(problem, engine, waiting, [(len(waiting), last[1])],
+               lambda s, k: bars.stage(s, k, more=True, total=len(waiting)), first_stage=stage)
     records.sort(key=lambda r: (-r.stage, r.misfit, r.start))
-    return records, len(waiting)
-
-
-def _steps_note(check, problem: Problem) -> list[str]:
-    """A note if a last check of the steps per sample (``_check_steps``) would change those the
-    fit ran with (it only reports)."""
-    if not check.changed:
-        return []
-    return [f"note: at the best fit the forward model would need "
-            f"{'/'.join(map(str, check.objective.steps_per_sample))} steps per sample (it ran "
-            f"{'/'.join(map(str, problem.objective.steps_per_sample))}); its own error may take more "
-            "than a tenth of the confidence region"]
+    return records, len(waiting), agreeing
 
 
 def _check_steps(problem: Problem, tests, records, n: int, d: int):
@@ -578,8 +575,9 @@ class _Progress:
     def screening(self, count: int):
         self._advance("screening", self.screening_total, "points", count)
 
-    def stage(self, index: int, count: int, again: bool = False, more: bool = False):
+    def stage(self, index: int, count: int, again: bool = False, more: bool = False, total: int | None = None):
         starts, evaluations = self.settings.stages[index]
+        starts = total or starts
         self._advance(f"stage {index + 1}/{len(self.settings.stages)} ({starts} starts x {evaluations})"
                       + (" again, finer steps" if again else "") + (" on more starts" if more else ""),
                       starts, "starts", count)
