@@ -165,8 +165,7 @@ class FitResult:
     @property
     def agreeing(self) -> int:
         """Starts of the last stage whose misfit is within the threshold of the best."""
-        final = [r for r in self.records if r.stage == self.records[0].stage] if self.records else []
-        return int(sum(r.misfit <= self.misfit + self.threshold for r in final)) if final else 1
+        return _agreeing(self.records, self.records[0].stage, self.misfit, self.threshold) if self.records else 1
 
     @property
     def at_floor(self) -> bool:
@@ -492,10 +491,8 @@ def _extend_if_alone(problem: Problem, engine, records: list[StartRecord], last:
     gets its chance to be confirmed, or a better optimum is found, before the fit says it is
     not converged. Returns the records (sorted as ``run_stages`` sorts them), how many starts
     were added and how many agreed before."""
-    final = [r for r in records if r.stage == stage]
-    best = min(r.misfit for r in final)
-    limit = best + misfit_threshold(best, n, d)
-    agreeing = sum(r.misfit <= limit for r in final)
+    best = min(r.misfit for r in records if r.stage == stage)
+    agreeing = _agreeing(records, stage, best, misfit_threshold(best, n, d))
     waiting = sorted((r for r in records if r.stage < stage), key=lambda r: (-r.stage, r.misfit, r.start))[:last[0]]
     if agreeing >= MIN_AGREEING or not waiting:
         return records, 0, agreeing
@@ -503,6 +500,12 @@ def _extend_if_alone(problem: Problem, engine, records: list[StartRecord], last:
                lambda s, k: bars.stage(s, k, more=True, total=len(waiting)), first_stage=stage)
     records.sort(key=lambda r: (-r.stage, r.misfit, r.start))
     return records, len(waiting), agreeing
+
+
+def _agreeing(records: list[StartRecord], stage: int, best_misfit: float, threshold: float) -> int:
+    """Starts that ran ``stage`` and reached ``best_misfit`` within ``threshold``: the agreement
+    count, the convergence evidence."""
+    return int(sum(r.misfit <= best_misfit + threshold for r in records if r.stage == stage))
 
 
 def _check_steps(problem: Problem, tests, records, n: int, d: int):
