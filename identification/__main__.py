@@ -77,6 +77,9 @@ def main(argv: list[str] | None = None) -> int:
     fit_parser.add_argument("--ssv", type=Path, help="also write an SSP 1.0 ParameterValues file")
     fit_parser.add_argument("--ensemble", type=Path,
                             help="also write the ensemble: every parameter set within the 95 %% confidence threshold")
+    fit_parser.add_argument("--no-ensemble", action="store_true",
+                            help="skip the ensemble (prediction profiles and posterior sampling): a faster fit "
+                                 "with its convergence evidence but no band")
     fit_parser.add_argument("--plots", type=Path, help="directory for the waterfall and the training tests' plots")
 
     sensitivity_parser = commands.add_parser(
@@ -252,6 +255,8 @@ def _fit(args) -> int:
                                  (args.ensemble, "--ensemble", ".json")):
         check_output(path, option, suffixes=(suffix,))
     check_output(args.plots, "--plots", directory=True)
+    if args.no_ensemble and args.ensemble is not None:
+        raise UsageError(f"--ensemble {args.ensemble} needs the ensemble that --no-ensemble skips: give one of them")
     tests, manifest_model = _training_tests(args)
     model = args.model or manifest_model or "proposed"
     if model not in MODEL_NAMES:
@@ -268,7 +273,7 @@ def _fit(args) -> int:
         warnings.simplefilter("ignore", FitNotConvergedWarning)   # printed below as WARNING
         result = fit(tests, model=model, preset=args.preset, seed=args.seed, workers=args.workers,
                      scheduler=args.scheduler, progress=not args.quiet, screening=args.screening,
-                     starts=args.starts, kdyn=table)
+                     starts=args.starts, kdyn=table, ensemble=not args.no_ensemble)
     written = _save_or_rescue(result, args, [t.measurement.source for t in tests]
                               + ([str(args.kdyn)] if args.kdyn else []))
     print(result.summary())

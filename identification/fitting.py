@@ -157,6 +157,8 @@ class FitResult:
     steps_per_sample: list[int] = field(default_factory=list)   # the forward model's, per test
     table: TableFit | None = None          # the dynamic-stiffness table, if one was fitted
     added_starts: int = 0                  # starts that ran the last stage because one alone reached the best
+    agreed_before_added: int | None = None  # the agreement count when the last stage ended, before any added start
+    ensemble_sampled: bool = True          # False: fit(ensemble=False), the ensemble is the best fit alone
 
     @property
     def model(self) -> str:
@@ -227,8 +229,9 @@ class FitResult:
         if self.space is not None:
             out.update({"starts_agreeing": self.agreeing, "final_starts": self.final_starts,
                         "starts_added_for_agreement": self.added_starts,
+                        "starts_agreeing_before_added": self.agreed_before_added,
                         "agreement_threshold_misfit": _round(self.threshold),
-                        "ensemble_members": len(self.ensemble),
+                        "ensemble_members": len(self.ensemble), "ensemble_sampled": self.ensemble_sampled,
                         "steps_per_sample": list(self.steps_per_sample),
                         "search_space": {"k_ref_N_per_mm": _round(self.space.k_ref),
                                          "c_ref_Ns_per_mm": _round(self.space.c_ref),
@@ -273,7 +276,8 @@ class FitResult:
         if self.space is not None:
             lines.append(f"starts: {self.agreeing} of {self.final_starts} final starts agree (misfit within "
                          f"{self.threshold:.2e} of the best: delta chi^2 at 95 % for {len(self.space.names)} parameters); "
-                         f"ensemble: {len(self.ensemble)} parameter sets")
+                         + (f"ensemble: {len(self.ensemble)} parameter sets" if self.ensemble_sampled
+                            else "ensemble: not sampled (ensemble=False), the best fit alone"))
         if self.steps_per_sample:
             lines.append("forward model: " + ", ".join(f"{m} step{'s' if m > 1 else ''} per sample on {t.name}"
                                                        for m, t in zip(self.steps_per_sample, self.tests)))
@@ -293,6 +297,9 @@ class FitResult:
         if ssv is not None:
             written.append(save_parameters(ssv, self.parameters.parameters, self.model))
         if ensemble is not None:
+            if not self.ensemble_sampled:
+                raise IdentificationError(f"no ensemble to write to {ensemble}: this fit ran with ensemble=False "
+                                          "(--no-ensemble); fit again without it for the ensemble")
             written.append(save_ensemble(ensemble, self.ensemble, self.model, provenance))
         return written
 
@@ -319,7 +326,7 @@ def as_tests(measurements) -> list[RigTest]:
 
 def fit(measurements, model: str = "proposed", preset: str = "default", seed: int = 0, workers: int | None = None,
         scheduler=None, engine=None, progress: bool = True, screening: int | None = None,
-        starts: int | None = None, kdyn=None) -> FitResult:
+        starts: int | None = None, kdyn=None, ensemble: bool = True) -> FitResult:
     """Identify ``model``'s parameters from training tests (see the module docstring).
 
     ``measurements``: a ``rig_tests.Manifest``, ``RigTest``s, ``Measurement``s or CSV paths.
@@ -328,6 +335,9 @@ def fit(measurements, model: str = "proposed", preset: str = "default", seed: in
     Sobol points and of first-stage starts (later stages shrink in proportion, at least
     MIN_FINAL_STARTS remain). ``kdyn``: a dynamic-stiffness table (a CSV path or a
     ``kdyn_table.KdynTable``) fitted with the tests, or alone (``measurements`` empty).
+    ``ensemble=False`` skips the prediction profiles and the posterior sampling (a third to
+    half of a fit's time): the result's ensemble is then the best fit alone, so ``predict``
+    gives no band and ``save(ensemble=...)`` refuses.
     Emits a ``FitNotConvergedWarning`` when the fit is not converged.
     """
     from threadpoolctl import threadpool_limits
@@ -351,7 +361,8 @@ def fit(measurements, model: str = "proposed", preset: str = "default", seed: in
             owned = engine is None
             engine = engine or make_engine(workers, scheduler)
             try:
-                result = _search(tests, noise, bushing.name, preset, settings, seed, engine, progress, started, table)
+                result = _search(tests, noise, bushing.name, preset, settings, seed, engine, progress, started, table,
+                                 ensemble)
             finally:
                 if owned:
                     engine.close()
@@ -380,7 +391,8 @@ def _settings(base: SearchSettings, screening: int | None, starts: int | None) -
     return SearchSettings(base.screening, base.stages)   # validates
 
 
-def _search(tests, noise, model, preset, settings, seed, engine, progress, started, table=None) -> FitResult:
+def _search(tests, noise, model, preset, settings, seed, engine, progress, started, table=None,
+            sample_ensemble=True) -> FitResult:
     measurements = [t.measurement for t in tests]
     space = SearchSpace.from_measurements(measurements, model, steps=[t.kind == "step" for t in tests], table=table)
     # with a table, the screening and the early stages run its coarser loop (kdyn_table)
@@ -430,16 +442,20 @@ def _search(tests, noise, model, preset, settings, seed, engine, progress, start
     threshold = misfit_threshold(best.misfit, n, d)
     scaled_jacobian, _ = jacobian(problem, best.theta)
     ident = identifiability(scaled_jacobian * np.sqrt(n), space.names, threshold * n)
+    evaluations += d + 1
     limit = best.misfit + threshold
-    extremes, extreme_misfits = profile_extremes(problem, best.theta, best.misfit, ident, limit, engine)
-    # here, not on a worker: the compiled kernel runs the walkers on every core of this process
-    draws, _, sampler = posterior_samples(problem, best.theta, seed, threshold_scale(best.misfit, n, d))
-    pushed, pushed_misfits = push_to_boundary(problem, best.theta, draws, limit)
-    evaluations += d + 1 + WALKERS * STEPS + len(draws) * len(PUSH) \
-        + len(PROBES) * 2 * (d + 1) * (1 + PROFILE_ROUNDS * PROFILE_EVALUATIONS)
-    members = select_members(best.theta, [(r.theta, r.misfit) for r in final],
-                             np.vstack([extremes, pushed]), np.concatenate([extreme_misfits, pushed_misfits]),
-                             limit, space.bounds())
+    sampler = None
+    members = [best.theta]
+    if sample_ensemble:
+        extremes, extreme_misfits = profile_extremes(problem, best.theta, best.misfit, ident, limit, engine)
+        # here, not on a worker: the compiled kernel runs the walkers on every core of this process
+        draws, _, sampler = posterior_samples(problem, best.theta, seed, threshold_scale(best.misfit, n, d))
+        pushed, pushed_misfits = push_to_boundary(problem, best.theta, draws, limit)
+        evaluations += WALKERS * STEPS + len(draws) * len(PUSH) \
+            + len(PROBES) * 2 * (d + 1) * (1 + PROFILE_ROUNDS * PROFILE_EVALUATIONS)
+        members = select_members(best.theta, [(r.theta, r.misfit) for r in final],
+                                 np.vstack([extremes, pushed]), np.concatenate([extreme_misfits, pushed_misfits]),
+                                 limit, space.bounds())
     rows = space.to_model_parameters(np.array(members))
     names = space.bushing.parameter_names
     ensemble = [dict(zip(names, map(float, row))) for row in rows]
@@ -448,7 +464,8 @@ def _search(tests, noise, model, preset, settings, seed, engine, progress, start
     result = FitResult(parameters, float(best.misfit), _test_fits(tests, noise, parameters, steps), records, threshold,
                        ensemble, ident, preset, seed, evaluations, time.perf_counter() - started, engine.description,
                        space, final_starts=len(final), sampler=sampler, notes=notes, steps_per_sample=steps,
-                       table=_table_fit(table, parameters), added_starts=added)
+                       table=_table_fit(table, parameters), added_starts=added, agreed_before_added=agreeing,
+                       ensemble_sampled=sample_ensemble)
     result.parameters.provenance = result.provenance()
     return result
 
