@@ -6,6 +6,8 @@ from scipy.integrate import solve_ivp
 
 import build_fmu
 from fmu_src.parameter_files import load_parameters
+from suite_options import (_optimizer_rounding_variant, pytest_addoption, pytest_collection_modifyitems,  # noqa: F401
+                           pytest_configure)
 
 REPO = Path(__file__).resolve().parents[1]
 DATA = REPO / "data"
