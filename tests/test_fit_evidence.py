@@ -43,7 +43,9 @@ def write_tests(folder, tests):
     return folder / "tests.json"
 
 
+@pytest.mark.optimizer
 def test_a_starved_budget_prints_the_warning_and_stores_converged_false(tmp_path, capsys):
+    # one start from 8 screened points: one final start cannot agree with another, on any path
     manifest = write_tests(tmp_path / "bushing", short_tests(paper_parameters("table2")))
     out = tmp_path / "starved.json"
     assert main(["fit", "--tests", str(manifest), "--screening", "8", "--starts", "1", "--workers", "1",
@@ -56,17 +58,51 @@ def test_a_starved_budget_prints_the_warning_and_stores_converged_false(tmp_path
     assert all(0.008 < t["noise_fraction"] < 0.012 for t in provenance["tests"])   # 1 % noise, estimated
 
 
-def test_starts_that_agree_above_the_floor_say_the_model_may_not_fit(capsys):
-    # The single Bouc-Wen element cannot show the proposed model's relaxation: its starts agree
-    # on an optimum well above the noise floor, and the warning says so.
+@pytest.mark.optimizer
+def test_a_model_that_cannot_describe_the_data_stays_above_the_floor_and_says_so():
+    # The single Bouc-Wen element cannot show the proposed model's relaxation: on every path
+    # its fit ends far above the noise floor (measured: NRMSE 6-7x the noise), and the warning
+    # leads with the training NRMSE. Its hint follows the starts: where they agree (they did on
+    # every path tried), the model is blamed; where not, more starts are asked for.
     with pytest.warns(FitNotConvergedWarning) as record:
         result = fit(short_tests(paper_parameters("table2")), model="bouc_wen", seed=0, workers=1,
                      progress=False, screening=256, starts=8)
-    assert result.agreeing >= 2 and not result.at_floor and not result.converged
+    assert not result.at_floor and not result.converged
+    assert max(t.ratio for t in result.tests) > 3.0
     message = str(record[0].message)
-    assert message.startswith("not converged: training NRMSE") and "the starts agree" in message
+    assert message.startswith("not converged: training NRMSE")
+    if result.agreeing >= 2:
+        assert "the starts agree" in message and "more starts" not in message
+    else:
+        assert "more starts" in message and "the starts agree" not in message
 
 
+def test_agreeing_starts_above_the_floor_blame_the_model_not_the_search():
+    # The hint's logic on records made by hand: two of three final starts within the threshold
+    # of the best, every test far above its noise level, the best fit inside the box.
+    from fmu_src.bushing_models import get_model
+    from fmu_src.parameter_files import ParameterSet
+    from identification.fitting import FitResult, TestFit
+    from identification.multistart import StartRecord
+    from identification.noise import estimate_noise
+    from identification.search_space import SearchSpace
+    tests = short_tests(paper_parameters("table5"))
+    space = SearchSpace.from_measurements([t.measurement for t in tests], steps=[t.kind == "step" for t in tests])
+    best = paper_parameters("table5")
+    theta = space.to_coordinates(best)
+    records = [StartRecord(0, theta, 20.0, 2, 100), StartRecord(1, theta, 20.005, 2, 100),
+               StartRecord(2, theta, 25.0, 2, 100)]
+    fits = [TestFit(t.name, t.kind, estimate_noise(t.measurement.force_N), 0.05) for t in tests]
+    result = FitResult(ParameterSet(get_model("proposed"), best), 20.0, fits, records, 0.01, [best], None,
+                       "default", 0, 1, 1.0, space=space, final_starts=3)
+    assert result.agreeing == 2 and not result.at_floor and not result.converged and result.at_box_edge() == []
+    assert "training NRMSE 5.00%" in result.warning and "the starts agree" in result.warning
+    result.records[1].misfit = 20.02        # beyond the threshold: now the search is to blame
+    assert result.agreeing == 1 and "more starts" in result.warning and "the starts agree" not in result.warning
+
+
+@pytest.mark.slow
+@pytest.mark.optimizer
 @pytest.mark.parametrize("refined", [False, True], ids=["signal_steps", "refined_steps"])
 def test_the_same_seed_gives_the_same_file_on_one_worker_two_workers_and_a_dask_cluster(tmp_path, monkeypatch,
                                                                                          refined):
@@ -78,6 +114,10 @@ def test_the_same_seed_gives_the_same_file_on_one_worker_two_workers_and_a_dask_
         # refined objective travels to the workers)
         monkeypatch.setattr(refinement, "ERROR_BUDGET", 0.0)
         monkeypatch.setattr(refinement, "MAX_REFINED_STEPS", 2)
+    else:
+        # the signal's steps on every path: whether the fitted set would ask for finer ones
+        # depends on where the search ends
+        monkeypatch.setattr(refinement, "MAX_REFINED_STEPS", 1)
     manifest = write_tests(tmp_path / "bushing", short_tests(paper_parameters("table5"), seed=4))
     files = []
     # 16 first-stage starts: more than the 8 chunks of 2 workers, so chunks hold several starts
@@ -107,25 +147,39 @@ def test_an_unreachable_scheduler_is_a_clear_error_not_a_hang(tmp_path, capsys):
     assert not (tmp_path / "never.json").exists()
 
 
+def fit_table2(config, **budget):
+    """A fit of short Table 2 tests (sine 0.5 s, step 2 s, 1 % noise) with its ensemble, under
+    the rounding variant the suite's options ask for."""
+    from suite_options import rounding_variant
+    with rounding_variant(config), warnings.catch_warnings():
+        tests = short_tests(paper_parameters("table2"), seed=5, sine_s=0.5, step_s=2.0)
+        warnings.simplefilter("ignore", FitNotConvergedWarning)   # judged by what it predicts
+        return fit(tests, seed=1, progress=False, **budget), tests
+
+
 @pytest.fixture(scope="module")
-def table2_fit(tmp_path_factory):
-    """A fit of short Table 2 tests with its ensemble, written to files."""
+def table2_fit(tmp_path_factory, request):
+    """A reduced-budget fit of short Table 2 tests with its ensemble, written to files: what
+    ``predict`` and ``report`` read (its band's coverage is no claim here: see below)."""
     folder = tmp_path_factory.mktemp("table2")
-    tests = short_tests(paper_parameters("table2"), seed=5, sine_s=0.5, step_s=2.0)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", FitNotConvergedWarning)   # judged by what it predicts, below
-        result = fit(tests, seed=1, workers=1, progress=False, screening=512, starts=16)
+    result, tests = fit_table2(request.config, workers=1, screening=512, starts=16)
     result.save(folder / "params.json", ensemble=folder / "ensemble.json")
     return result, folder, tests
 
 
-def test_the_ensemble_band_holds_the_truth_where_the_best_fit_misses(table2_fit):
+@pytest.mark.slow
+@pytest.mark.optimizer
+def test_the_ensemble_band_holds_the_truth_where_the_best_fit_misses(request):
     # Inputs the fit never saw, beyond the training amplitude: the best fit misses the
     # noise-free truth by more than 1 % NRMSE there, so the best alone (the band of one set)
     # leaves the truth outside; the ensemble's band widened by the noise level holds it.
+    # The default budget, as the reliability benchmark measures the band: with 512 screened
+    # points and 16 starts, 2 of 6 seeds agreed on a basin at chi^2/n 1.43 (the truth scores
+    # 1.18), said converged, and the band held the truth on only 36-56 % of the samples.
+    # Measured at the default budget, seeds 1-4: NRMSE 1.5-2.3 %, alone 27-59 %, inside 100 %.
     from identification.objectives import nrmse
-    result, _, tests = table2_fit
-    assert len(result.ensemble) > 10
+    result, _ = fit_table2(request.config, workers=2)
+    assert result.converged and len(result.ensemble) > 10
     sigma = max(t.noise.sigma_N for t in result.tests)
     for protocol in (Sine(3.0, 10.0, 0.5), Sine(3.0, 20.0, 0.5)):
         t = sample_times(0.5, 1000.0)
@@ -138,6 +192,7 @@ def test_the_ensemble_band_holds_the_truth_where_the_best_fit_misses(table2_fit)
         assert np.mean(alone) < 0.9 and np.mean(inside) >= 0.95, (protocol, np.mean(alone), np.mean(inside))
 
 
+@pytest.mark.optimizer
 def test_predict_writes_the_force_and_the_band(table2_fit, tmp_path, capsys):
     _, folder, _ = table2_fit
     t = sample_times(0.3, 1000.0)
@@ -154,6 +209,7 @@ def test_predict_writes_the_force_and_the_band(table2_fit, tmp_path, capsys):
     assert "band width" in capsys.readouterr().out
 
 
+@pytest.mark.optimizer
 def test_report_prints_the_band_width_per_case(table2_fit, capsys):
     _, folder, tests = table2_fit
     data = folder / "sine.csv"
