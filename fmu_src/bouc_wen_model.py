@@ -14,9 +14,10 @@ from __future__ import annotations
 import math
 
 from .bushing_params import DAMPING, EXPONENT, GAIN, SPRING, WEIGHT, ParameterSpec
-from .integration import DEFAULT_MAX_SUBSTEPS, HEUN_JUMP_LIMIT, NOT_FINITE, OK, THETA, THETA_JUMP, walk_along_xi
+from .integration import (DEFAULT_MAX_SUBSTEPS, HEUN_JUMP_LIMIT, NOT_FINITE, OK, THETA, THETA_JUMP, block_gain,
+                          walk_along_xi)
 from .model_definition import BushingModel, StateSpec
-from .spencer_model import single_block_checks
+from .spencer_model import SINGLE_BLOCK_CONSTRAINTS
 
 PARAMETER_SPECS = (
     ParameterSpec("c0", "N.s/mm", "viscous damping in parallel", **DAMPING),
@@ -27,7 +28,7 @@ PARAMETER_SPECS = (
     ParameterSpec("gamma", "N^(1-n)/mm", "Bouc-Wen shape parameter on u*|z|^n (as in eq. 1)"),
     ParameterSpec("n", "1", "Bouc-Wen exponent", **EXPONENT),
 )
-KERNELS = ("prepare", "initial_state", "jump", "integrate", "force")
+KERNELS = ("prepare", "initial_state", "jump", "integrate", "force", "derivatives", "switches")
 
 
 # ---------------------------------------------------------------------------- kernels
@@ -65,7 +66,19 @@ def integrate(m, state, x, v, h, max_substeps):
     return (z,), 1, status
 
 
+def derivatives(m, state, x, v):
+    """(dz/dt,) [N/s]: the element driven by the displacement itself (model exchange)."""
+    c0, k0, alpha, A, beta, gamma, n = m
+    return (v * block_gain(state[0], v, (0.0, alpha, 1.0, A, beta, gamma, n)),)
+
+
+def switches(m, state, x, v):
+    """v [mm/s] and z [N]: where the right-hand side switches."""
+    return (v, state[0])
+
+
 MODEL = BushingModel(
     "bouc_wen", "SingleBoucWenBushing", "single Bouc-Wen", PARAMETER_SPECS,
     (StateSpec("z", 0, "N", "hysteretic force"),), "params_bouc_wen_fit_synthetic_table5.json",
-    prepare, initial_state, jump, integrate, force, further_checks=single_block_checks)
+    prepare, initial_state, jump, integrate, force,
+    derivatives, switches, constraints=SINGLE_BLOCK_CONSTRAINTS)

@@ -45,6 +45,48 @@ class ParameterSpec:
         return f"{self.name} = {value} [{self.unit}] must be {self.allowed}" + (f" ({self.why})" if self.why else "")
 
 
+@dataclass(frozen=True)
+class Constraint:
+    """A condition on several parameters, sum(coefficient * parameter) > bound (``strict``) or
+    >= bound, with what breaking it means: an ``error`` (the equations cannot take the set) or a
+    warning (simulable but doubtful), and ``why`` in words. Declared here rather than written as
+    code, so that the FMUs, the native one's C included, check the same conditions."""
+    terms: tuple[tuple[str, float], ...]
+    bound: float
+    strict: bool
+    error: bool
+    unit: str
+    why: str
+
+    @property
+    def expression(self) -> str:
+        """The left side in words: 'c0 + c2', 'beta2 - gamma2', 'A1'."""
+        text = ""
+        for i, (name, coefficient) in enumerate(self.terms):
+            if coefficient not in (1.0, -1.0):
+                raise ValueError(f"a constraint's coefficients are +1 or -1, not {coefficient}")
+            text += (name if coefficient > 0 else f"-{name}") if i == 0 else \
+                f" {'+' if coefficient > 0 else '-'} {name}"
+        return text
+
+    def value(self, p: Mapping[str, float]) -> float:
+        total = 0.0
+        for name, coefficient in self.terms:
+            total += coefficient * p[name]
+        return total
+
+    def message(self, p: Mapping[str, float]) -> str | None:
+        """What is wrong with the finite set ``p``, or None if it meets the condition."""
+        value = self.value(p)
+        if value > self.bound if self.strict else value >= self.bound:
+            return None
+        condition = f"{'>' if self.strict else '>='} {self.bound:g}"
+        unit = f" {self.unit}" if self.unit else ""
+        if self.error:
+            return f"{self.expression} = {value}{unit} must be {condition} ({self.why})"
+        return f"{self.expression} = {value}{unit} violates {self.why} {self.expression} {condition}"
+
+
 SPRING = dict(minimum=0.0, why="a negative spring is unstable")
 DAMPING = dict(minimum=0.0, why="a negative dashpot adds energy")
 WEIGHT = dict(minimum=0.0, why="a negative weight turns the hysteresis loop inside out")
@@ -104,3 +146,9 @@ def number_errors(params: Mapping[str, float], units: Mapping[str, str], model_l
 def range_errors(p: Mapping[str, float], specs: tuple[ParameterSpec, ...]) -> list[str]:
     """Every value of ``p`` (finite floats) outside its spec's allowed range."""
     return [error for spec in specs if (error := spec.range_error(p[spec.name])) is not None]
+
+
+def constraint_messages(p: Mapping[str, float], constraints: tuple[Constraint, ...]) -> tuple[list[str], list[str]]:
+    """(errors, warnings) of the finite set ``p`` against ``constraints``."""
+    broken = [(c, message) for c in constraints if (message := c.message(p)) is not None]
+    return [m for c, m in broken if c.error], [m for c, m in broken if not c.error]

@@ -90,15 +90,16 @@ def integration_module() -> str:
 
 
 def model_source(model, machinery: str, appendix: str = "") -> str:
-    """``model``'s module (a ``BushingModel``'s kernel module), its kernels compiled, and
-    ``appendix``. Its relative imports point at its own package (plain Python: specs, checks)
+    """``model``'s module (a ``BushingModel``'s kernel module), its kernels compiled, the step
+    protocol (``integration.step``, compiled as ``step``) and ``appendix``. Its relative imports point at its own package (plain Python: specs, checks)
     and at the compiled machinery ``machinery``."""
     module = sys.modules[model.kernel_module]
     source = inspect.getsource(module)
     source = source.replace("from .integration import", f"from {machinery} import")
     source = source.replace("from .", f"from {module.__package__}.")
     return (source + "\n\n# ---- appended by fmu_src/compiled_kernels.py ----\nimport numba\n\n" + _JIT_KERNELS
-            + appendix)
+            + "\n\n" + inspect.getsource(integration.step)
+            + "\n\nstep = numba.njit(error_model='numpy', cache=True)(step)\n" + appendix)
 
 
 def compiled_module(model, appendix: str = "", prefix: str = "bushing") -> types.ModuleType:
@@ -124,19 +125,15 @@ def _step_axes(params, rows, h, max_substeps):
     step one axis at a time, which words the refusal.
 
     Written here, never called here: its source is compiled in the model's generated module
-    (:func:`_fmu_appendix`), where ``prepare`` ... ``force`` are that model's compiled kernels."""
+    (:func:`_fmu_appendix`), where ``prepare``, ``step`` and ``force`` are that model's compiled
+    kernels."""
     count, width = rows.shape
     out = np.empty((count, width - 1))
     failures = 0
     for i in range(count):
         m = prepare(_VALUES(params[i]))
         x, v, state_x = rows[i, 0], rows[i, 1], rows[i, 2]
-        state = _STATE(rows[i, 3:])
-        status = _OK
-        if x != state_x:
-            state, status = jump(m, state, x - state_x)
-        if status == _OK:
-            state, used, status = integrate(m, state, x, v, h, max_substeps)
+        state, used, status = step(m, _STATE(rows[i, 3:]), state_x, x, v, h, max_substeps)
         _STORE(out, i, state)
         x_end = x + v * h
         out[i, width - 3] = force(m, state, x_end, v)
@@ -151,11 +148,7 @@ def _step_one(params, state, state_x, x, v, h, max_substeps):
     for a row: ``params`` its values in spec order, ``state`` its committed state (a tuple).
     Returns (new state, force at x + v*h with velocity v, x + v*h, status)."""
     m = prepare(_VALUES(params))
-    status = _OK
-    if x != state_x:
-        state, status = jump(m, state, x - state_x)
-    if status == _OK:
-        state, used, status = integrate(m, state, x, v, h, max_substeps)
+    state, used, status = step(m, state, state_x, x, v, h, max_substeps)
     x_end = x + v * h
     return state, force(m, state, x_end, v), x_end, status
 

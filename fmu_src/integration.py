@@ -58,7 +58,7 @@ OK, TOO_MANY_SUBSTEPS, NOT_FINITE = 0, 1, 2
 """Status codes of the kernels."""
 
 KERNELS = ("decay_factors", "rk4_in_xi", "block_segment", "block_step", "gain_variation", "substeps_needed",
-           "walk_along_xi")
+           "walk_along_xi", "block_gain")
 """The functions of this module that the identification compiles with numba."""
 
 
@@ -66,13 +66,16 @@ class StepError(ArithmeticError):
     """The step cannot be computed (overflow, non-finite result, too many substeps)."""
 
 
-def hysteretic_gain(z: float, u: float, A: float, beta: float, gamma: float, n: float) -> float:
-    """The bracket of eqs. 1-2: A - (gamma + beta*sgn(u)*sgn(z))*|z|^n  [N/mm]."""
-    return A - (gamma + beta * _sign(u) * _sign(z)) * abs(z) ** n
-
-
-def _sign(value: float) -> float:
-    return 1.0 if value > 0.0 else (-1.0 if value < 0.0 else 0.0)
+def block_gain(z, u, blk):
+    """The bracket of eqs. 1-2 of a block ``blk`` (module docstring) at hysteretic force z and
+    relative velocity u: A - (gamma + beta*sgn(u)*sgn(z))*|z|^n  [N/mm]."""
+    K, alpha, c, A, beta, gamma, n = blk
+    sigma = 1.0 if u > 0.0 else (-1.0 if u < 0.0 else 0.0)
+    if z > 0.0:
+        return A - (gamma + beta * sigma) * z ** n
+    if z < 0.0:
+        return A - (gamma - beta * sigma) * (-z) ** n
+    return A
 
 
 def decay_factors(x: float) -> tuple[float, float, float]:
@@ -219,6 +222,26 @@ def walk_along_xi(z, xi_total, A, beta, gamma, n, heun_limit, theta, max_pieces)
     return z, OK
 
 
+# ---------------------------------------------------------------------------- the step
+def step(m, state, state_x, x, v, h, max_substeps):
+    """One communication step of a model, the protocol every path runs: the displacement is
+    x + v*t [mm] for 0 <= t <= h [s]; ``state`` is valid at displacement ``state_x``, so where
+    x differs from it the difference is first a displacement jump (``jump``), then the model
+    integrates over the step (``integrate``). Returns (state at x + v*h, substeps, status).
+
+    Written once here and bound to each model's own ``jump`` and ``integrate``: in plain Python
+    as ``BushingModel.step`` (a copy of this function whose globals are the model module's),
+    compiled into each model's generated module (``compiled_kernels.model_source``), and in the
+    generated C of the native FMU. It is never called in this module."""
+    status = OK
+    used = 0
+    if x != state_x:
+        state, status = jump(m, state, x - state_x)  # noqa: F821 (the model's, where bound)
+    if status == OK:
+        state, used, status = integrate(m, state, x, v, h, max_substeps)  # noqa: F821
+    return state, used, status
+
+
 # ---------------------------------------------------------------------------- the driver
 def advance(model, constants, state, state_x: float, x: float, v: float, h: float,
             max_substeps: int = DEFAULT_MAX_SUBSTEPS) -> tuple[tuple, int]:
@@ -229,12 +252,7 @@ def advance(model, constants, state, state_x: float, x: float, v: float, h: floa
     the substeps used. Raises StepError if the result would overflow or is not finite, or if
     more than ``max_substeps`` are needed; ``state`` (a tuple) is never modified."""
     try:
-        status, new = OK, state
-        if x != state_x:
-            new, status = model.jump(constants, new, x - state_x)
-        used = 0
-        if status == OK:
-            new, used, status = model.integrate(constants, new, x, v, h, max_substeps)
+        new, used, status = model.step(constants, state, state_x, x, v, h, max_substeps)
     except (OverflowError, ZeroDivisionError, ValueError) as exc:
         raise StepError(f"the step overflowed ({exc}) at x = {x:g} mm, v = {v:g} mm/s, "
                         f"state = {tuple(state)}; check the units of the inputs "

@@ -13,7 +13,7 @@ PARAMETER_SPECS = (
     ParameterSpec("c", "N.s/mm", "viscous damping", **DAMPING),
     ParameterSpec("preload", "N", "force at x = 0"),
 )
-KERNELS = ("prepare", "initial_state", "jump", "integrate", "force")
+KERNELS = ("prepare", "initial_state", "jump", "integrate", "force", "derivatives", "switches")
 
 
 def prepare(p):
@@ -40,7 +40,16 @@ def integrate(m, state, x, v, h, max_substeps):
     return state, 0, OK
 
 
+def derivatives(m, state, x, v):
+    """No state: nothing to integrate."""
+    return ()
+
+
+def switches(m, state, x, v):
+    return ()
+
+
 MODEL = BushingModel(
     "kelvin_voigt", "KelvinVoigtBushing", "Kelvin-Voigt (linear)", PARAMETER_SPECS, (),
     "params_kelvin_voigt_fit_synthetic_table5.json", prepare, initial_state, jump, integrate, force,
-    force_offset=lambda p: p["preload"])
+    derivatives, switches)

@@ -10,11 +10,16 @@ value's range, its default parameter file, and its equations as five kernels:
     jump(constants, state, jump_mm) -> (state, status)
     integrate(constants, state, x, v, h, max_substeps) -> (state, substeps, status)
     force(constants, state, x, v) -> F [N]
+    derivatives(constants, state, x, v) -> d(state)/dt
+    switches(constants, state, x, v) -> the quantities whose sign selects the equations' branch
 
-A state is a tuple of floats (``states`` names them, in order; empty for a model without
-state). Over a step the displacement is x + v*t [mm] for 0 <= t <= h [s] with v [mm/s]
-constant; ``jump`` is the model's exact response to an instantaneous displacement jump, and
-``force`` is the force at displacement x with velocity v, positive for positive x.
+A state is a tuple of floats (the kernels' order; ``states`` names them for the FMU; empty
+for a model without state). Over a step the displacement is x + v*t [mm] for 0 <= t <= h [s]
+with v [mm/s] constant; ``jump`` is the model's exact response to an instantaneous
+displacement jump, and ``force`` is the force at displacement x with velocity v, positive for
+positive x. ``derivatives`` and ``switches`` are for a host that integrates the state itself
+(FMI model exchange: the states' derivatives and event indicators). The step protocol that
+every path runs is ``integration.step`` (``BushingModel.step``).
 Kernels are plain float arithmetic that raise nothing and return status codes
 (``integration.OK`` ...), so that ``identification/compiled_core.py`` compiles the same
 source with numba; ``KERNELS`` of the module lists every function it must compile (the
@@ -22,10 +27,14 @@ five and their helpers). The shared machinery they step with is ``integration``.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+import sys
+import types
+from dataclasses import dataclass, field
 from typing import Callable, Mapping
 
-from .bushing_params import ParameterError, ParameterSpec, number_errors, range_errors
+from . import integration
+from .bushing_params import (Constraint, ParameterError, ParameterSpec, constraint_messages, number_errors,
+                             range_errors)
 
 PLAUSIBLE_TRAVEL_MM = 100.0
 PLAUSIBLE_VELOCITY_MM_S = 1000.0
@@ -45,10 +54,6 @@ class StateSpec:
     meaning: str
 
 
-def _no_further_check(p: Mapping[str, float]) -> tuple[list[str], list[str]]:
-    return [], []
-
-
 @dataclass(frozen=True)
 class BushingModel:
     name: str                    # command-line name: proposed, spencer, bouc_wen, kelvin_voigt
@@ -62,10 +67,19 @@ class BushingModel:
     jump: Callable
     integrate: Callable
     force: Callable
-    further_checks: Callable[[Mapping[str, float]], tuple[list[str], list[str]]] = _no_further_check
-    """(errors, warnings) beyond each value's range, for a complete set of finite floats."""
-    force_offset: Callable[[Mapping[str, float]], float] = lambda p: 0.0
-    """The part of the force [N] that is constant (a preload): counted in the plausible bound."""
+    derivatives: Callable
+    switches: Callable
+    constraints: tuple[Constraint, ...] = ()
+    """Conditions on several parameters beyond each value's range (errors or warnings)."""
+    step: Callable = field(init=False, repr=False, compare=False)
+    """step(constants, state, state_x, x, v, h, max_substeps) -> (state, substeps, status): the
+    step protocol of ``integration.step`` bound to this model's ``jump`` and ``integrate``."""
+
+    def __post_init__(self):
+        # integration.step's code with the globals of the module that defines the kernels in use
+        # (a model module, or a compiled copy of it): one definition of the protocol for all
+        namespace = sys.modules[self.kernel_module].__dict__
+        object.__setattr__(self, "step", types.FunctionType(integration.step.__code__, namespace, "step"))
 
     @property
     def parameter_names(self) -> tuple[str, ...]:
@@ -88,7 +102,7 @@ class BushingModel:
         if errors:
             return errors, []
         values = {name: float(params[name]) for name in self.parameter_names}
-        errors, warnings = self.further_checks(values)
+        errors, warnings = constraint_messages(values, self.constraints)
         return range_errors(values, self.specs) + errors, warnings
 
     def check(self, params: Mapping[str, float]) -> dict[str, float]:
@@ -111,6 +125,12 @@ class BushingModel:
         """``prepare`` of a parameter mapping."""
         return self.prepare(self.values(params))
 
+    def force_offset(self, params: Mapping[str, float]) -> float:
+        """The constant part of the force [N] (a preload, Spencer's spring offset): the force at
+        rest at x = 0 from the relaxed initial state there."""
+        constants = self.constants(params)
+        return self.force(constants, self.initial_state(constants, 0.0), 0.0, 0.0)
+
     def plausible_force_bound(self, params: Mapping[str, float], travel: float = PLAUSIBLE_TRAVEL_MM,
                               velocity: float = PLAUSIBLE_VELOCITY_MM_S) -> float:
         """A force [N] no bushing with these parameters should reach in service: every spring
@@ -118,8 +138,13 @@ class BushingModel:
         at ``travel`` [mm] and ``velocity`` [mm/s], plus the constant force. Above it the inputs
         are most likely in the wrong units (millimetres in the metre port). On a rotational
         axis (``axes``): rad, rad/s and N.mm."""
-        def weight(name):   # a Bouc-Wen gain A<i> counts with its alpha<i>
-            return abs(params.get("alpha" + name[1:], 1.0)) if name.startswith("A") else 1.0
-        stiffness = sum(abs(params[s.name]) * weight(s.name) for s in self.specs if s.unit in STIFFNESS_UNITS)
+        stiffness = sum(abs(params[s.name]) * abs(params.get(self.gain_weight(s.name), 1.0))
+                        for s in self.specs if s.unit in STIFFNESS_UNITS)
         damping = sum(abs(params[s.name]) for s in self.specs if s.unit in DAMPING_UNITS)
         return stiffness * travel + damping * velocity + abs(self.force_offset(params))
+
+    @staticmethod
+    def gain_weight(name: str) -> str:
+        """The parameter a stiffness counts with in the plausible bound: a Bouc-Wen gain A<i>
+        with its alpha<i> (a name no model has, so weight 1, for the others)."""
+        return "alpha" + name[1:] if name.startswith("A") else ""

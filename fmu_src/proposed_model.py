@@ -25,11 +25,10 @@ w by integrating dw/dt = v - u2.
 from __future__ import annotations
 
 import math
-from typing import Mapping
 
-from .bushing_params import DAMPING, EXPONENT, GAIN, SPRING, WEIGHT, ParameterSpec
+from .bushing_params import DAMPING, EXPONENT, GAIN, SPRING, WEIGHT, Constraint, ParameterSpec
 from .integration import (DEFAULT_MAX_SUBSTEPS, HEUN_JUMP_LIMIT, NOT_FINITE, OK, THETA_JUMP, TOO_MANY_SUBSTEPS,
-                          block_step, hysteretic_gain, substeps_needed, walk_along_xi)
+                          block_gain, block_step, substeps_needed, walk_along_xi)
 from .model_definition import BushingModel, StateSpec
 
 IDENTIFIER = "BoucWenBushing"
@@ -56,45 +55,20 @@ PARAMETER_SPECS: tuple[ParameterSpec, ...] = (
 PARAMETER_NAMES: tuple[str, ...] = tuple(spec.name for spec in PARAMETER_SPECS)
 PARAMETER_UNITS: dict[str, str] = {spec.name: spec.unit for spec in PARAMETER_SPECS}
 
-KERNELS = ("prepare", "initial_state", "jump", "integrate", "force")
+KERNELS = ("prepare", "initial_state", "jump", "integrate", "force", "derivatives", "switches")
 
 
-def constraint_checks(p: Mapping[str, float]) -> tuple[list[str], list[str]]:
-    """(errors, warnings) beyond each value's range, for a complete set of finite floats.
-
-    Error: c0 + c2 = 0 (it divides eq. 4). Warnings: the paper's identification constraints
-    (A >= 1, beta >= 0, beta1 + gamma1 > 0, beta2 - gamma2 > 0), which the equations do not
-    need but a fitted bushing should satisfy.
-    """
-    errors: list[str] = []
-    warnings: list[str] = []
-    if not p["c0"] + p["c2"] > 0:
-        errors.append(f"c0 + c2 = {p['c0'] + p['c2']} N.s/mm must be > 0 (it divides eq. 4)")
-    for name in ("A1", "A2"):
-        if p[name] < 1:
-            warnings.append(f"{name} = {p[name]} N/mm violates the paper's constraint {name} >= 1")
-    for name in ("beta1", "beta2"):
-        if p[name] < 0:
-            warnings.append(f"{name} = {p[name]} violates the paper's constraint {name} >= 0")
-    if not p["beta1"] + p["gamma1"] > 0:
-        warnings.append(f"beta1 + gamma1 = {p['beta1'] + p['gamma1']} violates the paper's constraint "
-                        "beta1 + gamma1 > 0")
-    if not p["beta2"] - p["gamma2"] > 0:
-        warnings.append(f"beta2 - gamma2 = {p['beta2'] - p['gamma2']} violates the paper's constraint "
-                        "beta2 - gamma2 > 0")
-    return errors, warnings
-
-
-def rhs(t: float, state, x0: float, v: float, p: Mapping[str, float]) -> list[float]:
-    """Eqs. 1-4 for the input x = x0 + v*t: [dy/dt, dz1/dt, dw/dt, dz2/dt], for scipy's
-    ``solve_ivp`` in references; the kernels below solve the same equations in block form."""
-    y, z1, w, z2 = state
-    x = x0 + v * t
-    dy = (p["c1"] * v + p["k1"] * (x - y) - p["k0"] * y + p["alpha1"] * z1) / p["c1"]
-    dw = (p["c2"] * v + p["k2"] * (x - w) + p["alpha2"] * z2) / (p["c0"] + p["c2"])
-    dz1 = (v - dy) * hysteretic_gain(z1, v - dy, p["A1"], p["beta1"], p["gamma1"], p["n1"])
-    dz2 = (v - dw) * hysteretic_gain(z2, v - dw, p["A2"], p["beta2"], p["gamma2"], p["n2"])
-    return [dy, dz1, dw, dz2]
+CONSTRAINTS = (
+    Constraint((("c0", 1.0), ("c2", 1.0)), 0.0, True, True, "N.s/mm", "it divides eq. 4"),
+    # the paper's identification constraints, which the equations do not need but a fitted
+    # bushing should satisfy
+    Constraint((("A1", 1.0),), 1.0, False, False, "N/mm", "the paper's constraint"),
+    Constraint((("A2", 1.0),), 1.0, False, False, "N/mm", "the paper's constraint"),
+    Constraint((("beta1", 1.0),), 0.0, False, False, "", "the paper's constraint"),
+    Constraint((("beta2", 1.0),), 0.0, False, False, "", "the paper's constraint"),
+    Constraint((("beta1", 1.0), ("gamma1", 1.0)), 0.0, True, False, "", "the paper's constraint"),
+    Constraint((("beta2", 1.0), ("gamma2", -1.0)), 0.0, True, False, "", "the paper's constraint"),
+)
 
 
 # ---------------------------------------------------------------------------- kernels
@@ -173,6 +147,26 @@ def integrate(m, state, x, v, h, max_substeps):
     return (y, z1, w, z2), used, OK
 
 
+def derivatives(m, state, x, v):
+    """Eqs. 1-4 at displacement x [mm] and velocity v [mm/s]: the state's rates (dy/dt, dz1/dt,
+    dw/dt, dz2/dt) [mm/s, N/s], for a host that integrates the state itself (model exchange)."""
+    k0, k1, k2, c0, c1, c2, C, K1, alpha1, alpha2, blk1, blk2 = m
+    y, z1, w, z2 = state
+    dy = (c1 * v + k1 * (x - y) - k0 * y + alpha1 * z1) / c1
+    dw = (c2 * v + k2 * (x - w) + alpha2 * z2) / C
+    u1 = v - dy
+    u2 = v - dw
+    return (dy, u1 * block_gain(z1, u1, blk1), dw, u2 * block_gain(z2, u2, blk2))
+
+
+def switches(m, state, x, v):
+    """Where the right-hand side of eqs. 1-2 switches branch: the blocks' relative velocities
+    u1 = v - dy/dt, u2 = v - dw/dt [mm/s] and their hysteretic forces z1, z2 [N] changing sign
+    (event indicators for a host's integrator)."""
+    dy, dz1, dw, dz2 = derivatives(m, state, x, v)
+    return (v - dy, state[1], v - dw, state[3])
+
+
 MODEL = BushingModel(
     "proposed", IDENTIFIER, "proposed (paper eqs. 1-5)", PARAMETER_SPECS,
     (StateSpec("z1", 1, "N", "hysteretic force of the left block (eq. 1)"),
@@ -180,4 +174,5 @@ MODEL = BushingModel(
      StateSpec("y", 0, "m", "displacement of the left plate (eq. 3)"),
      StateSpec("w", 2, "m", "displacement of the right plate (eq. 4)")),
     "params_table5_combined.json", prepare, initial_state, jump, integrate, force,
-    further_checks=constraint_checks)
+    derivatives, switches,
+    constraints=CONSTRAINTS)

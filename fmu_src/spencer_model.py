@@ -17,11 +17,10 @@ y follows dy/dt = v - u.
 from __future__ import annotations
 
 import math
-from typing import Mapping
 
-from .bushing_params import DAMPING, EXPONENT, GAIN, SPRING, WEIGHT, ParameterSpec
+from .bushing_params import DAMPING, EXPONENT, GAIN, SPRING, WEIGHT, Constraint, ParameterSpec
 from .integration import (DEFAULT_MAX_SUBSTEPS, HEUN_JUMP_LIMIT, NOT_FINITE, OK, THETA_JUMP, TOO_MANY_SUBSTEPS,
-                          block_step, substeps_needed, walk_along_xi)
+                          block_gain, block_step, substeps_needed, walk_along_xi)
 from .model_definition import BushingModel, StateSpec
 
 PARAMETER_SPECS = (
@@ -38,16 +37,13 @@ PARAMETER_SPECS = (
     ParameterSpec("gamma", "N^(1-n)/mm", "Spencer's gamma: on |u|*z*|z|^(n-1) (the paper's beta)"),
     ParameterSpec("n", "1", "Bouc-Wen exponent", **EXPONENT),
 )
-KERNELS = ("prepare", "initial_state", "jump", "integrate", "force")
+KERNELS = ("prepare", "initial_state", "jump", "integrate", "force", "derivatives", "switches")
 
 
-def single_block_checks(p: Mapping[str, float]) -> tuple[list[str], list[str]]:
-    """Beyond each value's range (shared with the single Bouc-Wen, whose element's shape
-    parameters are also named beta, gamma): beta + gamma > 0 for a bounded loop."""
-    warnings = []
-    if not p["beta"] + p["gamma"] > 0:
-        warnings.append(f"beta + gamma = {p['beta'] + p['gamma']} should be > 0 (bounded hysteresis)")
-    return [], warnings
+SINGLE_BLOCK_CONSTRAINTS = (
+    # beta and gamma as the single Bouc-Wen element names them too
+    Constraint((("beta", 1.0), ("gamma", 1.0)), 0.0, True, False, "", "the bounded hysteresis loop's condition"),
+)
 
 
 # ---------------------------------------------------------------------------- kernels
@@ -107,9 +103,25 @@ def integrate(m, state, x, v, h, max_substeps):
     return (y, z), used, OK
 
 
+def derivatives(m, state, x, v):
+    """(dy/dt, dz/dt) [mm/s, N/s] at displacement x [mm] and velocity v [mm/s] (model exchange)."""
+    c0, k0, c1, k1, x0, alpha, C, blk = m
+    y, z = state
+    u = (c1 * v - k0 * (x - y) - alpha * z) / C
+    return (v - u, u * block_gain(z, u, blk))
+
+
+def switches(m, state, x, v):
+    """The element's relative velocity u [mm/s] and z [N]: where the right-hand side switches."""
+    c0, k0, c1, k1, x0, alpha, C, blk = m
+    y, z = state
+    return ((c1 * v - k0 * (x - y) - alpha * z) / C, z)
+
+
 MODEL = BushingModel(
     "spencer", "SpencerBushing", "Spencer (1997)", PARAMETER_SPECS,
     (StateSpec("z", 1, "N", "hysteretic force"),
      StateSpec("y", 0, "m", "internal displacement (between the Bouc-Wen element and c1)")),
     "params_spencer_fit_synthetic_table5.json", prepare, initial_state, jump, integrate, force,
-    further_checks=single_block_checks, force_offset=lambda p: -p["k1"] * p["x0"])
+    derivatives, switches,
+    constraints=SINGLE_BLOCK_CONSTRAINTS)

@@ -35,8 +35,9 @@ def _population_forces(matrix, t, x, v, out_index, out_velocity, max_substeps):
     direct feedthrough of the velocity set at that instant).
 
     Written here, never called here: its source is compiled in each model's generated module
-    (see :func:`_population_appendix`), where ``prepare`` ... ``force`` are that model's compiled
-    kernels and ``_VALUES(row)`` the row's values as the tuple ``prepare`` takes."""
+    (see :func:`_population_appendix`), where ``prepare``, ``step`` (``integration.step``) and
+    ``force`` are that model's compiled kernels and ``_VALUES(row)`` the row's values as the
+    tuple ``prepare`` takes."""
     count, samples, outputs = matrix.shape[0], t.size, out_index.size
     forces = np.full((count, outputs), np.nan)
     for i in numba.prange(count):
@@ -52,11 +53,7 @@ def _population_forces(matrix, t, x, v, out_index, out_velocity, max_substeps):
             if j == outputs:
                 break
             h = t[k + 1] - t[k]
-            status = _OK
-            if x[k] != state_x:
-                state, status = jump(m, state, x[k] - state_x)
-            if status == _OK:
-                state, used, status = integrate(m, state, x[k], v[k], h, max_substeps)
+            state, used, status = step(m, state, state_x, x[k], v[k], h, max_substeps)
             if status != _OK:
                 break  # this candidate failed: NaN from here on
             state_x = x[k] + v[k] * h

@@ -149,7 +149,6 @@ class DaskEngine(SerialEngine):
         self.description = f"Dask cluster {self._client.scheduler.address} ({self.workers} workers)"
 
     def map(self, function, items, shared=None, progress=None, each=None, chunk_size=None):
-        from dask.distributed import as_completed
         shared_future = self._client.scatter(shared, broadcast=True, hash=False)
         chunks = _chunks(items, -(-len(items) // chunk_size) if chunk_size else self.workers * CHUNKS_PER_WORKER)
         starts = np.cumsum([0] + [len(c) for c in chunks])

@@ -1,8 +1,9 @@
 """The sine steady-state loop of the dynamic-stiffness characterisation, compiled per model.
 
 :func:`_sine_steady_state` is written here and never called here: like the population loop of
-``compiled_core``, its source is appended to each model's generated module, where ``prepare``
-... ``force`` are that model's compiled kernels and ``_VALUES(row)`` a parameter row's values.
+``compiled_core``, its source is appended to each model's generated module, where ``prepare``,
+``step`` (``fmu_src.integration.step``) and ``force`` are that model's compiled kernels and
+``_VALUES(row)`` a parameter row's values.
 
 Per item (a parameter set and one sine x = P + X*sin(2*pi*f*t)): the bushing starts in relaxed
 equilibrium at the preload P and is driven cycle after cycle, ``steps`` communication steps per
@@ -56,12 +57,7 @@ def _sine_steady_state(matrix, rows, amplitude, frequency, preload, steps, min_c
                 a += f_k * math.cos(phase)
                 b += f_k * math.sin(phase)
                 x_next = P + X * math.sin(2.0 * math.pi * ((k + 1) % steps) / steps)
-                if x_k != state_x:
-                    state, code = jump(m, state, x_k - state_x)
-                    if code != _OK:
-                        failed = True
-                        break
-                state, used, code = integrate(m, state, x_k, (x_next - x_k) / h, h, max_substeps)
+                state, used, code = step(m, state, state_x, x_k, (x_next - x_k) / h, h, max_substeps)
                 if code != _OK:
                     failed = True
                     break

@@ -46,37 +46,44 @@ def radau_forces(rhs, output, state, t, x, v):
     return np.array(forces)
 
 
+def spencer_y_dot(p, state, x_now, v_now):
+    y, z = state
+    return (p["alpha"] * z + p["c0"] * v_now + p["k0"] * (x_now - y)) / (p["c0"] + p["c1"])
+
+
+def spencer_rhs(p, state, x_now, v_now):
+    """Spencer et al. (1997): dy/dt = [alpha*z + c0*dx/dt + k0*(x - y)]/(c0 + c1),
+    dz/dt = -gamma*|u|*z*|z|^(n-1) - beta*u*|z|^n + A*u, u = dx/dt - dy/dt."""
+    y, z = state
+    dy = spencer_y_dot(p, state, x_now, v_now)
+    u = v_now - dy
+    dz = -p["gamma"] * abs(u) * signed_power(z, p["n"]) - p["beta"] * u * abs(z) ** p["n"] + p["A"] * u
+    return [dy, dz]
+
+
+def bouc_wen_rhs(p, state, x_now, v_now):
+    """Single Bouc-Wen: dz/dt = A*u - beta*|u|*z*|z|^(n-1) - gamma*u*|z|^n with u = dx/dt (the
+    paper's eq. 1 convention)."""
+    z = state[0]
+    return [p["A"] * v_now - p["beta"] * abs(v_now) * signed_power(z, p["n"]) - p["gamma"] * v_now * abs(z) ** p["n"]]
+
+
 def spencer_reference(p, t, x, v):
-    """Spencer et al. (1997): F = c1*dy/dt + k1*(x - x0), dy/dt = [alpha*z + c0*dx/dt +
-    k0*(x - y)]/(c0 + c1), dz/dt = -gamma*|u|*z*|z|^(n-1) - beta*u*|z|^n + A*u, u = dx/dt - dy/dt."""
-    def y_dot(state, x_now, v_now):
-        y, z = state
-        return (p["alpha"] * z + p["c0"] * v_now + p["k0"] * (x_now - y)) / (p["c0"] + p["c1"])
-
-    def rhs(time, state, x_start, v_now):
-        y, z = state
-        dy = y_dot(state, x_start + v_now * time, v_now)
-        u = v_now - dy
-        dz = -p["gamma"] * abs(u) * signed_power(z, p["n"]) - p["beta"] * u * abs(z) ** p["n"] + p["A"] * u
-        return [dy, dz]
-
+    """Spencer's equations (:func:`spencer_rhs`), F = c1*dy/dt + k1*(x - x0)."""
     def output(state, x_now, v_now):
-        return p["c1"] * y_dot(state, x_now, v_now) + p["k1"] * (x_now - p["x0"])
+        return p["c1"] * spencer_y_dot(p, state, x_now, v_now) + p["k1"] * (x_now - p["x0"])
 
-    return radau_forces(rhs, output, np.array([x[0], 0.0]), t, x, v)
+    return radau_forces(lambda time, state, x_start, v_now: spencer_rhs(p, state, x_start + v_now * time, v_now),
+                        output, np.array([x[0], 0.0]), t, x, v)
 
 
 def bouc_wen_reference(p, t, x, v):
-    """Single Bouc-Wen: F = c0*dx/dt + k0*x + alpha*z, dz/dt = A*u - beta*|u|*z*|z|^(n-1) -
-    gamma*u*|z|^n with u = dx/dt (the paper's eq. 1 convention)."""
-    def rhs(time, state, x_start, v_now):
-        z = state[0]
-        return [p["A"] * v_now - p["beta"] * abs(v_now) * signed_power(z, p["n"]) - p["gamma"] * v_now * abs(z) ** p["n"]]
-
+    """The single Bouc-Wen element (:func:`bouc_wen_rhs`), F = c0*dx/dt + k0*x + alpha*z."""
     def output(state, x_now, v_now):
         return p["c0"] * v_now + p["k0"] * x_now + p["alpha"] * state[0]
 
-    return radau_forces(rhs, output, np.array([0.0]), t, x, v)
+    return radau_forces(lambda time, state, x_start, v_now: bouc_wen_rhs(p, state, x_start + v_now * time, v_now),
+                        output, np.array([0.0]), t, x, v)
 
 
 @pytest.mark.parametrize("protocol, duration", [(Sine(2.0, 10.0), 0.3), (Step(2.0, 0.1, 0.4), 0.4)])

@@ -1,7 +1,6 @@
 """The fit says how sure it is: convergence evidence, the never-silent warning, the ensemble's
 band, the design of the next test, the same bits on every engine, the fleet."""
 import json
-import warnings
 
 import numpy as np
 import pytest

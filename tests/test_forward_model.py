@@ -4,7 +4,6 @@ import pytest
 
 from conftest import paper_force, paper_parameters
 from fmu_src.bushing_models import MODELS
-from fmu_src.parameter_files import ParameterSet
 from identification.compiled_core import simulate_model_held
 from identification.forward_model import prepare_input
 from identification.protocols import Random, Sine, Step, sample_times

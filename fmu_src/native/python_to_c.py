@@ -1,0 +1,603 @@
+"""Translate the models' kernels, restricted Python, into C99: one definition, a third way to run it.
+
+The kernels (``model_definition``: ``prepare``, ``initial_state``, ``step``, ``force`` ... and
+the shared machinery of ``integration``) are plain float arithmetic on scalars and tuples, which
+numba compiles. This module translates the same source into C, function by function, for the
+native FMU (``fmu_src/native``):
+
+- types are inferred from the arguments a function is called with (as numba does): ``double``,
+  ``int`` (counts and status codes; Python's bools too) and tuples of them, which become C structs
+  (``typedef struct {...} bw_tuple_<k>``) returned and passed by value. A function called with
+  other argument types is translated once more under another name.
+- the statements the kernels use: assignment (also unpacking a tuple), augmented assignment,
+  ``if``/``elif``/``else``, ``while``, ``for _ in range(...)`` with ``else``, ``break``,
+  ``return``; expressions with ``+ - * / **``, comparisons (chained too), ``and or not``,
+  conditional expressions, constant tuple indices, calls of other kernels and of ``abs``,
+  ``min``, ``max``, ``int``, ``float``, ``math.exp``/``log``/``sqrt``/``sin``/``cos``/``ceil``/
+  ``isfinite`` and the constants ``math.inf``, ``math.pi``.
+- Python's semantics where C's differ: ``/`` of two ints is a float division; ``int(x)`` of a
+  NaN or of a value beyond C's int gives the largest int (Python would raise: the kernels'
+  callers then refuse the step, as they do for too many substeps); ``min``/``max`` return the
+  first of equal arguments.
+
+Anything else is a ``TranslationError`` naming the function and the line: a kernel that the C
+cannot follow must fail the build, not run differently. The C is compiled without contraction
+of multiplications and additions (``-ffp-contract=off``), so on the same processor it gives the
+same floats as the Python and numba kernels (``tests/test_native_fmu.py`` checks 1e-12, and
+bitwise where it can).
+"""
+from __future__ import annotations
+
+import ast
+import builtins
+import inspect
+import math
+import textwrap
+import types
+from dataclasses import dataclass, field
+from typing import Callable, Union
+
+DOUBLE, INT = "double", "int"
+Type = Union[str, tuple]
+"""A kernel value's type: DOUBLE, INT, or a tuple of types."""
+
+MATH_FUNCTIONS = {"exp": "exp", "log": "log", "sqrt": "sqrt", "sin": "sin", "cos": "cos"}
+MATH_CONSTANTS = {"inf": "HUGE_VAL", "pi": "3.141592653589793"}
+C_RESERVED = frozenset("""auto break case char const continue default do double else enum extern float for goto if
+inline int long register restrict return short signed sizeof static struct switch typedef union unsigned void volatile
+while abs fabs pow exp log sqrt sin cos ceil floor isfinite bw_int main errno""".split())
+
+PRELUDE = """\
+#include <limits.h>
+#include <math.h>
+#include <stdlib.h>
+
+/* Python's int(x) of a float: truncation; a NaN or a value beyond int gives INT_MAX (Python
+   raises there, and the kernels' callers refuse the step on too many substeps). */
+static int bw_int(double x) {
+    if (!(x > (double)INT_MIN - 1.0 && x < (double)INT_MAX + 1.0)) return INT_MAX;
+    return (int)x;
+}
+/* Python's min and max of two values: the first of equal ones. */
+static double bw_min_d(double a, double b) { return b < a ? b : a; }
+static double bw_max_d(double a, double b) { return b > a ? b : a; }
+static int bw_min_i(int a, int b) { return b < a ? b : a; }
+static int bw_max_i(int a, int b) { return b > a ? b : a; }
+"""
+
+
+class TranslationError(ValueError):
+    """A kernel the C translation cannot follow (the message names the function and line)."""
+
+
+def merge(a: Type, b: Type) -> Type:
+    """The type that holds values of both: int and double give double; tuples merge by element."""
+    if a == b:
+        return a
+    if isinstance(a, tuple) and isinstance(b, tuple) and len(a) == len(b):
+        return tuple(merge(x, y) for x, y in zip(a, b))
+    if {a, b} == {DOUBLE, INT}:
+        return DOUBLE
+    raise TypeError(f"{describe(a)} and {describe(b)} cannot be merged")
+
+
+def describe(t: Type) -> str:
+    return f"({', '.join(describe(e) for e in t)}{',' if len(t) == 1 else ''})" if isinstance(t, tuple) else t
+
+
+@dataclass
+class Translation:
+    """The C of a set of kernels: struct typedefs, constants, prototypes and definitions."""
+    prefix: str = "bw"
+    structs: dict = field(default_factory=dict)          # type -> C name, in order of creation
+    constants: dict = field(default_factory=dict)        # (module, name) -> (C name, C literal, type)
+    functions: dict = field(default_factory=dict)        # (function, argument types) -> _Function
+    order: list = field(default_factory=list)            # _Functions in the order they were finished
+
+    def c_type(self, t: Type) -> str:
+        if not isinstance(t, tuple):
+            return t
+        if t not in self.structs:
+            for element in t:
+                self.c_type(element)
+            self.structs[t] = f"{self.prefix}_tuple_{len(self.structs)}"
+        return self.structs[t]
+
+    def function(self, function: Callable, argument_types: tuple) -> "_Function":
+        """The translation of ``function`` for ``argument_types`` (made on first request)."""
+        function = getattr(function, "py_func", function)   # a numba dispatcher: its Python source
+        key = (function, argument_types)
+        if key not in self.functions:
+            same_name = sum(f.python is function for f in self.functions.values())
+            name = f"{self.prefix}_{function.__module__.rsplit('.', 1)[-1]}_{function.__name__}".replace("__", "_")
+            translated = _Function(self, function, argument_types, name + (f"_{same_name}" if same_name else ""))
+            self.functions[key] = translated
+            translated.translate()
+            self.order.append(translated)
+        return self.functions[key]
+
+    def source(self) -> str:
+        """The C: typedefs, constants, prototypes, definitions (all ``static``)."""
+        lines = [PRELUDE]
+        for t, name in self.structs.items():
+            fields = " ".join(f"{self.c_type(e)} f{i};" for i, e in enumerate(t)) or "int unused;"
+            lines.append(f"typedef struct {{ {fields} }} {name};   /* {describe(t)} */")
+        lines.append("")
+        for c_name, literal, t in self.constants.values():
+            lines.append(f"static const {t} {c_name} = {literal};")
+        lines.append("")
+        for f in self.order:
+            lines.append(f.prototype() + ";")
+        lines.append("")
+        for f in self.order:
+            lines.append(f.definition())
+        return "\n".join(lines)
+
+
+class _Function:
+    """One function of the kernels translated for one tuple of argument types."""
+
+    def __init__(self, translation: Translation, python: types.FunctionType, argument_types: tuple, name: str):
+        self.translation = translation
+        self.python = python
+        self.argument_types = argument_types
+        self.name = name
+        source = textwrap.dedent(inspect.getsource(python))
+        self.tree = ast.parse(source).body[0]
+        self.line_offset = python.__code__.co_firstlineno - 1
+        self.arguments = [a.arg for a in self.tree.args.args]
+        if len(self.arguments) != len(argument_types) or self.tree.args.vararg or self.tree.args.kwarg:
+            raise self.error(self.tree, f"called with {len(argument_types)} arguments")
+        self.locals: dict[str, Type] = dict(zip(self.arguments, argument_types))
+        # C warns of variables set but never read: names never read are neither declared nor set
+        self.read = {n.id for n in ast.walk(self.tree) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)}
+        self.loop_names = {n.target.id for n in ast.walk(self.tree) if isinstance(n, ast.For)}
+        self.return_type: Type | None = None
+        self.temporaries = 0
+        self.loops: list = []
+
+    # ------------------------------------------------------------------ errors
+    def error(self, node, message: str) -> TranslationError:
+        line = getattr(node, "lineno", 1) + self.line_offset
+        return TranslationError(f"{self.python.__module__}.{self.python.__name__}, line {line}: {message}")
+
+    # ------------------------------------------------------------------ types
+    def translate(self):
+        """Infer the locals' and the return type (the statements until nothing changes), then
+        write the C."""
+        for _ in range(20):
+            before = (dict(self.locals), self.return_type)
+            self.infer_block(self.body)
+            if (dict(self.locals), self.return_type) == before:
+                break
+        else:
+            raise self.error(self.tree, "the types of its variables do not settle")
+        if self.return_type is None:
+            raise self.error(self.tree, "returns nothing")
+        self.translation.c_type(self.return_type)
+        self.code = self.emit_block(self.body, 1)
+
+    @property
+    def body(self):
+        body = self.tree.body
+        if body and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant):
+            body = body[1:]     # the docstring
+        return body
+
+    def assign_type(self, target, t: Type, node):
+        if isinstance(target, ast.Name):
+            if target.id in self.locals:
+                try:
+                    t = merge(self.locals[target.id], t)
+                except TypeError as exc:
+                    raise self.error(node, f"{target.id}: {exc}") from None
+            self.locals[target.id] = t
+        elif isinstance(target, ast.Tuple):
+            if not isinstance(t, tuple) or len(t) != len(target.elts):
+                raise self.error(node, f"cannot unpack {describe(t)} into {len(target.elts)} names")
+            for element, element_type in zip(target.elts, t):
+                self.assign_type(element, element_type, node)
+        else:
+            raise self.error(node, f"cannot assign to {ast.dump(target)}")
+
+    def infer_block(self, statements):
+        for s in statements:
+            self.infer_statement(s)
+
+    def infer_statement(self, s):
+        if isinstance(s, ast.Assign):
+            if len(s.targets) != 1:
+                raise self.error(s, "chained assignment")
+            self.assign_type(s.targets[0], self.type_of(s.value), s)
+        elif isinstance(s, ast.AugAssign):
+            target = ast.Name(s.target.id, ast.Load()) if isinstance(s.target, ast.Name) else None
+            if target is None:
+                raise self.error(s, "augmented assignment to something other than a name")
+            self.assign_type(s.target, self.type_of(ast.BinOp(target, s.op, s.value)), s)
+        elif isinstance(s, ast.Return):
+            if s.value is None:
+                raise self.error(s, "a bare return")
+            t = self.type_of(s.value)
+            try:
+                self.return_type = t if self.return_type is None else merge(self.return_type, t)
+            except TypeError as exc:
+                raise self.error(s, f"returns {exc}") from None
+        elif isinstance(s, ast.If):
+            self.type_of(s.test)
+            self.infer_block(s.body)
+            self.infer_block(s.orelse)
+        elif isinstance(s, ast.While):
+            self.type_of(s.test)
+            self.infer_block(s.body)
+            self.infer_block(s.orelse)
+        elif isinstance(s, ast.For):
+            self.range_arguments(s)
+            self.assign_type(s.target, INT, s)
+            self.infer_block(s.body)
+            self.infer_block(s.orelse)
+        elif isinstance(s, (ast.Break, ast.Continue, ast.Pass)):
+            pass
+        elif isinstance(s, ast.Expr) and isinstance(s.value, ast.Constant):
+            pass    # a string as a comment
+        else:
+            raise self.error(s, f"statement {type(s).__name__} is not supported")
+
+    def range_arguments(self, s: ast.For):
+        call = s.iter
+        if not (isinstance(call, ast.Call) and isinstance(call.func, ast.Name) and call.func.id == "range"
+                and 1 <= len(call.args) <= 2 and not call.keywords and isinstance(s.target, ast.Name)):
+            raise self.error(s, "only `for name in range(stop)` or `range(start, stop)` loops")
+        for argument in call.args:
+            if self.type_of(argument) != INT:
+                raise self.error(s, "range() takes ints")
+        return call.args if len(call.args) == 2 else [ast.Constant(0), call.args[0]]
+
+    def global_value(self, name: str, node):
+        namespace = self.python.__globals__
+        if name in namespace:
+            return namespace[name]
+        if hasattr(builtins, name):
+            return getattr(builtins, name)
+        raise self.error(node, f"unknown name {name!r}")
+
+    def type_of(self, e) -> Type:
+        if isinstance(e, ast.Constant):
+            if isinstance(e.value, bool):
+                return INT
+            if isinstance(e.value, int):
+                return INT
+            if isinstance(e.value, float):
+                return DOUBLE
+            raise self.error(e, f"constant {e.value!r}")
+        if isinstance(e, ast.Name):
+            if e.id in self.locals:
+                return self.locals[e.id]
+            value = self.global_value(e.id, e)
+            return self.constant_type(value, e)
+        if isinstance(e, ast.Attribute):
+            if isinstance(e.value, ast.Name) and e.value.id == "math" and e.attr in MATH_CONSTANTS:
+                return DOUBLE
+            raise self.error(e, f"attribute {ast.unparse(e)}")
+        if isinstance(e, ast.Tuple):
+            return tuple(self.type_of(element) for element in e.elts)
+        if isinstance(e, ast.Subscript):
+            t = self.type_of(e.value)
+            index = self.constant_index(e, t)
+            return t[index]
+        if isinstance(e, ast.UnaryOp):
+            t = self.type_of(e.operand)
+            if isinstance(e.op, ast.Not):
+                return INT
+            if isinstance(e.op, (ast.USub, ast.UAdd)) and not isinstance(t, tuple):
+                return t
+            raise self.error(e, f"unary {type(e.op).__name__} of {describe(t)}")
+        if isinstance(e, ast.BinOp):
+            left, right = self.type_of(e.left), self.type_of(e.right)
+            if isinstance(left, tuple) or isinstance(right, tuple):
+                raise self.error(e, "arithmetic on tuples")
+            if isinstance(e.op, (ast.Div, ast.Pow)):
+                if isinstance(e.op, ast.Pow) and left == right == INT:
+                    raise self.error(e, "int ** int")
+                return DOUBLE
+            if isinstance(e.op, (ast.Add, ast.Sub, ast.Mult)):
+                return INT if left == right == INT else DOUBLE
+            raise self.error(e, f"operator {type(e.op).__name__}")
+        if isinstance(e, ast.BoolOp):
+            for value in e.values:
+                if isinstance(self.type_of(value), tuple):
+                    raise self.error(e, "and/or of tuples")
+            return INT
+        if isinstance(e, ast.Compare):
+            for operand in (e.left, *e.comparators):
+                if isinstance(self.type_of(operand), tuple):
+                    raise self.error(e, "comparison of tuples")
+            for op in e.ops:
+                if not isinstance(op, (ast.Lt, ast.LtE, ast.Gt, ast.GtE, ast.Eq, ast.NotEq)):
+                    raise self.error(e, f"comparison {type(op).__name__}")
+            return INT
+        if isinstance(e, ast.IfExp):
+            self.type_of(e.test)
+            try:
+                return merge(self.type_of(e.body), self.type_of(e.orelse))
+            except TypeError as exc:
+                raise self.error(e, str(exc)) from None
+        if isinstance(e, ast.Call):
+            return self.call_type(e)
+        raise self.error(e, f"expression {type(e).__name__} is not supported")
+
+    def constant_index(self, e: ast.Subscript, t: Type) -> int:
+        if not isinstance(t, tuple):
+            raise self.error(e, f"indexing a {describe(t)}")
+        index = e.slice
+        if isinstance(index, ast.UnaryOp) and isinstance(index.op, ast.USub) and isinstance(index.operand, ast.Constant):
+            value = -index.operand.value
+        elif isinstance(index, ast.Constant):
+            value = index.value
+        else:
+            raise self.error(e, "only constant tuple indices")
+        if not isinstance(value, int) or not -len(t) <= value < len(t):
+            raise self.error(e, f"index {value!r} of a tuple of {len(t)}")
+        return value % len(t)
+
+    def constant_type(self, value, node) -> Type:
+        if isinstance(value, bool) or isinstance(value, int):
+            return INT
+        if isinstance(value, float):
+            return DOUBLE
+        raise self.error(node, f"global {ast.unparse(node)} is a {type(value).__name__}, not a number")
+
+    def callee(self, e: ast.Call):
+        """('builtin', name) or ('kernel', function) of a call."""
+        if e.keywords:
+            raise self.error(e, "keyword arguments")
+        f = e.func
+        if isinstance(f, ast.Attribute) and isinstance(f.value, ast.Name) and f.value.id == "math":
+            if f.attr in MATH_FUNCTIONS or f.attr in ("ceil", "isfinite"):
+                return "math", f.attr
+            raise self.error(e, f"math.{f.attr}")
+        if isinstance(f, ast.Name) and f.id not in self.locals:
+            value = self.global_value(f.id, e)
+            if value in (abs, min, max, int, float):
+                return "builtin", f.id
+            if callable(value):
+                return "kernel", value
+        raise self.error(e, f"call of {ast.unparse(f)}")
+
+    def call_type(self, e: ast.Call) -> Type:
+        kind, what = self.callee(e)
+        arguments = [self.type_of(a) for a in e.args]
+        if any(isinstance(a, tuple) for a in arguments) and kind != "kernel":
+            raise self.error(e, f"{what}() of a tuple")
+        if kind == "math":
+            if len(arguments) != 1:
+                raise self.error(e, f"math.{what} takes one argument")
+            return INT if what in ("ceil", "isfinite") else DOUBLE
+        if kind == "builtin":
+            if what in ("int", "float", "abs") and len(arguments) != 1:
+                raise self.error(e, f"{what}() takes one argument")
+            if what in ("min", "max") and len(arguments) != 2:
+                raise self.error(e, f"{what}() of two arguments only")
+            if what == "int":
+                return INT
+            if what == "float":
+                return DOUBLE
+            if what == "abs":
+                return arguments[0]
+            return INT if arguments == [INT, INT] else DOUBLE
+        return self.translation.function(what, tuple(arguments)).return_type
+
+    # ------------------------------------------------------------------ C
+    def prototype(self) -> str:
+        t = self.translation
+        parameters = ", ".join(f"{t.c_type(a)} {self.c_name(n)}" for n, a in zip(self.arguments, self.argument_types)) \
+            or "void"
+        return f"static {t.c_type(self.return_type)} {self.name}({parameters})"
+
+    def definition(self) -> str:
+        t = self.translation
+        declarations = [f"    {t.c_type(v)} {self.c_name(name)};" for name, v in self.locals.items()
+                        if name not in self.arguments and (name in self.read or name in self.loop_names)]
+        declarations += [f"    (void){self.c_name(name)};" for name in self.arguments if name not in self.read]
+        origin = f"/* {self.python.__module__}.{self.python.__name__}{self.signature_comment()} */"
+        return "\n".join([origin, self.prototype() + " {", *declarations, *self.code, "}", ""])
+
+    def signature_comment(self) -> str:
+        return "(" + ", ".join(f"{n}: {describe(a)}" for n, a in zip(self.arguments, self.argument_types)) + ")"
+
+    @staticmethod
+    def c_name(name: str) -> str:
+        """A Python name as a C identifier (a C keyword or library name gets a trailing _)."""
+        return name + "_" if name in C_RESERVED else name
+
+    def temporary(self) -> str:
+        self.temporaries += 1
+        return f"t_{self.temporaries}"
+
+    def emit_block(self, statements, depth: int) -> list[str]:
+        lines = []
+        for s in statements:
+            lines += self.emit_statement(s, depth)
+        return lines
+
+    def emit_statement(self, s, depth: int) -> list[str]:
+        pad = "    " * depth
+        if isinstance(s, ast.Assign):
+            return self.emit_assignment(s.targets[0], s.value, depth)
+        if isinstance(s, ast.AugAssign):
+            return self.emit_assignment(s.target, ast.BinOp(ast.Name(s.target.id, ast.Load()), s.op, s.value), depth)
+        if isinstance(s, ast.Return):
+            return [f"{pad}return {self.converted(s.value, self.return_type)};"]
+        if isinstance(s, ast.If):
+            lines = [f"{pad}if ({self.expression(s.test)}) {{", *self.emit_block(s.body, depth + 1)]
+            if s.orelse:
+                lines += [f"{pad}}} else {{", *self.emit_block(s.orelse, depth + 1)]
+            return lines + [f"{pad}}}"]
+        if isinstance(s, ast.While):
+            if s.orelse:
+                raise self.error(s, "while ... else")
+            self.loops.append(None)
+            body = self.emit_block(s.body, depth + 1)
+            self.loops.pop()
+            return [f"{pad}while ({self.expression(s.test)}) {{", *body, f"{pad}}}"]
+        if isinstance(s, ast.For):
+            start, stop = (self.expression(a) for a in self.range_arguments(s))
+            flag = self.temporary() if s.orelse else None      # set by a break: the else is skipped
+            end = self.temporary()                               # range() evaluates its stop once
+            self.loops.append(flag)
+            body = self.emit_block(s.body, depth + 1)
+            self.loops.pop()
+            name = self.c_name(s.target.id)
+            lines = [f"{pad}int {flag} = 0;"] if flag else []
+            lines += [f"{pad}const int {end} = {stop};",
+                      f"{pad}for ({name} = {start}; {name} < {end}; {name}++) {{", *body, f"{pad}}}"]
+            if flag:
+                lines += [f"{pad}if (!{flag}) {{", *self.emit_block(s.orelse, depth + 1), f"{pad}}}"]
+            return lines
+        if isinstance(s, ast.Break):
+            if not self.loops:
+                raise self.error(s, "break outside a loop")
+            flag = self.loops[-1]
+            return [f"{pad}{flag} = 1;", f"{pad}break;"] if flag else [f"{pad}break;"]
+        if isinstance(s, ast.Continue):
+            return [f"{pad}continue;"]
+        if isinstance(s, ast.Pass) or (isinstance(s, ast.Expr) and isinstance(s.value, ast.Constant)):
+            return []
+        raise self.error(s, f"statement {type(s).__name__}")
+
+    def emit_assignment(self, target, value, depth: int) -> list[str]:
+        pad = "    " * depth
+        if isinstance(target, ast.Name):
+            if target.id not in self.read:
+                return []        # the kernels are pure: a value never read need not be computed
+            return [f"{pad}{self.c_name(target.id)} = {self.converted(value, self.locals[target.id])};"]
+        # unpacking: evaluate the right side once, then each name from its field
+        t = self.type_of(value)
+        temporary = self.temporary()
+        lines = [f"{pad}{self.translation.c_type(t)} {temporary} = {self.expression(value)};"]
+        lines += self.unpack(target, temporary, t, pad)
+        return [f"{pad}{{", *["    " + line for line in lines], f"{pad}}}"]
+
+    def unpack(self, target, source: str, t: Type, pad: str) -> list[str]:
+        lines = []
+        for i, (element, element_type) in enumerate(zip(target.elts, t)):
+            if isinstance(element, ast.Tuple):
+                lines += self.unpack(element, f"{source}.f{i}", element_type, pad)
+            elif element.id in self.read:
+                cast = self.cast(f"{source}.f{i}", element_type, self.locals[element.id])
+                lines.append(f"{pad}{self.c_name(element.id)} = {cast};")
+        return lines
+
+    def cast(self, code: str, have: Type, want: Type) -> str:
+        if have == want:
+            return code
+        if want == DOUBLE and have == INT:
+            return f"(double)({code})"
+        raise TypeError(f"{describe(have)} where {describe(want)} is needed")
+
+    def converted(self, e, want: Type) -> str:
+        """``e`` as a value of type ``want`` (ints widened to double, tuples field by field)."""
+        have = self.type_of(e)
+        if have == want:
+            return self.expression(e)
+        if isinstance(want, tuple):
+            if not isinstance(e, ast.Tuple):
+                raise self.error(e, f"{describe(have)} where {describe(want)} is needed")
+            fields = ", ".join(self.converted(element, w) for element, w in zip(e.elts, want))
+            return f"({self.translation.c_type(want)}){{{fields}}}"
+        try:
+            return self.cast(self.expression(e), have, want)
+        except TypeError as exc:
+            raise self.error(e, str(exc)) from None
+
+    def expression(self, e) -> str:
+        if isinstance(e, ast.Constant):
+            if isinstance(e.value, bool):
+                return "1" if e.value else "0"
+            if isinstance(e.value, int):
+                return str(e.value)
+            return self.float_literal(e.value, e)
+        if isinstance(e, ast.Name):
+            if e.id in self.locals:
+                return self.c_name(e.id)
+            return self.global_constant(e)
+        if isinstance(e, ast.Attribute):
+            return MATH_CONSTANTS[e.attr]
+        if isinstance(e, ast.Tuple):
+            t = self.type_of(e)
+            fields = ", ".join(self.expression(element) for element in e.elts)
+            return f"({self.translation.c_type(t)}){{{fields}}}" if e.elts else f"({self.translation.c_type(t)}){{0}}"
+        if isinstance(e, ast.Subscript):
+            return f"{self.expression(e.value)}.f{self.constant_index(e, self.type_of(e.value))}"
+        if isinstance(e, ast.UnaryOp):
+            operand = self.expression(e.operand)
+            return f"(!{operand})" if isinstance(e.op, ast.Not) else f"({'-' if isinstance(e.op, ast.USub) else '+'}{operand})"
+        if isinstance(e, ast.BinOp):
+            left, right = self.expression(e.left), self.expression(e.right)
+            if isinstance(e.op, ast.Pow):
+                return f"pow({self.as_double(e.left, left)}, {self.as_double(e.right, right)})"
+            if isinstance(e.op, ast.Div):
+                return f"({self.as_double(e.left, left)} / {self.as_double(e.right, right)})"
+            symbol = {ast.Add: "+", ast.Sub: "-", ast.Mult: "*"}[type(e.op)]
+            return f"({left} {symbol} {right})"
+        if isinstance(e, ast.BoolOp):
+            symbol = " && " if isinstance(e.op, ast.And) else " || "
+            return "(" + symbol.join(self.expression(v) for v in e.values) + ")"
+        if isinstance(e, ast.Compare):
+            symbols = {ast.Lt: "<", ast.LtE: "<=", ast.Gt: ">", ast.GtE: ">=", ast.Eq: "==", ast.NotEq: "!="}
+            parts, left = [], e.left
+            for op, right in zip(e.ops, e.comparators):
+                parts.append(f"({self.expression(left)} {symbols[type(op)]} {self.expression(right)})")
+                left = right
+            return parts[0] if len(parts) == 1 else "(" + " && ".join(parts) + ")"
+        if isinstance(e, ast.IfExp):
+            t = self.type_of(e)
+            return f"({self.expression(e.test)} ? {self.converted(e.body, t)} : {self.converted(e.orelse, t)})"
+        if isinstance(e, ast.Call):
+            return self.call(e)
+        raise self.error(e, f"expression {type(e).__name__}")
+
+    def as_double(self, e, code: str) -> str:
+        return f"(double){code}" if self.type_of(e) == INT else code
+
+    def float_literal(self, value: float, node) -> str:
+        if math.isnan(value):
+            raise self.error(node, "a NaN constant")
+        if math.isinf(value):
+            return "HUGE_VAL" if value > 0 else "(-HUGE_VAL)"
+        text = repr(value)     # the shortest decimal that reads back as the same double
+        return text if any(c in text for c in ".en") else text + ".0"
+
+    def global_constant(self, e: ast.Name) -> str:
+        value = self.global_value(e.id, e)
+        t = self.constant_type(value, e)
+        module = self.python.__module__.rsplit(".", 1)[-1]
+        key = (module, e.id)
+        constants = self.translation.constants
+        if key not in constants:
+            literal = str(int(value)) if t == INT else self.float_literal(float(value), e)
+            constants[key] = (f"{self.translation.prefix}_{module}_{e.id}".replace("__", "_"), literal, t)
+        return constants[key][0]
+
+    def call(self, e: ast.Call) -> str:
+        kind, what = self.callee(e)
+        arguments = [self.expression(a) for a in e.args]
+        types_ = [self.type_of(a) for a in e.args]
+        if kind == "math":
+            argument = self.as_double(e.args[0], arguments[0])
+            if what == "ceil":
+                return f"bw_int(ceil({argument}))"
+            if what == "isfinite":
+                return f"(isfinite({argument}) != 0)"
+            return f"{MATH_FUNCTIONS[what]}({argument})"
+        if kind == "builtin":
+            if what == "int":
+                return arguments[0] if types_[0] == INT else f"bw_int({arguments[0]})"
+            if what == "float":
+                return f"(double)({arguments[0]})"
+            if what == "abs":
+                return f"fabs({arguments[0]})" if types_[0] == DOUBLE else f"abs({arguments[0]})"
+            suffix = "i" if types_ == [INT, INT] else "d"
+            converted = [self.as_double(a, c) if suffix == "d" else c for a, c in zip(e.args, arguments)]
+            return f"bw_{what}_{suffix}({', '.join(converted)})"
+        target = self.translation.function(what, tuple(types_))
+        return f"{target.name}({', '.join(arguments)})"
