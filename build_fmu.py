@@ -39,7 +39,7 @@ REPO = Path(__file__).resolve().parent
 LIBRARY_MODULES = ("bushing_params.py", "model_definition.py", "integration.py", "compiled_kernels.py", "axes.py",
                    "proposed_model.py",
                    "spencer_model.py", "bouc_wen_model.py", "kelvin_voigt_model.py", "bushing_models.py",
-                   "parameter_files.py")
+                   "parameter_files.py", "variables.py")
 SLAVE_MODULE = "bushing_slave.py"
 
 sys.path.insert(0, str(REPO))
@@ -53,7 +53,7 @@ from fmu_src.parameter_files import (parameter_document, read_parameter_set, rea
 PACKED_LIBRARY_INIT = '''"""Packed library of the bushing FMU (written by build_fmu.py)."""
 from pathlib import Path
 
-from . import axes, bushing_models, compiled_kernels, integration, model_definition, parameter_files
+from . import axes, bushing_models, compiled_kernels, integration, model_definition, parameter_files, variables
 
 # Compiled here, once per process, while the extracted files surely exist (a host may delete them
 # after the first instance); STEP_AXES holds the compiled batched step of each model ({} for the

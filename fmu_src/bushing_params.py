@@ -117,6 +117,9 @@ UNIT_DEFINITIONS: dict[str, dict[str, str] | None] = {
     "N.mm": {"kg": "1", "m": "2", "s": "-2", "factor": "0.001"},
     "N.mm/rad": {"kg": "1", "m": "2", "s": "-2", "rad": "-1", "factor": "0.001"},
     "N.mm.s/rad": {"kg": "1", "m": "2", "s": "-1", "rad": "-1", "factor": "0.001"},
+    # rates of the states (the native FMU's model exchange)
+    "N/s": {"kg": "1", "m": "1", "s": "-3"},
+    "N.m/s": {"kg": "1", "m": "2", "s": "-3"},
     "(N.mm)^(1-n)/rad": None,
     "(N.mm)^(1-n1)/rad": None,
     "(N.mm)^(1-n2)/rad": None,

@@ -44,7 +44,7 @@ from pythonfmu.enums import Fmi2Status
 # (fmpy's simulate_fmu does). So module-level code here must touch no files: the packed
 # library, imported once and then cached, reads the default parameters.
 if __package__:
-    from . import axes, integration
+    from . import axes, integration, variables
     AXES = None   # only an FMU built by build_fmu.py has axes, models and defaults
     STEP_AXES = {}
     STEP = None
@@ -52,6 +52,7 @@ else:
     _library = importlib.import_module(__name__ + "_lib")
     axes = _library.axes
     integration = _library.integration
+    variables = _library.variables
     AXES = _library.AXES   # [(axes.Axis, BushingModel on that axis, default parameters)]
     STEP_AXES = _library.STEP_AXES   # {model name: compiled step of all its axes}; {} for pure Python
     STEP = _library.STEP   # which step runs: compiled (numba) or pure Python, and why
@@ -131,41 +132,29 @@ class BushingSlave(Fmi2Slave):
         self._initial_state_pending = True  # set at exit of initialization, or first valid step
         self._parameters_changed = True     # some axis's parameters were set since the last check
         self._parameters_usable = False
-        for a in self._axes:
-            self._register_axis(a)
+        for variable in variables.fmu_variables(AXES):
+            self._register(variable)
         self.log(STEP, Fmi2Status.ok, "logAll")
 
-    def _register_axis(self, a):
-        axis, model = a.axis, a.model
-        for spec in model.specs:
-            self.register_variable(Real(
-                axis.prefix + spec.name, causality=Fmi2Causality.parameter, variability=Fmi2Variability.tunable,
-                description=f"{axis.label}{spec.description} [{spec.unit}]",
-                getter=self._parameter_getter(a, spec.name), setter=self._parameter_setter(a, spec.name)))
-        what = "rotation" if axis.rotational else "displacement"
-        self.register_variable(Real(
-            axis.displacement, causality=Fmi2Causality.input, variability=Fmi2Variability.continuous,
-            description=(f"relative {what} of I with respect to J about/along {axis.name[-1]} "
-                         f"[{axis.displacement_unit}]" if axis.name else
-                         "relative displacement of the bushing (upper plate minus base) [m]"),
-            getter=partial(getattr, a, "x"), setter=partial(self._set_displacement, a)))
-        self.register_variable(Real(
-            axis.velocity, causality=Fmi2Causality.input, variability=Fmi2Variability.continuous,
-            description=f"relative velocity d{axis.displacement}/dt [{axis.velocity_unit}]",
-            getter=partial(getattr, a, "v"), setter=partial(self._set_velocity, a)))
-        self.register_variable(Real(
-            axis.output, causality=Fmi2Causality.output, variability=Fmi2Variability.continuous,
-            description=(f"{'moment' if axis.rotational else 'force'} on J along/about {axis.name[-1]}, positive "
-                         f"for a positive {axis.displacement} [{axis.output_unit}]" if axis.name else
-                         "bushing force, positive for positive x (force on the base) [N]"),
-            getter=partial(self._output, a)))
-        for state in model.states:
-            unit, scale = axis.state_port(state.unit)
-            index = state.index
-            self.register_variable(Real(
-                axis.prefix + state.name, causality=Fmi2Causality.local, variability=Fmi2Variability.continuous,
-                description=f"{axis.label}internal state: {state.meaning} [{unit}]",
-                getter=lambda index=index, scale=scale: a.state[index] * scale))
+    def _register(self, variable):
+        """Register one variable of the FMU's table (``variables``), with its getter and setter."""
+        a = self._axes[variable.axis]
+        kind, name, index = variable.kind, variable.name, variable.index
+        if kind == "parameter":
+            spec_name = a.model.specs[index].name
+            getter, setter = self._parameter_getter(a, spec_name), self._parameter_setter(a, spec_name)
+        elif kind == "displacement":
+            getter, setter = partial(getattr, a, "x"), partial(self._set_displacement, a)
+        elif kind == "velocity":
+            getter, setter = partial(getattr, a, "v"), partial(self._set_velocity, a)
+        elif kind == "output":
+            getter, setter = partial(self._output, a), None
+        else:
+            scale = variable.scale
+            getter, setter = (lambda: a.state[index] * scale), None
+        self.register_variable(Real(name, causality=getattr(Fmi2Causality, variable.causality),
+                                    variability=getattr(Fmi2Variability, variable.variability),
+                                    description=variable.description, getter=getter, setter=setter))
 
     # ---------------------------------------------------------------- variable access
     @staticmethod

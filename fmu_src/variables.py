@@ -1,0 +1,74 @@
+"""The variables of a bushing FMU, declared once: the pythonfmu slave registers them and the
+native FMU's generator writes them, in the same order, so both FMUs have the same names, value
+references, causalities, units and descriptions.
+
+Per axis (``axes``), in this order: the model's parameters (spec order), the displacement and
+velocity inputs, the output, then the model's states as the model names them (``StateSpec``).
+A value reference is the variable's position in the list (pythonfmu numbers them so). The
+native FMU adds, after all of them, the derivative of each state for model exchange
+(:func:`derivative_variables`).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class FmuVariable:
+    name: str
+    value_reference: int
+    causality: str          # parameter, input, output, local
+    variability: str        # tunable, continuous
+    unit: str
+    description: str
+    axis: int               # position of the axis in the FMU's axes
+    kind: str               # parameter, displacement, velocity, output, state, derivative
+    index: int              # the parameter's position in spec order; the state's in the kernels' tuple
+    scale: float = 1.0      # port value = scale * kernel value (states and their derivatives)
+    start: float | None = None
+    state: int = -1         # derivatives: the value reference of their state
+
+
+def fmu_variables(axis_models) -> list[FmuVariable]:
+    """The variables of an FMU whose axes are ``axis_models`` [(axes.Axis, model on that axis,
+    parameters)], parameters starting at those values, the inputs at 0."""
+    out: list[FmuVariable] = []
+
+    def add(**fields):
+        out.append(FmuVariable(value_reference=len(out), **fields))
+
+    for position, (axis, model, parameters) in enumerate(axis_models):
+        for index, spec in enumerate(model.specs):
+            add(name=axis.prefix + spec.name, causality="parameter", variability="tunable", unit=spec.unit,
+                description=f"{axis.label}{spec.description} [{spec.unit}]", axis=position, kind="parameter",
+                index=index, start=float(parameters[spec.name]))
+        what = "rotation" if axis.rotational else "displacement"
+        add(name=axis.displacement, causality="input", variability="continuous", unit=axis.displacement_unit,
+            description=(f"relative {what} of I with respect to J about/along {axis.name[-1]} "
+                         f"[{axis.displacement_unit}]" if axis.name else
+                         "relative displacement of the bushing (upper plate minus base) [m]"),
+            axis=position, kind="displacement", index=0, start=0.0)
+        add(name=axis.velocity, causality="input", variability="continuous", unit=axis.velocity_unit,
+            description=f"relative velocity d{axis.displacement}/dt [{axis.velocity_unit}]", axis=position,
+            kind="velocity", index=0, start=0.0)
+        add(name=axis.output, causality="output", variability="continuous", unit=axis.output_unit,
+            description=(f"{'moment' if axis.rotational else 'force'} on J along/about {axis.name[-1]}, positive "
+                         f"for a positive {axis.displacement} [{axis.output_unit}]" if axis.name else
+                         "bushing force, positive for positive x (force on the base) [N]"),
+            axis=position, kind="output", index=0)
+        for state in model.states:
+            unit, scale = axis.state_port(state.unit)
+            add(name=axis.prefix + state.name, causality="local", variability="continuous", unit=unit,
+                description=f"{axis.label}internal state: {state.meaning} [{unit}]", axis=position, kind="state",
+                index=state.index, scale=scale)
+    return out
+
+
+def derivative_variables(variables: list[FmuVariable]) -> list[FmuVariable]:
+    """``der(<state>)`` for every state of ``variables``, numbered after them: the rates a host's
+    integrator reads in model exchange (FMI's naming of a derivative)."""
+    states = [v for v in variables if v.kind == "state"]
+    return [FmuVariable(f"der({s.name})", len(variables) + i, "local", "continuous", f"{s.unit}/s",
+                        f"rate of {s.name} [{s.unit}/s]", s.axis, "derivative", s.index, s.scale,
+                        state=s.value_reference)
+            for i, s in enumerate(states)]
