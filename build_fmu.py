@@ -1,6 +1,8 @@
-"""Build a bushing FMU: ``python build_fmu.py [--model NAME] [--params FILE] [--out DIR]``.
+"""Build a bushing FMU: ``python build_fmu.py [--model NAME] [--params FILE] [--out DIR] [--native
+[--fmi-version 2|3]]``.
 
-Writes ``DIR/<identifier>.fmu`` (FMI 2.0 co-simulation, pythonfmu) of the model NAME
+Writes ``DIR/<identifier>.fmu`` (FMI 2.0 co-simulation, pythonfmu; with ``--native``: compiled C,
+FMI 2.0 or 3.0, co-simulation and model exchange, see ``fmu_src/native``) of the model NAME
 (``proposed``, the default: ``BoucWenBushing.fmu``; ``spencer``: ``SpencerBushing``;
 ``bouc_wen``: ``SingleBoucWenBushing``; ``kelvin_voigt``: ``KelvinVoigtBushing``; ``six_axis``:
 ``SixAxisBushing``, six uncoupled axes each one of the four, see ``fmu_src/axes.py``) whose
@@ -86,28 +88,47 @@ def default_parameter_file(model: str = "proposed") -> Path:
                          "(package bushing_data); reinstall the project or give --params FILE") from None
 
 
-def build_fmu(params_file: str | Path | None = None, out_dir: str | Path = "dist",
-              model: str = "proposed") -> Path:
-    """Build the FMU of ``model`` with the parameter set in ``params_file`` as start values
-    (default: :func:`default_parameter_file`); return its path."""
-    from pythonfmu.builder import FmuBuilder
-
+def fmu_axes(params_file: str | Path | None = None, model: str = "proposed"):
+    """(identifier, title, axes [(axes.Axis, model on it, parameters)], the defaults document) of
+    the FMU of ``model`` with the parameter set in ``params_file`` (default:
+    :func:`default_parameter_file`)."""
     six = model in (SIX_AXIS, SIX_AXIS_IDENTIFIER)
     name = SIX_AXIS if six else get_model(model).name
     params_file = Path(params_file) if params_file is not None else default_parameter_file(name)
     source = {"source": f"build_fmu.py --model {name} --params {params_file.name}"}
     if six:
         six_axes = read_six_axis(params_file)
-        defaults_json = six_axis_document({axis: (one.model.identifier, one.parameters)
-                                           for axis, one in six_axes.axes.items()}, source)
-        identifier, title = SIX_AXIS_IDENTIFIER, "six-axis bushing"
-        axes = six_axes.fmu_axes()
-    else:
-        bushing = get_model(name)
-        parameters = read_parameter_set(params_file, name).parameters
-        defaults_json = parameter_document(parameters, name, source)
-        identifier, title = bushing.identifier, f"{bushing.title} model"
-        axes = [(ONE_AXIS, bushing, parameters)]
+        document = six_axis_document({axis: (one.model.identifier, one.parameters)
+                                      for axis, one in six_axes.axes.items()}, source)
+        return SIX_AXIS_IDENTIFIER, "six-axis bushing", six_axes.fmu_axes(), document
+    bushing = get_model(name)
+    parameters = read_parameter_set(params_file, name).parameters
+    return (bushing.identifier, f"{bushing.title} model", [(ONE_AXIS, bushing, parameters)],
+            parameter_document(parameters, name, source))
+
+
+def build_native_fmu(params_file: str | Path | None = None, out_dir: str | Path = "dist", model: str = "proposed",
+                     fmi_version: int = 2, platforms: tuple[str, ...] | None = None):
+    """Build the native FMU (compiled C, FMI ``fmi_version``, co-simulation and model exchange)
+    of ``model`` with the parameter set in ``params_file`` as start values; returns a
+    ``fmu_src.native.build.NativeBuild`` (its path, the platforms built and those skipped)."""
+    from fmpy.validation import validate_fmu
+    from fmu_src.native.build import build_native
+    identifier, _, axes, _ = fmu_axes(params_file, model)
+    build = build_native(axes, identifier, out_dir, fmi_version, platforms)
+    problems = validate_fmu(str(build.path))
+    if problems:
+        raise BuildError(f"{build.path} fails validation:\n  " + "\n  ".join(problems))
+    return build
+
+
+def build_fmu(params_file: str | Path | None = None, out_dir: str | Path = "dist",
+              model: str = "proposed") -> Path:
+    """Build the pythonfmu FMU of ``model`` with the parameter set in ``params_file`` as start
+    values (default: :func:`default_parameter_file`); return its path."""
+    from pythonfmu.builder import FmuBuilder
+
+    identifier, title, axes, defaults_json = fmu_axes(params_file, model)
     defaults_text = json.dumps(defaults_json, indent=2) + "\n"
     slave_text = ((SOURCE_DIR / SLAVE_MODULE).read_text()
                   + f"\n\nclass {identifier}(BushingSlave):\n"
@@ -231,10 +252,24 @@ def main(argv: list[str] | None = None) -> int:
                                          "proposed model, data/params_<model>_fit_synthetic_table5.json for the "
                                          f"others, data/{SIX_AXIS_DEFAULT_FILE} for six_axis")
     parser.add_argument("--out", default="dist", help="output directory (default: dist/ in the working directory)")
+    parser.add_argument("--native", action="store_true",
+                        help="build the native FMU: compiled C, co-simulation and model exchange, no Python in the "
+                             "host (linux64 with the system's C compiler, win64 where mingw-w64 is installed)")
+    parser.add_argument("--fmi-version", type=int, choices=(2, 3), default=2,
+                        help="FMI version of the native FMU (default 2; the pythonfmu FMU is FMI 2 only)")
     args = parser.parse_args(argv)
+    from fmu_src.native.build import NativeBuildError
     try:
-        path = build_fmu(args.params, args.out, args.model)
-    except (bushing_params.ParameterError, BuildError) as exc:
+        if args.native:
+            build = build_native_fmu(args.params, args.out, args.model, args.fmi_version)
+            path = build.path
+            for platform, why in build.skipped.items():
+                print(f"note: no {platform} binary: {why}", file=sys.stderr)
+        elif args.fmi_version != 2:
+            raise BuildError("--fmi-version 3 needs --native (pythonfmu builds FMI 2.0 FMUs only)")
+        else:
+            path = build_fmu(args.params, args.out, args.model)
+    except (bushing_params.ParameterError, BuildError, NativeBuildError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     print(f"wrote {path}")

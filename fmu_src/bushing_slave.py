@@ -64,19 +64,6 @@ class InitializationError(RuntimeError):
     """Start values with which the simulation cannot start (fmi2Fatal at the first doStep)."""
 
 
-def _description(axis_models) -> str:
-    if axis_models is None or (len(axis_models) == 1 and axis_models[0][1].name == "proposed"):
-        return ("Nonlinear rubber bushing, one axis: the modified Spencer/Bouc-Wen model of "
-                "'New nonlinear bushing model for general excitations using Bouc-Wen hysteretic "
-                "model' (eqs. 1-5). Ports in SI, parameters in the paper's N-mm-s units.")
-    if len(axis_models) == 1:
-        return (f"Bushing, one axis: the {axis_models[0][1].title} baseline model of the Bouc-Wen bushing project. "
-                "Ports in SI, parameters in N-mm-s units.")
-    return ("Six-axis rubber bushing between markers I and J (uncoupled axes, small rotations; "
-            "inputs and outputs in J's axes): " + ", ".join(f"{axis.name} {model.title}" for axis, model, _ in axis_models)
-            + ". Ports in SI; translational parameters in N-mm-s units, rotational in N.mm, rad, s.")
-
-
 class _AxisState:
     """One axis of the slave: its model, parameters as set, inputs, and committed state (in the
     kernels' units: mm or rad, N or N.mm)."""
@@ -107,7 +94,7 @@ class _AxisState:
 
 class BushingSlave(Fmi2Slave):
     author = "Bouc-Wen bushing project"
-    description = _description(AXES)
+    description = variables.fmu_description(AXES)
     version = None  # the project's version, written into each FMU's class by build_fmu.py
     license = "MIT"
     default_experiment = DefaultExperiment(start_time=0.0, stop_time=1.0, step_size=1e-3)

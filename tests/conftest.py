@@ -107,3 +107,38 @@ def fmu_path(tmp_path_factory) -> Path:
 def fmu_path_table2(tmp_path_factory) -> Path:
     """An FMU built with the paper's Table 2 as default parameters."""
     return build_fmu.build_fmu(DATA / "params_table2_sine.json", tmp_path_factory.mktemp("fmu_table2"))
+
+
+@pytest.fixture(scope="session")
+def native_fmu_path(tmp_path_factory) -> Path:
+    """The native FMU (compiled C, FMI 2.0) built with the default parameters (Table 5)."""
+    return build_fmu.build_native_fmu(out_dir=tmp_path_factory.mktemp("native_table5")).path
+
+
+def is_native(fmu_path) -> bool:
+    """Whether ``fmu_path`` is a native FMU (build_fmu.py --native), not a pythonfmu one."""
+    from fmpy import read_model_description
+    return "--native" in read_model_description(str(fmu_path)).generationTool
+
+
+_PRINT_LOG_MESSAGE = None
+
+
+@pytest.fixture(autouse=True)
+def _fmpy_logger_proxy_alive():
+    """fmpy (0.3.32) formats FMI 2 log messages in a native proxy that keeps the Python logger to
+    call in one global: simulate_fmu(logger=...) points it at that call's logger, which is freed
+    when the call returns, and the next FMU that logs through fmpy's default callbacks calls
+    freed memory (seen here: SIGFPE in fmpy/logging's logMessage, after a test that passed a
+    logger; the native FMU logs every error and warning, as the Reference-FMUs do). After every
+    test the proxy points again at fmpy's own printer, kept alive here."""
+    yield
+    global _PRINT_LOG_MESSAGE
+    from ctypes import byref
+    from fmpy.fmi2 import fmi2CallbackFunctions, fmi2CallbackLoggerTYPE, printLogMessage
+    from fmpy.logging import addLoggerProxy
+    if _PRINT_LOG_MESSAGE is None:
+        _PRINT_LOG_MESSAGE = fmi2CallbackLoggerTYPE(printLogMessage)
+    callbacks = fmi2CallbackFunctions()
+    callbacks.logger = _PRINT_LOG_MESSAGE
+    addLoggerProxy(byref(callbacks))

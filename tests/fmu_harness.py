@@ -20,9 +20,10 @@ class BushingFmu:
     """One FMU instance, initialised and ready to step."""
 
     def __init__(self, fmu_path, instance_name="bushing", start_values=None, x0_m=0.0, v0_m_s=0.0,
-                 initial_inputs=None):
+                 initial_inputs=None, exit_initialization=True):
         """``initial_inputs``: {port: value} set before initialisation ends (default: x and v of a
-        one-axis FMU from ``x0_m``, ``v0_m_s``)."""
+        one-axis FMU from ``x0_m``, ``v0_m_s``). ``exit_initialization=False``: the instance stays
+        in initialization mode (the caller ends it: ``self.fmu.exitInitializationMode()``)."""
         self.description = read_model_description(fmu_path)
         self.refs = {v.name: v.valueReference for v in self.description.modelVariables}
         self.messages: list[tuple[str, str, str]] = []  # (status, category, message)
@@ -41,7 +42,8 @@ class BushingFmu:
             self.set(name, value)
         for name, value in (initial_inputs if initial_inputs is not None else {"x": x0_m, "v": v0_m_s}).items():
             self.set(name, value)
-        self.fmu.exitInitializationMode()
+        if exit_initialization:
+            self.fmu.exitInitializationMode()
         self.time = 0.0
 
     def _log(self, component, instance_name, status, category, message):

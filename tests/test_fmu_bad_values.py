@@ -1,4 +1,7 @@
-"""Bad values: refused with a logged reason, no NaN force, nothing lost, no crash or hang."""
+"""Bad values: refused with a logged reason, no NaN force, nothing lost, no crash or hang. Every
+test runs on the pythonfmu FMU and on the native one (``build_fmu.py --native``), which answers
+an invalid start value with fmi2Error at the exit of initialization mode (pythonfmu cannot: it
+fails the first step with fmi2Fatal)."""
 import math
 import subprocess
 import sys
@@ -9,10 +12,17 @@ import pytest
 from fmpy import simulate_fmu
 from fmpy.fmi1 import FMICallException
 
+from conftest import is_native
 from fmu_harness import BushingFmu
 
 MM = 1e-3
 STEP = 1e-3
+
+
+@pytest.fixture(params=["pythonfmu", "native"])
+def fmu_path(request):
+    """The Table 5 FMU of each kind (conftest's session fixtures)."""
+    return request.getfixturevalue("fmu_path" if request.param == "pythonfmu" else "native_fmu_path")
 
 
 def run_steps(fmu, count, start=0):
@@ -164,11 +174,16 @@ def test_messages_carry_a_category_the_model_description_declares(fmu_path):
 ])
 def test_invalid_start_values_make_simulate_fmu_raise_and_name_the_parameter(fmu_path, name, value, fragment,
                                                                              capfd):
-    # Before: a 2-row result with F = 0 and no error. Now the first step fails (fmi2Fatal:
-    # pythonfmu's only failing status) and the reason reaches stderr without any logging set up.
-    with pytest.raises(FMICallException, match="fmi2DoStep failed with status 4"):
+    # Before: a 2-row result with F = 0 and no error. Now the run fails with the reason, without
+    # any logging set up: the pythonfmu FMU at the first step (fmi2Fatal, pythonfmu's only
+    # failing status; it writes the reason to stderr), the native one at the exit of
+    # initialization mode (fmi2Error, the reason through the logger, which fmpy prints).
+    failure = ("fmi2ExitInitializationMode failed with status 3" if is_native(fmu_path) else
+               "fmi2DoStep failed with status 4")
+    with pytest.raises(FMICallException, match=failure):
         simulate_fmu(str(fmu_path), stop_time=0.01, step_size=STEP, start_values={name: value})
-    assert fragment in capfd.readouterr().err
+    captured = capfd.readouterr()
+    assert fragment in captured.err + captured.out
     messages = []
     with pytest.raises(FMICallException):
         simulate_fmu(str(fmu_path), stop_time=0.01, step_size=STEP, start_values={name: value}, debug_logging=True,
@@ -179,11 +194,23 @@ def test_invalid_start_values_make_simulate_fmu_raise_and_name_the_parameter(fmu
 
 
 def test_start_values_fixed_before_the_first_step_start_from_the_equilibrium(fmu_path):
-    # Invalid at exitInitializationMode (logged), corrected before the first step: the run starts
-    # from the relaxed equilibrium at x0, as if they had been valid.
-    fmu = BushingFmu(fmu_path, start_values={"c1": -1.0}, x0_m=1.0 * MM)
-    assert any("c1 = -1.0 [N.s/mm] must be > 0" in m for m in fmu.messages_with("error"))
-    fmu.set("c1", 1.485)
+    # pythonfmu: invalid at exitInitializationMode (logged), corrected before the first step, the
+    # run starts from the relaxed equilibrium at x0, as if they had been valid. The native FMU
+    # refuses to leave initialization mode instead (fmi2Error, the value named): fix it there.
+    if is_native(fmu_path):
+        fmu = BushingFmu(fmu_path, start_values={"c1": -1.0}, x0_m=1.0 * MM, exit_initialization=False)
+        with pytest.raises(FMICallException, match="fmi2ExitInitializationMode failed with status 3"):
+            fmu.fmu.exitInitializationMode()
+        assert any("c1 = -1.0 [N.s/mm] must be > 0" in m for m in fmu.messages_with("error"))
+        fmu.fmu.reset()      # after fmi2Error: reset (or free), as FMI 2 asks, and start again
+        fmu.fmu.setupExperiment(startTime=0.0)
+        fmu.fmu.enterInitializationMode()
+        fmu.set("x", 1.0 * MM)
+        fmu.fmu.exitInitializationMode()
+    else:
+        fmu = BushingFmu(fmu_path, start_values={"c1": -1.0}, x0_m=1.0 * MM)
+        assert any("c1 = -1.0 [N.s/mm] must be > 0" in m for m in fmu.messages_with("error"))
+        fmu.set("c1", 1.485)
     assert fmu.do_step(STEP) == "ok"
     reference = BushingFmu(fmu_path, x0_m=1.0 * MM)
     assert reference.do_step(STEP) == "ok"
@@ -197,7 +224,7 @@ def test_invalid_start_value_makes_fmpys_command_line_fail(fmu_path):
                "--stop-time", "0.01", "--start-values", "c1", "-1"]
     result = subprocess.run(command, capture_output=True, text=True, timeout=120)
     assert result.returncode != 0
-    assert "c1 = -1.0 [N.s/mm] must be > 0" in result.stderr, result.stderr[-2000:]
+    assert "c1 = -1.0 [N.s/mm] must be > 0" in result.stderr + result.stdout, result.stderr[-2000:]
 
 
 FAIL_FREE_AND_RUN_AGAIN = """
@@ -209,24 +236,28 @@ path = sys.argv[1]
 description, folder = read_model_description(path), extract(path)
 refs = {v.name: v.valueReference for v in description.modelVariables}
 
-def instance(name, c1):
+def instance(name):
     fmu = FMU2Slave(guid=description.guid, unzipDirectory=folder,
                     modelIdentifier=description.coSimulation.modelIdentifier, instanceName=name)
     fmu.instantiate()
     fmu.setupExperiment(startTime=0.0)
     fmu.enterInitializationMode()
-    fmu.setReal([refs["c1"]], [c1])
-    fmu.exitInitializationMode()
     return fmu
 
+def start(fmu, c1):
+    fmu.setReal([refs["c1"]], [c1])
+    fmu.exitInitializationMode()
+
 for attempt in range(3):
-    fmu = instance(f"bad{attempt}", -1.0)
+    fmu = instance(f"bad{attempt}")
     try:
+        start(fmu, -1.0)
         fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=1e-3)
     except FMICallException as exc:
         print("failed with status", exc.status)
     fmu.freeInstance()
-good = instance("good", 1.485)
+good = instance("good")
+start(good, 1.485)
 good.doStep(currentCommunicationPoint=0.0, communicationStepSize=1e-3)
 print("then ran", good.getReal([refs["F"]])[0])
 good.terminate()
@@ -237,7 +268,10 @@ good.freeInstance()
 def test_instances_that_failed_to_start_can_be_freed_and_the_host_runs_on(fmu_path):
     # pythonfmu 0.7 releases an instance twice after an exception (once when raised, once when
     # freed): the host crashed when it freed the failed instance, or at its exit (libcosim).
+    # The native FMU fails at the exit of initialization mode: the script prints no status of
+    # the step then, and each failed instance is freed as well.
     result = subprocess.run([sys.executable, "-c", FAIL_FREE_AND_RUN_AGAIN, str(fmu_path)], capture_output=True,
                             text=True, timeout=300)
     assert result.returncode == 0, (result.returncode, result.stderr[-2000:])
-    assert result.stdout.count("failed with status 4") == 3 and "then ran 0.0" in result.stdout
+    failures = "failed with status 3" if is_native(fmu_path) else "failed with status 4"
+    assert result.stdout.count(failures) == 3 and "then ran 0.0" in result.stdout

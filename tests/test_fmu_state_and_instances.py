@@ -1,4 +1,5 @@
-"""FMU state (get/set/serialize), tunable parameters, several instances and builds."""
+"""FMU state (get/set/serialize), tunable parameters, several instances and builds; each test on
+the pythonfmu FMU and on the native one (``build_fmu.py --native``)."""
 import numpy as np
 import pytest
 
@@ -10,6 +11,22 @@ from python_core import simulate_python_core
 MM = 1e-3
 STEP = 1e-3
 SINE = Sine(2.0, 10.0)
+
+
+@pytest.fixture(params=["pythonfmu", "native"])
+def fmu_path(request):
+    """The Table 5 FMU of each kind (conftest's session fixtures)."""
+    return request.getfixturevalue("fmu_path" if request.param == "pythonfmu" else "native_fmu_path")
+
+
+@pytest.fixture
+def fmu_path_table2(fmu_path, tmp_path_factory, request):
+    """A second build of the same kind as ``fmu_path``, with Table 2 as defaults."""
+    from conftest import DATA, is_native
+    import build_fmu
+    if not is_native(fmu_path):
+        return request.getfixturevalue("fmu_path_table2")
+    return build_fmu.build_native_fmu(DATA / "params_table2_sine.json", tmp_path_factory.mktemp("native_table2")).path
 
 
 def drive(fmu, first_step, count):

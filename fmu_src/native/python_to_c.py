@@ -47,23 +47,20 @@ C_RESERVED = frozenset("""auto break case char const continue default do double 
 inline int long register restrict return short signed sizeof static struct switch typedef union unsigned void volatile
 while abs fabs pow exp log sqrt sin cos ceil floor isfinite bw_int main errno""".split())
 
-PRELUDE = """\
-#include <limits.h>
-#include <math.h>
-#include <stdlib.h>
-
-/* Python's int(x) of a float: truncation; a NaN or a value beyond int gives INT_MAX (Python
+PRELUDE = "#include <limits.h>\n#include <math.h>\n#include <stdlib.h>\n"
+HELPERS = {
+    "bw_int": """/* Python's int(x) of a float: truncation; a NaN or a value beyond int gives INT_MAX (Python
    raises there, and the kernels' callers refuse the step on too many substeps). */
 static int bw_int(double x) {
     if (!(x > (double)INT_MIN - 1.0 && x < (double)INT_MAX + 1.0)) return INT_MAX;
     return (int)x;
+}""",
+    # Python's min and max of two values: the first of equal ones
+    "bw_min_d": "static double bw_min_d(double a, double b) { return b < a ? b : a; }",
+    "bw_max_d": "static double bw_max_d(double a, double b) { return b > a ? b : a; }",
+    "bw_min_i": "static int bw_min_i(int a, int b) { return b < a ? b : a; }",
+    "bw_max_i": "static int bw_max_i(int a, int b) { return b > a ? b : a; }",
 }
-/* Python's min and max of two values: the first of equal ones. */
-static double bw_min_d(double a, double b) { return b < a ? b : a; }
-static double bw_max_d(double a, double b) { return b > a ? b : a; }
-static int bw_min_i(int a, int b) { return b < a ? b : a; }
-static int bw_max_i(int a, int b) { return b > a ? b : a; }
-"""
 
 
 class TranslationError(ValueError):
@@ -93,6 +90,7 @@ class Translation:
     constants: dict = field(default_factory=dict)        # (module, name) -> (C name, C literal, type)
     functions: dict = field(default_factory=dict)        # (function, argument types) -> _Function
     order: list = field(default_factory=list)            # _Functions in the order they were finished
+    helpers: set = field(default_factory=set)            # the HELPERS the C calls
 
     def c_type(self, t: Type) -> str:
         if not isinstance(t, tuple):
@@ -118,7 +116,7 @@ class Translation:
 
     def source(self) -> str:
         """The C: typedefs, constants, prototypes, definitions (all ``static``)."""
-        lines = [PRELUDE]
+        lines = [PRELUDE] + [HELPERS[name] for name in HELPERS if name in self.helpers] + [""]
         for t, name in self.structs.items():
             fields = " ".join(f"{self.c_type(e)} f{i};" for i, e in enumerate(t)) or "int unused;"
             lines.append(f"typedef struct {{ {fields} }} {name};   /* {describe(t)} */")
@@ -585,18 +583,23 @@ class _Function:
         if kind == "math":
             argument = self.as_double(e.args[0], arguments[0])
             if what == "ceil":
+                self.translation.helpers.add("bw_int")
                 return f"bw_int(ceil({argument}))"
             if what == "isfinite":
                 return f"(isfinite({argument}) != 0)"
             return f"{MATH_FUNCTIONS[what]}({argument})"
         if kind == "builtin":
             if what == "int":
-                return arguments[0] if types_[0] == INT else f"bw_int({arguments[0]})"
+                if types_[0] == INT:
+                    return arguments[0]
+                self.translation.helpers.add("bw_int")
+                return f"bw_int({arguments[0]})"
             if what == "float":
                 return f"(double)({arguments[0]})"
             if what == "abs":
                 return f"fabs({arguments[0]})" if types_[0] == DOUBLE else f"abs({arguments[0]})"
             suffix = "i" if types_ == [INT, INT] else "d"
+            self.translation.helpers.add(f"bw_{what}_{suffix}")
             converted = [self.as_double(a, c) if suffix == "d" else c for a, c in zip(e.args, arguments)]
             return f"bw_{what}_{suffix}({', '.join(converted)})"
         target = self.translation.function(what, tuple(types_))

@@ -1,17 +1,20 @@
-/* A minimal non-Python FMI 2.0 co-simulation host, for the smoke test in
- * tests/test_c_host.py: it loads an FMU's shared library the way a C/C++ tool does.
+/* A minimal non-Python FMI 2.0 co-simulation host, for tests/test_c_host.py and
+ * tests/test_native_fmu.py: it loads an FMU's shared library the way a C/C++ tool does.
  *
  * usage: fmi2_host LIBPYTHON FMU_SO MODEL_GUID RESOURCES_URI REF_X REF_V REF_F STEPS STEP_S
  *
  * pythonfmu's binary does not link libpython: its Python symbols must already be in the
- * process, so the host loads libpython with RTLD_GLOBAL first (a tool would use LD_PRELOAD).
- * It drives x = 2 mm * sin(2*pi*10*t) with the exact velocity, prints "t F" after each
- * step and every log message on stderr, and exits non-zero on any status other than OK. */
+ * process, so the host loads libpython with RTLD_GLOBAL first (a tool would use LD_PRELOAD);
+ * LIBPYTHON "-" loads none (a native FMU). It drives x = 2 mm * sin(2*pi*10*t) with the exact
+ * velocity, prints "t F" after each step and every log message on stderr, and exits non-zero
+ * on any status other than OK. On Linux it ends by saying on stderr whether libpython was
+ * mapped into the process ("python in process: yes/no"). */
 #include <dlfcn.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 typedef void *fmi2Component;
 typedef unsigned int fmi2ValueReference;
@@ -47,7 +50,10 @@ typedef void (*FreeInstance)(fmi2Component);
 
 int main(int argc, char **argv) {
     if (argc != 10) { fprintf(stderr, "usage: see source\n"); return 1; }
-    if (!dlopen(argv[1], RTLD_NOW | RTLD_GLOBAL)) { fprintf(stderr, "libpython: %s\n", dlerror()); return 2; }
+    if (strcmp(argv[1], "-") != 0 && !dlopen(argv[1], RTLD_NOW | RTLD_GLOBAL)) {
+        fprintf(stderr, "libpython: %s\n", dlerror());
+        return 2;
+    }
     void *fmu = dlopen(argv[2], RTLD_NOW | RTLD_LOCAL);
     if (!fmu) { fprintf(stderr, "fmu: %s\n", dlerror()); return 2; }
     LOAD(Instantiate, fmi2Instantiate)
@@ -81,5 +87,15 @@ int main(int argc, char **argv) {
     }
     CHECK(fmi2Terminate(c));
     fmi2FreeInstance(c);
+#ifdef __linux__
+    {
+        FILE *maps = fopen("/proc/self/maps", "r");
+        char line[4096];
+        int python = 0;
+        while (maps && fgets(line, sizeof line, maps)) python = python || strstr(line, "libpython") != NULL;
+        if (maps) fclose(maps);
+        fprintf(stderr, "python in process: %s\n", python ? "yes" : "no");
+    }
+#endif
     return 0;
 }

@@ -1,0 +1,133 @@
+"""Build a native bushing FMU: C generated from the model definitions, compiled for linux64 (the
+system's C compiler) and win64 (mingw-w64, where it is installed), its sources inside so that
+any tool can compile it for another platform (FMI 2 ``<SourceFiles>``, FMI 3
+``buildDescription.xml``). No Python in the host: ``needsExecutionTool="false"``.
+
+Layout of the FMU::
+
+    modelDescription.xml
+    binaries/linux64/<id>.so, binaries/win64/<id>.dll        (FMI 3: x86_64-linux, x86_64-windows)
+    sources/<id>.c            the one translation unit: includes the files below
+    sources/bushing_fmu.h, bushing_model.c (generated), bushing_instance.c, fmi2_functions.c
+            (or fmi3_functions.c), and the FMI headers (from fmpy's c-code)
+    sources/buildDescription.xml                                (FMI 3)
+"""
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import tempfile
+import zipfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from . import model_description
+from .generate import model_source
+
+C_LAYER = Path(__file__).resolve().parent / "c"
+HAND_WRITTEN = ("bushing_fmu.h", "bushing_instance.c")
+FMI_HEADERS = {2: ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h"),
+               3: ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h")}
+WARNINGS = ("-std=c99", "-pedantic", "-Wall", "-Wextra", "-Werror")
+FLAGS = ("-O2", "-fPIC", "-ffp-contract=off", "-fvisibility=hidden")
+"""-ffp-contract=off: no fused multiply-add, so the C gives the Python kernels' floats;
+-fvisibility=hidden: only the FMI functions are exported."""
+MINGW = "x86_64-w64-mingw32-gcc"
+PLATFORMS = {2: {"linux64": ".so", "win64": ".dll"}, 3: {"x86_64-linux": ".so", "x86_64-windows": ".dll"}}
+
+
+class NativeBuildError(RuntimeError):
+    """The native FMU could not be built (the message says which step and why)."""
+
+
+@dataclass
+class NativeBuild:
+    path: Path
+    platforms: list[str] = field(default_factory=list)
+    skipped: dict[str, str] = field(default_factory=dict)    # platform -> why it was not built
+
+
+def fmi_header_directory() -> Path:
+    """fmpy's copy of the FMI 2 and 3 headers."""
+    import fmpy
+    folder = Path(fmpy.__file__).resolve().parent / "c-code"
+    if not (folder / "fmi2Functions.h").is_file():
+        raise NativeBuildError(f"the FMI headers are not in {folder}: reinstall fmpy (>= 0.3.20)")
+    return folder
+
+
+def write_sources(folder: Path, axis_models, identifier: str, fmi_version: int):
+    """Write the FMU's sources/ into ``folder``; returns the generated model (``generate``)."""
+    folder.mkdir(parents=True, exist_ok=True)
+    generated = model_source(axis_models, identifier)
+    (folder / "bushing_model.c").write_text(generated.source)
+    functions = f"fmi{fmi_version}_functions.c"
+    for name in (*HAND_WRITTEN, functions):
+        shutil.copy2(C_LAYER / name, folder / name)
+    headers = fmi_header_directory()
+    for name in FMI_HEADERS[fmi_version]:
+        shutil.copy2(headers / name, folder / name)
+    (folder / f"{identifier}.c").write_text(
+        f"/* The native FMU {identifier}: one translation unit (see bushing_fmu.h). */\n"
+        '#include "bushing_fmu.h"\n#include "bushing_model.c"\n#include "bushing_instance.c"\n'
+        f'#include "{functions}"\n')
+    return generated
+
+
+def compile_binary(sources: Path, identifier: str, target: Path, compiler: str, extra=()) -> None:
+    """Compile the unit ``sources/<identifier>.c`` into the shared library ``target``."""
+    target.parent.mkdir(parents=True, exist_ok=True)
+    command = [compiler, *WARNINGS, *FLAGS, *extra, "-shared", "-I", str(sources), "-o", str(target),
+               str(sources / f"{identifier}.c"), "-lm"]
+    result = subprocess.run(command, capture_output=True, text=True)
+    if result.returncode != 0:
+        raise NativeBuildError(f"{compiler} failed on {identifier}.c:\n{result.stderr[-4000:]}")
+
+
+def build_native(axis_models, identifier: str, out_dir: str | Path, fmi_version: int = 2,
+                 platforms: tuple[str, ...] | None = None) -> NativeBuild:
+    """Write ``out_dir/<identifier>.fmu``, a native FMU (FMI ``fmi_version``, co-simulation and
+    model exchange) of the axes ``axis_models`` [(axes.Axis, model on that axis, parameters)].
+    ``platforms``: default every platform whose compiler is here (linux64 with the system's
+    ``cc``, win64 with mingw-w64); the result says which were skipped and why."""
+    if fmi_version not in (2, 3):
+        raise NativeBuildError(f"FMI version {fmi_version}: give 2 or 3")
+    compilers = {2: {"linux64": os.environ.get("CC", "cc"), "win64": MINGW},
+                 3: {"x86_64-linux": os.environ.get("CC", "cc"), "x86_64-windows": MINGW}}[fmi_version]
+    wanted = list(platforms or compilers)
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    build = NativeBuild(out_dir / f"{identifier}.fmu")
+    with tempfile.TemporaryDirectory(prefix="bushing_native_") as stage:
+        stage = Path(stage)
+        sources = stage / "sources"
+        generated = write_sources(sources, axis_models, identifier, fmi_version)
+        if fmi_version == 2:
+            xml = model_description.fmi2(axis_models, identifier, generated.token,
+                                         event_indicators=generated.event_indicators, source_file=f"{identifier}.c")
+        else:
+            xml = model_description.fmi3(axis_models, identifier, generated.token)
+            (sources / "buildDescription.xml").write_bytes(model_description.build_description(identifier))
+        (stage / "modelDescription.xml").write_bytes(xml)
+        for platform in wanted:
+            if platform not in compilers:
+                raise NativeBuildError(f"unknown platform {platform!r} for FMI {fmi_version}; "
+                                       f"choose from {', '.join(compilers)}")
+            compiler = compilers[platform]
+            if shutil.which(compiler) is None:
+                build.skipped[platform] = (f"{compiler} is not installed" + (
+                    " (Debian: apt-get install gcc-mingw-w64-x86-64)" if compiler == MINGW else ""))
+                continue
+            extra = ("-static-libgcc",) if compiler == MINGW else ()
+            binary = stage / "binaries" / platform / f"{identifier}{PLATFORMS[fmi_version][platform]}"
+            compile_binary(sources, identifier, binary, compiler, extra)
+            build.platforms.append(platform)
+        if not build.platforms:
+            raise NativeBuildError("no platform could be built: " + "; ".join(f"{p}: {why}"
+                                                                              for p, why in build.skipped.items()))
+        with zipfile.ZipFile(build.path, "w", zipfile.ZIP_DEFLATED) as archive:
+            for path in sorted(stage.rglob("*")):
+                if path.is_file():
+                    archive.write(path, path.relative_to(stage).as_posix())
+    return build

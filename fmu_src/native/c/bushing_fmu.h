@@ -1,0 +1,99 @@
+/* The native bushing FMU: the types every part shares.
+ *
+ * One translation unit per FMU (<modelIdentifier>.c, written by the build) includes, in order,
+ * this header, the generated bushing_model.c (the models' kernels translated from their Python
+ * source, the FMU's axes, variables and parameter rules), bushing_instance.c (the instance:
+ * life cycle, variables, validation, steps, model exchange, FMU state; no FMI types) and one of
+ * fmi2_functions.c or fmi3_functions.c (the FMI API on top of the instance). Everything but the
+ * FMI functions is static: many FMUs of this project load into one process side by side, and
+ * an instance keeps all its data in itself (no global state).
+ *
+ * Units as in the Python models: the kernels work in mm (or rad), mm/s, N (or N.mm) and s;
+ * the ports are SI; parameters are in the paper's N-mm-s units (N.mm and rad on rotational
+ * axes). */
+#ifndef BUSHING_FMU_H
+#define BUSHING_FMU_H
+
+#include <stddef.h>
+
+/* The outcome of an instance function; the FMI layer maps it onto fmi2Status / fmi3Status. */
+typedef enum { BW_OK = 0, BW_WARNING = 1, BW_DISCARD = 2, BW_ERROR = 3, BW_FATAL = 4 } bw_status;
+
+/* What a variable of the FMU is (fmu_src/variables.py). */
+typedef enum {
+    BW_PARAMETER, BW_DISPLACEMENT, BW_VELOCITY, BW_OUTPUT, BW_STATE, BW_DERIVATIVE
+} bw_kind;
+
+typedef struct {
+    const char *name;
+    bw_kind kind;
+    int axis;          /* position of its axis */
+    int index;         /* parameter: position in spec order; state and derivative: kernel state index */
+    double scale;      /* port value = scale * kernel value (states, derivatives) */
+} bw_variable;
+
+/* A parameter's allowed range (bushing_params.ParameterSpec): value >= minimum (> if
+ * exclusive) where bounded, with why; role in the plausible-force bound. */
+typedef struct {
+    const char *name;
+    const char *unit;
+    int bounded;
+    double minimum;
+    int exclusive;
+    const char *why;
+    int stiffness;     /* counts as a spring in the plausible bound (N/mm, N.mm/rad) */
+    int damping;       /* counts as a dashpot (N.s/mm, N.mm.s/rad) */
+    int weight;        /* the parameter whose |value| weights this stiffness (a gain's alpha), or -1 */
+} bw_parameter_spec;
+
+/* A condition on several parameters (bushing_params.Constraint): sum of +-parameter > bound
+ * (strict) or >= bound. */
+#define BW_MAX_TERMS 4
+typedef struct {
+    int terms;
+    int parameter[BW_MAX_TERMS];
+    double coefficient[BW_MAX_TERMS];
+    double bound;
+    int strict;
+    int error;          /* 1: the set is unusable; 0: a warning */
+    const char *expression;
+    const char *unit;
+    const char *why;
+} bw_constraint;
+
+/* A model: its parameter rules and its kernels (generated wrappers around the translated
+ * Python kernels; the constants are the model's own struct, behind void pointers). */
+typedef struct {
+    const char *name;
+    int parameters;
+    int states;
+    int switches;
+    const bw_parameter_spec *specs;
+    int constraints;
+    const bw_constraint *constraint;
+    void (*prepare)(const double *parameters, void *constants);
+    void (*initial_state)(const void *constants, double x0, double *state);
+    int (*step)(const void *constants, double *state, double state_x, double x, double v, double h, int max_substeps);
+    int (*jump)(const void *constants, double *state, double jump);
+    double (*force)(const void *constants, const double *state, double x, double v);
+    void (*derivatives)(const void *constants, const double *state, double x, double v, double *rates);
+    void (*switch_values)(const void *constants, const double *state, double x, double v, double *values);
+} bw_model;
+
+/* An axis of the FMU (fmu_src/axes.py): its ports, units and model. */
+typedef struct {
+    const char *label;          /* how messages name it: "axis rz: ", or "" for a one-axis FMU */
+    const char *displacement;   /* port names */
+    const char *velocity;
+    const char *output;
+    int rotational;
+    double to_kernel;           /* port displacement -> kernel: m -> mm (1000) or rad -> rad (1) */
+    double from_kernel;         /* kernel force -> port: N -> N (1) or N.mm -> N.m (1e-3) */
+    double travel_limit;        /* port displacement above which the FMU warns (once) */
+    double plausible_travel;    /* kernel units, for the plausible-force bound */
+    double plausible_velocity;
+    const bw_model *model;
+    const double *defaults;     /* the parameters' start values */
+} bw_axis_spec;
+
+#endif

@@ -1,0 +1,596 @@
+/* The instance of a native bushing FMU: what fmu_src/bushing_slave.py does for the pythonfmu
+ * FMU, with the same variables, conventions and messages, and the error statuses pythonfmu
+ * cannot give (an invalid start value is an error at the exit of initialization mode).
+ *
+ * Compiled after the generated bushing_model.c, which defines BW_AXES, BW_VARIABLES,
+ * BW_MAX_PARAMETERS, BW_MAX_STATES, BW_MAX_SWITCHES, bw_constants (a union of the models'
+ * constant structs), bw_axis_specs[], bw_variables[] and BW_KERNEL_OK / BW_KERNEL_TOO_MANY_SUBSTEPS
+ * / BW_KERNEL_NOT_FINITE / BW_MAX_SUBSTEPS (the Python kernels' status codes and substep limit).
+ *
+ * Conventions (README "Conventions"): over a communication step [t, t + h) the displacement is
+ * x + v*(t' - t); a step that starts away from the displacement the state belongs to takes the
+ * difference as a displacement jump; the output has direct feedthrough of x and v; at the exit
+ * of initialization mode every axis is in relaxed equilibrium at its x. */
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define BW_MESSAGE 1024
+
+/* How the FMI layer hears of a message: status, category, text (already formatted). */
+typedef void (*bw_log_function)(void *fmi_instance, bw_status status, const char *category, const char *message);
+
+typedef struct {
+    double parameters[BW_MAX_PARAMETERS];
+    double x, v;                     /* the ports as set (m or rad, per s) */
+    double x_now;                    /* kernel displacement: x as set, else x_k + v_k*h */
+    double state[BW_MAX_STATES];     /* committed, kernel units */
+    double state_x;                  /* kernel displacement the committed state belongs to */
+    double last_output;              /* last finite output, port units */
+    int output_is_current;
+    int parameters_changed;
+    int usable;                      /* the parameters in force passed validation */
+    double output_bound;             /* port units; above it the output is implausible */
+    int travel_warned, output_warned, stale_output_logged;
+    bw_constants constants;
+} bw_axis;
+
+/* Everything an FMU state saves and restores: the instance's data without its callbacks. */
+typedef struct {
+    bw_axis axes[BW_AXES];
+    int initial_state_pending;       /* set at the exit of initialization, or at the first valid step */
+    double time;
+} bw_data;
+
+typedef struct {
+    bw_data data;
+    int model_exchange;              /* 1: a model-exchange instance (the host integrates the states) */
+    int logging_on;
+    int initialized;                 /* the exit of initialization mode succeeded */
+    bw_log_function log;
+    void *fmi_instance;              /* passed back to log */
+} bw_instance;
+
+/* ------------------------------------------------------------------------------- messages */
+
+/* A double as Python's repr writes it: the fewest significant digits that read back as the
+   same double, in fixed notation for exponents -4 to 15 (with ".0" for a whole number) and
+   in scientific notation otherwise; so the messages name values as the Python FMU and the
+   parameter files do. */
+static void bw_format_double(char *out, size_t size, double value) {
+    char scientific[40];
+    int digits, exponent;
+    if (isnan(value)) { snprintf(out, size, "nan"); return; }
+    if (isinf(value)) { snprintf(out, size, value > 0 ? "inf" : "-inf"); return; }
+    for (digits = 1; digits < 17; digits++) {
+        snprintf(scientific, sizeof scientific, "%.*e", digits - 1, value);
+        if (strtod(scientific, NULL) == value) break;
+    }
+    snprintf(scientific, sizeof scientific, "%.*e", digits - 1, value);
+    exponent = atoi(strchr(scientific, 'e') + 1);
+    if (exponent < -4 || exponent >= 16) {
+        snprintf(out, size, "%s", scientific);
+        return;
+    }
+    snprintf(out, size, "%.*f", digits - 1 - exponent > 0 ? digits - 1 - exponent : 0, value);
+    if (!strchr(out, '.') && strlen(out) + 2 < size) strcat(out, ".0");
+}
+
+static void bw_log(bw_instance *inst, bw_status status, const char *category, const char *format, ...) {
+    char message[BW_MESSAGE];
+    va_list arguments;
+    if (!inst->log) return;
+    va_start(arguments, format);
+    vsnprintf(message, sizeof message, format, arguments);
+    va_end(arguments);
+    inst->log(inst->fmi_instance, status, category, message);
+}
+
+static void bw_error(bw_instance *inst, const char *format, const char *text) {
+    bw_log(inst, BW_ERROR, "logStatusError", format, text);
+}
+
+/* ------------------------------------------------------------------------------- parameters */
+
+/* Validate and prepare one axis's parameters (as BushingModel.validate), logging every
+   problem; 1 if usable. Warnings are logged once per change, as the Python FMU does. */
+static int bw_check_axis(bw_instance *inst, int a) {
+    bw_axis *axis = &inst->data.axes[a];
+    const bw_axis_spec *spec = &bw_axis_specs[a];
+    const bw_model *model = spec->model;
+    char value[40];
+    int i, t, errors = 0;
+    for (i = 0; i < model->parameters; i++) {
+        const bw_parameter_spec *p = &model->specs[i];
+        double x = axis->parameters[i];
+        bw_format_double(value, sizeof value, x);
+        if (!isfinite(x)) {
+            bw_log(inst, BW_ERROR, "logStatusError", "%s%s = %s [%s] must be a finite number", spec->label, p->name,
+                   value, p->unit);
+            errors++;
+        }
+    }
+    if (!errors) {
+        for (i = 0; i < model->parameters; i++) {
+            const bw_parameter_spec *p = &model->specs[i];
+            double x = axis->parameters[i];
+            if (p->bounded && !(p->exclusive ? x > p->minimum : x >= p->minimum)) {
+                char minimum[40];
+                bw_format_double(value, sizeof value, x);
+                snprintf(minimum, sizeof minimum, "%g", p->minimum);
+                bw_log(inst, BW_ERROR, "logStatusError", "%s%s = %s [%s] must be %s %s%s%s%s", spec->label, p->name,
+                       value, p->unit, p->exclusive ? ">" : ">=", minimum, p->why[0] ? " (" : "", p->why,
+                       p->why[0] ? ")" : "");
+                errors++;
+            }
+        }
+        for (i = 0; i < model->constraints; i++) {
+            const bw_constraint *c = &model->constraint[i];
+            double sum = 0.0;
+            char bound[40];
+            for (t = 0; t < c->terms; t++) sum += c->coefficient[t] * axis->parameters[c->parameter[t]];
+            if (c->strict ? sum > c->bound : sum >= c->bound) continue;
+            bw_format_double(value, sizeof value, sum);
+            snprintf(bound, sizeof bound, "%s %g", c->strict ? ">" : ">=", c->bound);
+            if (c->error) {
+                bw_log(inst, BW_ERROR, "logStatusError", "%s%s = %s%s%s must be %s (%s)", spec->label, c->expression,
+                       value, c->unit[0] ? " " : "", c->unit, bound, c->why);
+                errors++;
+            }
+        }
+    }
+    axis->usable = !errors;
+    if (errors) return 0;
+    for (i = 0; i < model->constraints; i++) {
+        const bw_constraint *c = &model->constraint[i];
+        double sum = 0.0;
+        char bound[40];
+        for (t = 0; t < c->terms; t++) sum += c->coefficient[t] * axis->parameters[c->parameter[t]];
+        if (c->error || (c->strict ? sum > c->bound : sum >= c->bound)) continue;
+        bw_format_double(value, sizeof value, sum);
+        snprintf(bound, sizeof bound, "%s %g", c->strict ? ">" : ">=", c->bound);
+        bw_log(inst, BW_WARNING, "logStatusWarning", "%saccepted, but %s = %s%s%s violates %s %s %s", spec->label,
+               c->expression, value, c->unit[0] ? " " : "", c->unit, c->why, c->expression, bound);
+    }
+    model->prepare(axis->parameters, &axis->constants);
+    {   /* the plausible bound (BushingModel.plausible_force_bound), in port units */
+        double stiffness = 0.0, damping = 0.0, offset, rest[BW_MAX_STATES];
+        for (i = 0; i < model->parameters; i++) {
+            const bw_parameter_spec *p = &model->specs[i];
+            double weight = p->weight >= 0 ? fabs(axis->parameters[p->weight]) : 1.0;
+            if (p->stiffness) stiffness += fabs(axis->parameters[i]) * weight;
+            if (p->damping) damping += fabs(axis->parameters[i]);
+        }
+        model->initial_state(&axis->constants, 0.0, rest);
+        offset = model->force(&axis->constants, rest, 0.0, 0.0);
+        axis->output_bound = (stiffness * spec->plausible_travel + damping * spec->plausible_velocity + fabs(offset))
+                             * spec->from_kernel;
+    }
+    return 1;
+}
+
+/* Check every axis whose parameters changed; 1 if all are usable. */
+static int bw_check_parameters(bw_instance *inst) {
+    int a, usable = 1;
+    for (a = 0; a < BW_AXES; a++) {
+        bw_axis *axis = &inst->data.axes[a];
+        if (axis->parameters_changed) {
+            axis->parameters_changed = 0;
+            bw_check_axis(inst, a);
+        }
+        usable = usable && axis->usable;
+    }
+    return usable;
+}
+
+/* ------------------------------------------------------------------------------- life cycle */
+
+static void bw_reset(bw_instance *inst) {
+    int a, i;
+    memset(&inst->data, 0, sizeof inst->data);
+    for (a = 0; a < BW_AXES; a++) {
+        bw_axis *axis = &inst->data.axes[a];
+        for (i = 0; i < bw_axis_specs[a].model->parameters; i++) axis->parameters[i] = bw_axis_specs[a].defaults[i];
+        axis->parameters_changed = 1;
+        axis->output_bound = HUGE_VAL;
+    }
+    inst->data.initial_state_pending = 1;
+    inst->initialized = 0;
+}
+
+static void bw_set_initial_state(bw_instance *inst) {
+    int a;
+    for (a = 0; a < BW_AXES; a++) {
+        bw_axis *axis = &inst->data.axes[a];
+        bw_axis_specs[a].model->initial_state(&axis->constants, axis->x_now, axis->state);
+        axis->state_x = axis->x_now;
+        axis->output_is_current = 0;
+    }
+    inst->data.initial_state_pending = 0;
+}
+
+/* The exit of initialization mode: start values that cannot run are an error, each named. */
+static bw_status bw_exit_initialization(bw_instance *inst) {
+    int a, usable = bw_check_parameters(inst);
+    for (a = 0; a < BW_AXES; a++) {
+        const bw_axis_spec *spec = &bw_axis_specs[a];
+        bw_axis *axis = &inst->data.axes[a];
+        if (!isfinite(axis->x) || !isfinite(axis->v)) {
+            char value[40];
+            int x_bad = !isfinite(axis->x);
+            bw_format_double(value, sizeof value, x_bad ? axis->x : axis->v);
+            bw_log(inst, BW_ERROR, "logStatusError", "input %s = %s %s is not a finite number",
+                   x_bad ? spec->displacement : spec->velocity, value,
+                   x_bad ? (spec->rotational ? "rad" : "m") : (spec->rotational ? "rad/s" : "m/s"));
+            usable = 0;
+        }
+    }
+    if (!usable) {
+        bw_log(inst, BW_ERROR, "logStatusError", "the simulation cannot start: fix the values above and "
+               "instantiate again");
+        return BW_ERROR;
+    }
+    bw_set_initial_state(inst);
+    inst->initialized = 1;
+    return BW_OK;
+}
+
+/* ------------------------------------------------------------------------------- variables */
+
+static bw_status bw_set_parameter(bw_instance *inst, const bw_variable *var, double value) {
+    bw_axis *axis = &inst->data.axes[var->axis];
+    const bw_axis_spec *spec = &bw_axis_specs[var->axis];
+    axis->parameters[var->index] = value;
+    axis->parameters_changed = 1;
+    axis->output_is_current = 0;
+    if (!isfinite(value)) {
+        char text[40];
+        bw_format_double(text, sizeof text, value);
+        bw_log(inst, BW_ERROR, "logStatusError", "%sparameter %s = %s [%s] is not a finite number; the next doStep "
+               "will be refused until it is", spec->label, spec->model->specs[var->index].name, text,
+               spec->model->specs[var->index].unit);
+    }
+    return BW_OK;
+}
+
+static bw_status bw_set_displacement(bw_instance *inst, int a, double value) {
+    bw_axis *axis = &inst->data.axes[a];
+    const bw_axis_spec *spec = &bw_axis_specs[a];
+    char text[40];
+    axis->x = value;
+    axis->x_now = value * spec->to_kernel;
+    axis->output_is_current = 0;
+    bw_format_double(text, sizeof text, value);
+    if (!isfinite(value)) {
+        bw_log(inst, BW_ERROR, "logStatusError", "input %s = %s %s is not a finite number; the next doStep will "
+               "be refused", spec->displacement, text, spec->rotational ? "rad" : "m");
+    } else if (fabs(value) > spec->travel_limit && !axis->travel_warned) {
+        axis->travel_warned = 1;
+        if (spec->rotational) {
+            bw_log(inst, BW_WARNING, "logStatusWarning", "input %s = %s rad exceeds %g rad: the bushing takes "
+                   "rotations as small angles (each component of the rotation vector about its own axis), which "
+                   "is approximate beyond about 20 degrees", spec->displacement, text, spec->travel_limit);
+        } else {
+            bw_log(inst, BW_WARNING, "logStatusWarning", "input %s = %s m exceeds %g m, far beyond a bushing's "
+                   "travel; the FMU takes metres (2 mm is %s = 0.002)", spec->displacement, text,
+                   spec->travel_limit, spec->displacement);
+        }
+    }
+    return BW_OK;
+}
+
+static bw_status bw_set_velocity(bw_instance *inst, int a, double value) {
+    bw_axis *axis = &inst->data.axes[a];
+    const bw_axis_spec *spec = &bw_axis_specs[a];
+    axis->v = value;
+    axis->output_is_current = 0;
+    if (!isfinite(value)) {
+        char text[40];
+        bw_format_double(text, sizeof text, value);
+        bw_log(inst, BW_ERROR, "logStatusError", "input %s = %s %s is not a finite number; the next doStep will "
+               "be refused", spec->velocity, text, spec->rotational ? "rad/s" : "m/s");
+    }
+    return BW_OK;
+}
+
+/* The axis's output at the current inputs: where x was set away from the displacement of the
+   committed state (co-simulation), it includes the model's response to that jump. Never NaN:
+   where it cannot be computed it keeps its last finite value, and says so once. */
+static double bw_output(bw_instance *inst, int a) {
+    bw_axis *axis = &inst->data.axes[a];
+    const bw_axis_spec *spec = &bw_axis_specs[a];
+    const char *reason = "the parameters are invalid (see the errors above)";
+    if (axis->output_is_current) return axis->last_output;
+    if (bw_check_parameters(inst) || axis->usable) {
+        double state[BW_MAX_STATES], output;
+        int status = BW_KERNEL_OK;
+        memcpy(state, axis->state, sizeof state);
+        if (!inst->model_exchange && axis->x_now != axis->state_x) {
+            status = spec->model->jump(&axis->constants, state, axis->x_now - axis->state_x);
+        }
+        output = spec->model->force(&axis->constants, state, axis->x_now, axis->v * spec->to_kernel)
+                 * spec->from_kernel;
+        if (status == BW_KERNEL_OK && isfinite(output)) {
+            axis->last_output = output;
+            axis->output_is_current = 1;
+            axis->stale_output_logged = 0;
+            return output;
+        }
+        reason = "it is not finite at the inputs set (check their units: the FMU takes metres and m/s)";
+    }
+    if (!axis->stale_output_logged) {
+        char text[40];
+        axis->stale_output_logged = 1;
+        bw_format_double(text, sizeof text, axis->last_output);
+        bw_log(inst, BW_ERROR, "logStatusError", "%s cannot be computed: %s; %s keeps its last finite value %s %s",
+               spec->output, reason, spec->output, text, spec->rotational ? "N.m" : "N");
+    }
+    return axis->last_output;
+}
+
+static bw_status bw_set_real(bw_instance *inst, unsigned int reference, double value) {
+    const bw_variable *var;
+    if (reference >= BW_VARIABLES) {
+        bw_log(inst, BW_ERROR, "logStatusError", "value reference %u does not exist (this FMU has 0 to %d)",
+               reference, BW_VARIABLES - 1);
+        return BW_ERROR;
+    }
+    var = &bw_variables[reference];
+    switch (var->kind) {
+    case BW_PARAMETER: return bw_set_parameter(inst, var, value);
+    case BW_DISPLACEMENT: return bw_set_displacement(inst, var->axis, value);
+    case BW_VELOCITY: return bw_set_velocity(inst, var->axis, value);
+    default:
+        bw_log(inst, BW_ERROR, "logStatusError", "%s (value reference %u) is not an input or a parameter: it cannot be "
+               "set", var->name, reference);
+        return BW_ERROR;
+    }
+}
+
+static double bw_rate(bw_instance *inst, int a, int index);
+
+static bw_status bw_get_real(bw_instance *inst, unsigned int reference, double *value) {
+    const bw_variable *var;
+    bw_axis *axis;
+    if (reference >= BW_VARIABLES) {
+        bw_log(inst, BW_ERROR, "logStatusError", "value reference %u does not exist (this FMU has 0 to %d)",
+               reference, BW_VARIABLES - 1);
+        return BW_ERROR;
+    }
+    var = &bw_variables[reference];
+    axis = &inst->data.axes[var->axis];
+    switch (var->kind) {
+    case BW_PARAMETER: *value = axis->parameters[var->index]; break;
+    case BW_DISPLACEMENT: *value = axis->x; break;
+    case BW_VELOCITY: *value = axis->v; break;
+    case BW_OUTPUT: *value = bw_output(inst, var->axis); break;
+    case BW_STATE: *value = axis->state[var->index] * var->scale; break;
+    case BW_DERIVATIVE: *value = bw_rate(inst, var->axis, var->index) * var->scale; break;
+    }
+    return BW_OK;
+}
+
+/* ------------------------------------------------------------------------------- co-simulation */
+
+static bw_status bw_refuse(bw_instance *inst, const char *format, ...) {
+    char message[BW_MESSAGE];
+    va_list arguments;
+    va_start(arguments, format);
+    vsnprintf(message, sizeof message, format, arguments);
+    va_end(arguments);
+    bw_error(inst, "%s", message);
+    return BW_DISCARD;
+}
+
+/* One communication step of every axis; a step that cannot succeed on any axis is refused
+   (BW_DISCARD) and leaves every axis as it was. */
+static bw_status bw_do_step(bw_instance *inst, double current_time, double h) {
+    double states[BW_AXES][BW_MAX_STATES], x_end[BW_AXES], outputs[BW_AXES];
+    char t_text[40], h_text[40];
+    int a;
+    bw_format_double(t_text, sizeof t_text, current_time);
+    bw_format_double(h_text, sizeof h_text, h);
+    if (!(h > 0.0 && h < HUGE_VAL)) {
+        return bw_refuse(inst, "communication step size %s s must be a finite number > 0", h_text);
+    }
+    if (!bw_check_parameters(inst)) {
+        if (inst->data.initial_state_pending) {
+            bw_error(inst, "%s", "the simulation cannot start: the parameters are invalid (see the errors above)");
+            return BW_ERROR;
+        }
+        return bw_refuse(inst, "doStep refused: the parameters are invalid (see the errors above)");
+    }
+    for (a = 0; a < BW_AXES; a++) {
+        const bw_axis_spec *spec = &bw_axis_specs[a];
+        bw_axis *axis = &inst->data.axes[a];
+        char value[40];
+        if (!isfinite(axis->x)) {
+            bw_format_double(value, sizeof value, axis->x);
+            return bw_refuse(inst, "doStep refused: input %s = %s %s is not a finite number", spec->displacement, value,
+                             spec->rotational ? "rad" : "m");
+        }
+        if (!isfinite(axis->v)) {
+            bw_format_double(value, sizeof value, axis->v);
+            return bw_refuse(inst, "doStep refused: input %s = %s %s is not a finite number", spec->velocity, value,
+                             spec->rotational ? "rad/s" : "m/s");
+        }
+    }
+    if (inst->data.initial_state_pending) bw_set_initial_state(inst);
+    for (a = 0; a < BW_AXES; a++) {   /* every axis first, then commit all */
+        const bw_axis_spec *spec = &bw_axis_specs[a];
+        bw_axis *axis = &inst->data.axes[a];
+        double x = axis->x_now, v = axis->v * spec->to_kernel;
+        char x_text[40], v_text[40];
+        int status;
+        memcpy(states[a], axis->state, sizeof states[a]);
+        status = spec->model->step(&axis->constants, states[a], axis->state_x, x, v, h, BW_MAX_SUBSTEPS);
+        bw_format_double(x_text, sizeof x_text, x);
+        bw_format_double(v_text, sizeof v_text, v);
+        if (status == BW_KERNEL_TOO_MANY_SUBSTEPS) {
+            return bw_refuse(inst, "doStep at t = %s s refused: %sthe step of %g s would need more than %d substeps "
+                             "(x = %g mm, v = %g mm/s); check the units of the inputs (the FMU takes metres and m/s) "
+                             "or shorten the communication step", t_text, spec->label, h, BW_MAX_SUBSTEPS, x, v);
+        }
+        if (status != BW_KERNEL_OK) {
+            return bw_refuse(inst, "doStep at t = %s s refused: %sthe step gave a non-finite state at x = %g mm, "
+                             "v = %g mm/s; check the units of the inputs (the FMU takes metres and m/s) and the "
+                             "parameters", t_text, spec->label, x, v);
+        }
+        x_end[a] = x + v * h;
+        outputs[a] = spec->model->force(&axis->constants, states[a], x_end[a], v) * spec->from_kernel;
+        if (!isfinite(outputs[a])) {
+            char x_port[40], v_port[40];
+            bw_format_double(x_port, sizeof x_port, axis->x);
+            bw_format_double(v_port, sizeof v_port, axis->v);
+            return bw_refuse(inst, "doStep at t = %s s refused: %s would be %g %s (%s = %s %s, %s = %s %s); check the "
+                             "units of the inputs", t_text, spec->output, outputs[a], spec->rotational ? "N.m" : "N",
+                             spec->displacement, x_port, spec->rotational ? "rad" : "m", spec->velocity, v_port,
+                             spec->rotational ? "rad/s" : "m/s");
+        }
+    }
+    for (a = 0; a < BW_AXES; a++) {
+        const bw_axis_spec *spec = &bw_axis_specs[a];
+        bw_axis *axis = &inst->data.axes[a];
+        if (fabs(outputs[a]) > axis->output_bound && !axis->output_warned) {
+            char x_port[40], v_port[40];
+            axis->output_warned = 1;
+            bw_format_double(x_port, sizeof x_port, axis->x);
+            bw_format_double(v_port, sizeof v_port, axis->v);
+            bw_log(inst, BW_WARNING, "logStatusWarning", "%s = %.4g %s at t = %.17g s exceeds %.3g %s, the %s of all "
+                   "the bushing's springs and dashpots at the largest plausible %s: check the units of the inputs "
+                   "(%s = %s %s, %s = %s %s; the FMU takes %s)", spec->output, outputs[a],
+                   spec->rotational ? "N.m" : "N", current_time + h, axis->output_bound, spec->rotational ? "N.m" : "N",
+                   spec->rotational ? "moment" : "force",
+                   spec->rotational ? "rotation and angular velocity" : "travel and speed", spec->displacement,
+                   x_port, spec->rotational ? "rad" : "m", spec->velocity, v_port, spec->rotational ? "rad/s" : "m/s",
+                   spec->rotational ? "radians" : "metres");
+        }
+        memcpy(axis->state, states[a], sizeof axis->state);
+        axis->state_x = axis->x_now = x_end[a];
+        axis->last_output = outputs[a];
+        axis->output_is_current = 1;
+    }
+    inst->data.time = current_time + h;
+    return BW_OK;
+}
+
+/* ------------------------------------------------------------------------------- model exchange
+   The host integrates the states: the continuous-state vector is every axis's states in the
+   order the FMU names them (its variables), in port units (m or rad, N or N.m). */
+
+static double bw_rate(bw_instance *inst, int a, int index) {
+    const bw_axis_spec *spec = &bw_axis_specs[a];
+    bw_axis *axis = &inst->data.axes[a];
+    double rates[BW_MAX_STATES];
+    if (!axis->usable) return 0.0;
+    spec->model->derivatives(&axis->constants, axis->state, axis->x_now, axis->v * spec->to_kernel, rates);
+    return rates[index];
+}
+
+static bw_status bw_wrong_count(bw_instance *inst, const char *what, size_t count, int expected) {
+    bw_log(inst, BW_ERROR, "logStatusError", "%s %lu values: this FMU has %d", what, (unsigned long)count, expected);
+    return BW_ERROR;
+}
+
+static bw_status bw_get_continuous_states(bw_instance *inst, double *values, size_t count) {
+    size_t k = 0;
+    int i;
+    if (count != BW_CONTINUOUS_STATES) return bw_wrong_count(inst, "continuous states: asked for", count, BW_CONTINUOUS_STATES);
+    for (i = 0; i < BW_VARIABLES && k < count; i++) {
+        const bw_variable *var = &bw_variables[i];
+        if (var->kind == BW_STATE) values[k++] = inst->data.axes[var->axis].state[var->index] * var->scale;
+    }
+    return BW_OK;
+}
+
+static bw_status bw_set_continuous_states(bw_instance *inst, const double *values, size_t count) {
+    size_t k = 0;
+    int i;
+    if (count != BW_CONTINUOUS_STATES) return bw_wrong_count(inst, "continuous states: given", count, BW_CONTINUOUS_STATES);
+    for (i = 0; i < BW_VARIABLES && k < count; i++) {
+        const bw_variable *var = &bw_variables[i];
+        bw_axis *axis = &inst->data.axes[var->axis];
+        if (var->kind != BW_STATE) continue;
+        axis->state[var->index] = values[k++] / var->scale;
+        axis->state_x = axis->x_now;      /* the host's state belongs to the inputs it set */
+        axis->output_is_current = 0;
+    }
+    return BW_OK;
+}
+
+static bw_status bw_derivatives(bw_instance *inst, double *values, size_t count) {
+    size_t k = 0;
+    int i;
+    if (count != BW_CONTINUOUS_STATES) return bw_wrong_count(inst, "derivatives: asked for", count, BW_CONTINUOUS_STATES);
+    if (!bw_check_parameters(inst)) {
+        bw_error(inst, "%s", "the derivatives cannot be computed: the parameters are invalid (see the errors above)");
+        return BW_ERROR;
+    }
+    for (i = 0; i < BW_VARIABLES && k < count; i++) {
+        const bw_variable *var = &bw_variables[i];
+        if (var->kind != BW_STATE) continue;
+        values[k] = bw_rate(inst, var->axis, var->index) * var->scale;
+        if (!isfinite(values[k])) {
+            bw_log(inst, BW_ERROR, "logStatusError", "the derivative of %s is not finite (%g): check the units of the "
+                   "inputs and the states set", var->name, values[k]);
+            return BW_ERROR;
+        }
+        k++;
+    }
+    return BW_OK;
+}
+
+static bw_status bw_event_indicators(bw_instance *inst, double *values, size_t count) {
+    size_t k = 0;
+    int a, i;
+    if (count != BW_EVENT_INDICATORS) return bw_wrong_count(inst, "event indicators: asked for", count, BW_EVENT_INDICATORS);
+    if (!bw_check_parameters(inst)) {
+        bw_error(inst, "%s", "the event indicators cannot be computed: the parameters are invalid");
+        return BW_ERROR;
+    }
+    for (a = 0; a < BW_AXES; a++) {
+        const bw_axis_spec *spec = &bw_axis_specs[a];
+        bw_axis *axis = &inst->data.axes[a];
+        double switches[BW_MAX_SWITCHES + 1];
+        spec->model->switch_values(&axis->constants, axis->state, axis->x_now, axis->v * spec->to_kernel, switches);
+        for (i = 0; i < spec->model->switches; i++) values[k++] = switches[i];
+    }
+    return BW_OK;
+}
+
+static void bw_nominals(double *values, size_t count) {
+    size_t k = 0;
+    int i;
+    for (i = 0; i < BW_VARIABLES && k < count; i++) {
+        if (bw_variables[i].kind == BW_STATE) values[k++] = bw_nominal[i];
+    }
+}
+
+/* ------------------------------------------------------------------------------- FMU state */
+
+#define BW_STATE_MAGIC 0x42575346u   /* "BWSF" */
+
+typedef struct {
+    unsigned int magic;
+    unsigned int size;
+    bw_data data;
+} bw_saved_state;
+
+static size_t bw_serialized_size(void) { return sizeof(bw_saved_state); }
+
+static void bw_save(const bw_instance *inst, bw_saved_state *saved) {
+    saved->magic = BW_STATE_MAGIC;
+    saved->size = (unsigned int)sizeof(bw_saved_state);
+    saved->data = inst->data;
+}
+
+static bw_status bw_restore(bw_instance *inst, const bw_saved_state *saved) {
+    if (saved->magic != BW_STATE_MAGIC || saved->size != sizeof(bw_saved_state)) {
+        bw_error(inst, "%s", "the FMU state was not saved by this FMU (or by another build of it)");
+        return BW_ERROR;
+    }
+    inst->data = saved->data;
+    return BW_OK;
+}

@@ -1,0 +1,227 @@
+"""The generated part of a native bushing FMU's C: ``bushing_model.c``.
+
+From the FMU's axes [(axes.Axis, model on that axis, parameters)] it writes
+
+- the models' kernels (``prepare``, ``initial_state``, ``step`` (``integration.step``), ``jump``,
+  ``force``, ``derivatives``, ``switches`` and the shared machinery they call), translated from
+  their Python source by ``python_to_c``;
+- per model, wrappers with the array interface of ``bw_model`` (``c/bushing_fmu.h``), and its
+  parameter rules (``ParameterSpec``, ``Constraint``) as tables;
+- the FMU's axes with their start values, its variables (``variables.fmu_variables`` and the
+  states' derivatives, numbered as the pythonfmu FMU numbers its variables) and the states'
+  nominal values.
+
+Nothing here knows a model's equations: a model added to ``bushing_models`` is generated too.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import uuid
+from dataclasses import dataclass
+
+from .. import integration
+from ..model_definition import DAMPING_UNITS, STIFFNESS_UNITS, BushingModel
+from ..variables import FmuVariable, derivative_variables, fmu_variables
+from .python_to_c import DOUBLE, INT, Translation, describe
+
+KINDS = {"parameter": "BW_PARAMETER", "displacement": "BW_DISPLACEMENT", "velocity": "BW_VELOCITY",
+         "output": "BW_OUTPUT", "state": "BW_STATE", "derivative": "BW_DERIVATIVE"}
+NOMINAL_DISPLACEMENT = {"m": 1e-3, "rad": 1e-2}
+"""Nominal values of displacement states (a bushing's travel: millimetres, or 0.6 degrees), so
+that a host's error control sees them at their size in m or rad."""
+NOMINAL_FORCE = {"N": 1000.0, "N.m": 1.0}
+"""Nominal values of hysteretic-force states: a kilonewton (a newton metre on rotational axes)."""
+
+
+def c_string(text: str) -> str:
+    return json.dumps(text)      # a C string literal for ASCII text (json escapes as C does)
+
+
+def c_double(value: float) -> str:
+    if value != value or value in (float("inf"), float("-inf")):
+        raise ValueError(f"{value} cannot be a start value")
+    text = repr(float(value))
+    return text if any(c in text for c in ".e") else text + ".0"
+
+
+class ModelCode:
+    """One model's translated kernels and the C types of their tuples."""
+
+    def __init__(self, translation: Translation, model: BushingModel):
+        self.model = model
+        self.name = model.name
+        parameters = (DOUBLE,) * len(model.specs)
+        self.parameters_type = parameters
+        prepare = translation.function(model.prepare, (parameters,))
+        self.constants_type = prepare.return_type
+        initial = translation.function(model.initial_state, (self.constants_type, DOUBLE))
+        self.state_type = initial.return_type
+        if not all(t == DOUBLE for t in self.state_type):
+            raise ValueError(f"{model.name}: a state must be a tuple of floats, not {describe(self.state_type)}")
+        m, s = self.constants_type, self.state_type
+        self.kernels = {
+            "prepare": prepare, "initial_state": initial,
+            "step": translation.function(model.step, (m, s, DOUBLE, DOUBLE, DOUBLE, DOUBLE, INT)),
+            "jump": translation.function(model.jump, (m, s, DOUBLE)),
+            "force": translation.function(model.force, (m, s, DOUBLE, DOUBLE)),
+            "derivatives": translation.function(model.derivatives, (m, s, DOUBLE, DOUBLE)),
+            "switches": translation.function(model.switches, (m, s, DOUBLE, DOUBLE)),
+        }
+        self.switches = len(self.kernels["switches"].return_type)
+        self.translation = translation
+
+    def state_literal(self, array: str) -> str:
+        fields = ", ".join(f"{array}[{i}]" for i in range(len(self.state_type))) or "0"
+        return f"({self.translation.c_type(self.state_type)}){{{fields}}}"
+
+    def wrappers(self) -> str:
+        """The array interface of ``bw_model`` around the translated kernels."""
+        k, name = self.kernels, self.name
+        constants = f"((const bw_constants *)c)->{name}"
+        states = len(self.state_type)
+        parameters = ", ".join(f"p[{i}]" for i in range(len(self.parameters_type)))
+        copy_state = lambda source, target: "".join(f"    {target}[{i}] = {source}.f{i};\n" for i in range(states)) \
+            or "    (void)s;\n"
+        lines = [
+            f"static void bw_{name}_prepare(const double *p, void *c) {{\n"
+            f"    ((bw_constants *)c)->{name} = {k['prepare'].name}(({self.translation.c_type(self.parameters_type)})"
+            f"{{{parameters}}});\n}}\n",
+            f"static void bw_{name}_initial_state(const void *c, double x0, double *s) {{\n"
+            f"    {self.translation.c_type(self.state_type)} r = {k['initial_state'].name}({constants}, x0);\n"
+            + (copy_state("r", "s") if states else "    (void)r;\n    (void)s;\n") + "}\n",
+            f"static int bw_{name}_step(const void *c, double *s, double state_x, double x, double v, double h, "
+            f"int max_substeps) {{\n"
+            f"    {self.translation.c_type(k['step'].return_type)} r = {k['step'].name}({constants}, "
+            f"{self.state_literal('s')}, state_x, x, v, h, max_substeps);\n"
+            + copy_state("r.f0", "s") + "    return r.f2;\n}\n",
+            f"static int bw_{name}_jump(const void *c, double *s, double jump) {{\n"
+            f"    {self.translation.c_type(k['jump'].return_type)} r = {k['jump'].name}({constants}, "
+            f"{self.state_literal('s')}, jump);\n" + copy_state("r.f0", "s") + "    return r.f1;\n}\n",
+            f"static double bw_{name}_force(const void *c, const double *s, double x, double v) {{\n"
+            + ("    (void)s;\n" if not states else "")
+            + f"    return {k['force'].name}({constants}, {self.state_literal('s')}, x, v);\n}}\n",
+        ]
+        for kernel, out in (("derivatives", "rates"), ("switches", "values")):
+            count = len(k[kernel].return_type)
+            lines.append(
+                f"static void bw_{name}_{kernel}(const void *c, const double *s, double x, double v, double *{out}) {{\n"
+                f"    {self.translation.c_type(k[kernel].return_type)} r = {k[kernel].name}({constants}, "
+                f"{self.state_literal('s')}, x, v);\n"
+                + ("".join(f"    {out}[{i}] = r.f{i};\n" for i in range(count)) or
+                   f"    (void)r;\n    (void){out};\n" + ("    (void)s;\n" if not states else "")) + "}\n")
+        return "\n".join(lines)
+
+    def tables(self, suffix: str, model: BushingModel) -> str:
+        """The parameter rules of ``model`` (this model on one kind of axis: its units) and its
+        ``bw_model``, named ``bw_model_<name><suffix>``."""
+        index = {spec.name: i for i, spec in enumerate(model.specs)}
+        specs = []
+        for spec in model.specs:
+            weight = index.get(model.gain_weight(spec.name), -1)
+            specs.append(f"    {{{c_string(spec.name)}, {c_string(spec.unit)}, {int(spec.minimum is not None)}, "
+                         f"{c_double(spec.minimum or 0.0)}, {int(spec.exclusive)}, {c_string(spec.why)}, "
+                         f"{int(spec.unit in STIFFNESS_UNITS)}, {int(spec.unit in DAMPING_UNITS)}, {weight}}}")
+        constraints = []
+        for c in model.constraints:
+            terms = list(c.terms)
+            parameters = ", ".join(str(index[name]) for name, _ in terms) or "0"
+            coefficients = ", ".join(c_double(coefficient) for _, coefficient in terms) or "0.0"
+            constraints.append(f"    {{{len(terms)}, {{{parameters}}}, {{{coefficients}}}, {c_double(c.bound)}, "
+                               f"{int(c.strict)}, {int(c.error)}, {c_string(c.expression)}, {c_string(c.unit)}, "
+                               f"{c_string(c.why)}}}")
+        name = f"{self.name}{suffix}"
+        out = f"static const bw_parameter_spec bw_specs_{name}[] = {{\n" + ",\n".join(specs) + "\n};\n"
+        if constraints:
+            out += f"static const bw_constraint bw_constraints_{name}[] = {{\n" + ",\n".join(constraints) + "\n};\n"
+        kernels = ", ".join(f"bw_{self.name}_{kernel}" for kernel in
+                            ("prepare", "initial_state", "step", "jump", "force", "derivatives", "switches"))
+        out += (f"static const bw_model bw_model_{name} = {{{c_string(self.name)}, {len(model.specs)}, "
+                f"{len(self.state_type)}, {self.switches}, bw_specs_{name}, {len(constraints)}, "
+                f"{'bw_constraints_' + name if constraints else 'NULL'}, {kernels}}};\n")
+        return out
+
+
+def all_variables(axis_models) -> list[FmuVariable]:
+    """The native FMU's variables: the pythonfmu FMU's, then the states' derivatives."""
+    variables = fmu_variables(axis_models)
+    return variables + derivative_variables(variables)
+
+
+def nominal(variable: FmuVariable) -> float:
+    """A state's nominal value (1.0 for the other variables)."""
+    if variable.kind != "state":
+        return 1.0
+    return NOMINAL_DISPLACEMENT.get(variable.unit) or NOMINAL_FORCE[variable.unit]
+
+
+@dataclass(frozen=True)
+class GeneratedModel:
+    source: str               # bushing_model.c
+    token: str                # the instantiation token (FMI 2: guid)
+    event_indicators: int
+
+
+def model_source(axis_models, identifier: str) -> GeneratedModel:
+    """bushing_model.c for an FMU whose axes are ``axis_models`` [(axes.Axis, model on that axis,
+    parameters)]. The instantiation token is derived from the C and the identifier, so a
+    rebuild of the same FMU gives the same token."""
+    translation = Translation(prefix="bw")
+    models: dict[str, ModelCode] = {}
+    for _, model, _ in axis_models:
+        if model.name not in models:
+            models[model.name] = ModelCode(translation, model)
+    variables = all_variables(axis_models)
+    kernels = translation.source()
+
+    parts = [kernels, "\ntypedef union {"]
+    parts += [f"    {translation.c_type(code.constants_type)} {name};" for name, code in models.items()]
+    parts.append("} bw_constants;\n")
+    for code in models.values():
+        parts.append(code.wrappers())
+    done = set()
+    for axis, model, _ in axis_models:
+        suffix = "_rotational" if axis.rotational else ""
+        if (model.name, suffix) not in done:
+            done.add((model.name, suffix))
+            parts.append(models[model.name].tables(suffix, model))
+    axis_lines = []
+    for position, (axis, model, parameters) in enumerate(axis_models):
+        values = ", ".join(c_double(parameters[spec.name]) for spec in model.specs)
+        parts.append(f"static const double bw_defaults_{position}[] = {{{values}}};")
+        suffix = "_rotational" if axis.rotational else ""
+        plausible = (1.0, 50.0) if axis.rotational else (100.0, 1000.0)
+        axis_lines.append(
+            f"    {{{c_string(axis.label)}, {c_string(axis.displacement)}, {c_string(axis.velocity)}, "
+            f"{c_string(axis.output)}, {int(axis.rotational)}, {c_double(axis.to_kernel)}, {c_double(axis.from_kernel)}, "
+            f"{c_double(axis.plausible_travel)}, {c_double(plausible[0])}, {c_double(plausible[1])}, "
+            f"&bw_model_{model.name}{suffix}, bw_defaults_{position}}}")
+    parts.append("\nstatic const bw_axis_spec bw_axis_specs[BW_AXES] = {\n" + ",\n".join(axis_lines) + "\n};\n")
+    parts.append("static const bw_variable bw_variables[BW_VARIABLES] = {\n" + ",\n".join(
+        f"    {{{c_string(v.name)}, {KINDS[v.kind]}, {v.axis}, {v.index}, {c_double(v.scale)}}}" for v in variables)
+        + "\n};\n")
+    parts.append("static const double bw_nominal[BW_VARIABLES] = {" + ", ".join(c_double(nominal(v)) for v in variables)
+                 + "};\n")
+    body = "\n".join(parts)
+
+    states = sum(v.kind == "state" for v in variables)
+    indicators = sum(models[m.name].switches for _, m, _ in axis_models)
+    token = "{" + str(uuid.UUID(hashlib.sha256((identifier + body).encode()).hexdigest()[:32])) + "}"
+    header = (
+        f"/* Generated by fmu_src/native/generate.py for the FMU {identifier}: the models' kernels translated\n"
+        " * from their Python source, the FMU's axes, variables and parameter rules. Do not edit: build the\n"
+        " * FMU again (build_fmu.py --native). */\n"
+        f"#define BW_MODEL_IDENTIFIER {c_string(identifier)}\n"
+        f"#define BW_INSTANTIATION_TOKEN {c_string(token)}\n"
+        f"#define BW_AXES {len(axis_models)}\n"
+        f"#define BW_VARIABLES {len(variables)}\n"
+        f"#define BW_MAX_PARAMETERS {max(len(m.specs) for _, m, _ in axis_models)}\n"
+        f"#define BW_MAX_STATES {max([1] + [len(code.state_type) for code in models.values()])}\n"
+        f"#define BW_MAX_SWITCHES {max([1] + [code.switches for code in models.values()])}\n"
+        f"#define BW_CONTINUOUS_STATES {states}\n"
+        f"#define BW_EVENT_INDICATORS {indicators}\n"
+        f"#define BW_KERNEL_OK {integration.OK}\n"
+        f"#define BW_KERNEL_TOO_MANY_SUBSTEPS {integration.TOO_MANY_SUBSTEPS}\n"
+        f"#define BW_KERNEL_NOT_FINITE {integration.NOT_FINITE}\n"
+        f"#define BW_MAX_SUBSTEPS {integration.DEFAULT_MAX_SUBSTEPS}\n\n")
+    return GeneratedModel(header + body, token, indicators)

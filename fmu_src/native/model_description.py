@@ -1,0 +1,110 @@
+"""modelDescription.xml of a native bushing FMU, FMI 2.0 or 3.0, from the same variable table as
+the pythonfmu FMU (``fmu_src/variables.py``): the same names, value references, causalities,
+units, descriptions and start values, plus the states' derivatives and the event indicators of
+model exchange.
+"""
+from __future__ import annotations
+
+import datetime
+from xml.dom.minidom import parseString
+from xml.etree import ElementTree as ET
+
+from .. import __version__
+from ..bushing_params import UNIT_DEFINITIONS
+from ..variables import FmuVariable, fmu_description
+from .generate import all_variables, c_double, nominal
+
+LOG_CATEGORIES = (("logStatusWarning", "Warnings: values accepted but doubtful (units, the paper's constraints)"),
+                  ("logStatusDiscard", "Steps refused"),
+                  ("logStatusError", "Errors: values that cannot be used, steps that cannot be taken"),
+                  ("logStatusFatal", "Fatal errors"),
+                  ("logAll", "Everything else"))
+INTERFACES = ("cs", "me")
+
+
+def _units(root: ET.Element, variables: list[FmuVariable], position: int) -> None:
+    definitions = ET.Element("UnitDefinitions")
+    for unit in sorted({v.unit for v in variables if v.unit}):
+        element = ET.SubElement(definitions, "Unit", name=unit)
+        base = UNIT_DEFINITIONS[unit]
+        if base is not None:
+            ET.SubElement(element, "BaseUnit", base)
+    root.insert(position, definitions)
+
+
+def _pretty(root: ET.Element) -> bytes:
+    text = parseString(ET.tostring(root, encoding="UTF-8")).toprettyxml(indent="  ", encoding="UTF-8")
+    return b"\n".join(line for line in text.splitlines() if line.strip()) + b"\n"
+
+
+def _common_attributes(identifier: str, token_name: str, token: str, axis_models, version: str) -> dict:
+    return {"fmiVersion": version, "modelName": identifier, token_name: token,
+            "description": fmu_description(axis_models), "author": "Bouc-Wen bushing project", "version": __version__,
+            "license": "MIT", "generationTool": f"boucwen-bushing {__version__} (build_fmu.py --native)",
+            "generationDateAndTime": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
+            "variableNamingConvention": "structured"}
+
+
+def _state_dependencies(variables, axis) -> list[FmuVariable]:
+    """What an axis's output depends on: its inputs and, in model exchange, its states."""
+    return [v for v in variables if v.axis == axis and v.kind in ("displacement", "velocity", "state")]
+
+
+def fmi2(axis_models, identifier: str, token: str, interfaces=INTERFACES, event_indicators: int = 0,
+         source_file: str | None = None) -> bytes:
+    """FMI 2.0 modelDescription.xml (``interfaces``: "cs" and/or "me")."""
+    variables = all_variables(axis_models)
+    attributes = _common_attributes(identifier, "guid", token, axis_models, "2.0")
+    if "me" in interfaces:
+        attributes["numberOfEventIndicators"] = str(event_indicators)
+    root = ET.Element("fmiModelDescription", attributes)
+    capabilities = {"modelIdentifier": identifier, "needsExecutionTool": "false",
+                    "canBeInstantiatedOnlyOncePerProcess": "false", "canNotUseMemoryManagementFunctions": "false",
+                    "canGetAndSetFMUstate": "true", "canSerializeFMUstate": "true",
+                    "providesDirectionalDerivative": "false"}
+    for interface in interfaces:
+        if interface == "me":
+            element = ET.SubElement(root, "ModelExchange", dict(capabilities, completedIntegratorStepNotNeeded="true"))
+        else:
+            element = ET.SubElement(root, "CoSimulation", dict(
+                capabilities, canHandleVariableCommunicationStepSize="true", canInterpolateInputs="false",
+                maxOutputDerivativeOrder="0", canRunAsynchronuously="false"))
+        if source_file:
+            ET.SubElement(ET.SubElement(element, "SourceFiles"), "File", name=source_file)
+    _units(root, variables, len(root))
+    categories = ET.SubElement(root, "LogCategories")
+    for name, description in LOG_CATEGORIES:
+        ET.SubElement(categories, "Category", name=name, description=description)
+    ET.SubElement(root, "DefaultExperiment", startTime="0.0", stopTime="1.0", stepSize="0.001")
+    model_variables = ET.SubElement(root, "ModelVariables")
+    index = {v.value_reference: i + 1 for i, v in enumerate(variables)}
+    for v in variables:
+        element = ET.SubElement(model_variables, "ScalarVariable", name=v.name, valueReference=str(v.value_reference),
+                                description=v.description, causality=v.causality, variability=v.variability)
+        real = {"unit": v.unit}
+        if v.start is not None:
+            real["start"] = c_double(v.start)
+        if v.kind == "derivative":
+            real["derivative"] = str(index[v.state])
+        if v.kind == "state":
+            real["nominal"] = c_double(nominal(v))
+        ET.SubElement(element, "Real", real)
+    structure = ET.SubElement(root, "ModelStructure")
+    outputs = ET.SubElement(structure, "Outputs")
+    for v in variables:
+        if v.kind == "output":
+            knowns = _state_dependencies(variables, v.axis) if "me" in interfaces else \
+                [k for k in variables if k.axis == v.axis and k.kind in ("displacement", "velocity")]
+            ET.SubElement(outputs, "Unknown", index=str(index[v.value_reference]),
+                          dependencies=" ".join(str(index[k.value_reference]) for k in knowns),
+                          dependenciesKind=" ".join("dependent" for _ in knowns))
+    if "me" in interfaces and any(v.kind == "derivative" for v in variables):
+        derivatives = ET.SubElement(structure, "Derivatives")
+        for v in variables:
+            if v.kind == "derivative":
+                ET.SubElement(derivatives, "Unknown", index=str(index[v.value_reference]))
+    initial = ET.SubElement(structure, "InitialUnknowns")
+    for v in variables:
+        if v.kind == "output" or ("me" in interfaces and v.kind in ("state", "derivative")):
+            ET.SubElement(initial, "Unknown", index=str(index[v.value_reference]))
+    return _pretty(root)
