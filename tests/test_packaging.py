@@ -60,6 +60,17 @@ def test_the_installed_build_finds_its_default_parameters_outside_the_checkout(i
     assert read_model_description(str(fmu)).version == __version__
 
 
+def test_the_installed_build_makes_a_native_fmu_outside_the_checkout(installed_wheel, tmp_path):
+    # the C layer ships with the package (package data), the generated C is written at build time
+    result = run_outside_the_checkout(installed_wheel, tmp_path,
+                                      "import sys, build_fmu\nsys.exit(build_fmu.main(['--native']))\n")
+    assert result.returncode == 0, result.stderr[-3000:]
+    fmu = tmp_path / "dist" / "BoucWenBushing.fmu"
+    with zipfile.ZipFile(fmu) as archive:
+        assert {"sources/bushing_instance.c", "sources/fmi2_functions.c", "binaries/linux64/BoucWenBushing.so"} \
+            <= set(archive.namelist())
+
+
 @pytest.mark.parametrize("script", ["bushing-identify", "bushing-build-fmu"])
 def test_console_scripts_print_the_projects_version_from_any_directory(script, tmp_path):
     path = BIN / script
