@@ -88,9 +88,12 @@ class Axis:
         return SMALL_ANGLE_RAD if self.rotational else PLAUSIBLE_TRAVEL_M
 
     def state_port(self, unit: str) -> tuple[str, float]:
-        """(FMU unit, kernel -> port factor) of a state declared in "N" or "m" (model_definition)."""
+        """(FMU unit, kernel -> port factor) of a state declared in "N", "m" or "m/s"
+        (model_definition)."""
         if unit == "N":
             return ("N.m", 1e-3) if self.rotational else ("N", 1.0)
+        if unit == "m/s":
+            return ("rad/s", 1.0) if self.rotational else ("m/s", 1e-3)
         return ("rad", 1.0) if self.rotational else ("m", 1e-3)
 
 

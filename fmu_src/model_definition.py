@@ -47,10 +47,11 @@ DAMPING_UNITS = ("N.s/mm", "N.mm.s/rad")
 
 @dataclass(frozen=True)
 class StateSpec:
-    """An internal state exposed by the FMU: entry ``index`` of the model's state tuple."""
+    """An internal state exposed by the FMU: entry ``index`` of the model's state tuple (or of
+    the ``switches`` tuple, for a switch)."""
     name: str
     index: int
-    unit: str      # "N" or "m" at the FMU (the kernels work in mm)
+    unit: str      # "N", "m" or "m/s" at the FMU (the kernels work in mm)
     meaning: str
 
 
@@ -71,6 +72,9 @@ class BushingModel:
     switches: Callable
     constraints: tuple[Constraint, ...] = ()
     """Conditions on several parameters beyond each value's range (errors or warnings)."""
+    switch_specs: tuple[StateSpec, ...] = ()
+    """What ``switches`` returns, in order (index: the position in its tuple; unit "m/s" or "N"
+    on a translational axis): the native FMU's event indicators."""
     step: Callable = field(init=False, repr=False, compare=False)
     """step(constants, state, state_x, x, v, h, max_substeps) -> (state, substeps, status): the
     step protocol of ``integration.step`` bound to this model's ``jump`` and ``integrate``."""

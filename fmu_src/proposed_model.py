@@ -175,4 +175,8 @@ MODEL = BushingModel(
      StateSpec("w", 2, "m", "displacement of the right plate (eq. 4)")),
     "params_table5_combined.json", prepare, initial_state, jump, integrate, force,
     derivatives, switches,
+    switch_specs=(StateSpec("u1", 0, "m/s", "relative velocity of block 1, v - dy/dt"),
+                  StateSpec("z1", 1, "N", "hysteretic force of block 1"),
+                  StateSpec("u2", 2, "m/s", "relative velocity of block 2, v - dw/dt"),
+                  StateSpec("z2", 3, "N", "hysteretic force of block 2")),
     constraints=CONSTRAINTS)

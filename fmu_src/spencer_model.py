@@ -124,4 +124,6 @@ MODEL = BushingModel(
      StateSpec("y", 0, "m", "internal displacement (between the Bouc-Wen element and c1)")),
     "params_spencer_fit_synthetic_table5.json", prepare, initial_state, jump, integrate, force,
     derivatives, switches,
+    switch_specs=(StateSpec("u", 0, "m/s", "relative velocity of the Bouc-Wen element, v - dy/dt"),
+                  StateSpec("z", 1, "N", "hysteretic force")),
     constraints=SINGLE_BLOCK_CONSTRAINTS)

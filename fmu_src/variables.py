@@ -22,7 +22,7 @@ class FmuVariable:
     unit: str
     description: str
     axis: int               # position of the axis in the FMU's axes
-    kind: str               # parameter, displacement, velocity, output, state, derivative
+    kind: str               # parameter, displacement, velocity, output, state, derivative, indicator
     index: int              # the parameter's position in spec order; the state's in the kernels' tuple
     scale: float = 1.0      # port value = scale * kernel value (states and their derivatives)
     start: float | None = None
@@ -72,6 +72,20 @@ def derivative_variables(variables: list[FmuVariable]) -> list[FmuVariable]:
                         f"rate of {s.name} [{s.unit}/s]", s.axis, "derivative", s.index, s.scale,
                         state=s.value_reference)
             for i, s in enumerate(states)]
+
+
+def indicator_variables(first_reference: int, axis_models) -> list[FmuVariable]:
+    """``<axis.>event.<switch>`` for every switch of every axis (``BushingModel.switch_specs``):
+    the quantities whose sign change is a state event, the event indicators of model exchange
+    (FMI 3 declares them as variables), numbered from ``first_reference``."""
+    out = []
+    for position, (axis, model, _) in enumerate(axis_models):
+        for switch in model.switch_specs:
+            unit, scale = axis.state_port(switch.unit)
+            out.append(FmuVariable(f"{axis.prefix}event.{switch.name}", first_reference + len(out), "local",
+                                   "continuous", unit, f"{axis.label}event indicator: {switch.meaning} (its sign "
+                                   f"changes at a switch) [{unit}]", position, "indicator", switch.index, scale))
+    return out
 
 
 def fmu_description(axis_models) -> str:

@@ -52,9 +52,12 @@ def test_native_fmu_validates_needs_no_python_and_has_the_pythonfmu_fmus_interfa
     shared = {v.name: declared(v) for v in python.modelVariables}
     mine = {v.name: declared(v) for v in native.modelVariables if v.name in shared}
     assert mine == shared    # every variable of the pythonfmu FMU, the same in every attribute
-    extra = [v for v in native.modelVariables if v.name not in shared]
-    assert all(v.name.startswith("der(") and v.derivative is not None for v in extra)   # model exchange's
-    assert len(extra) == native.numberOfContinuousStates
+    extra = [v for v in native.modelVariables if v.name not in shared]     # model exchange's, numbered after
+    derivatives = [v for v in extra if v.name.startswith("der(") and v.derivative is not None]
+    indicators = [v for v in extra if v.name.startswith("event.") or ".event." in v.name]
+    assert len(derivatives) == native.numberOfContinuousStates and len(indicators) == native.numberOfEventIndicators
+    assert len(extra) == len(derivatives) + len(indicators)
+    assert all(v.valueReference > max(p.valueReference for p in python.modelVariables) for v in extra)
 
 
 SIGNALS = {
@@ -152,3 +155,53 @@ def test_a_c_host_without_python_runs_the_native_fmu(native_fmus, tmp_path):
     # the host makes its inputs with C's sin and cos in metres: they differ from numpy's in the last bit
     np.testing.assert_allclose(rows[:, 1], simulate_python_core(paper_parameters("table5"), t, x, v)[1:], rtol=1e-9,
                                atol=1e-6)
+
+
+MINGW_GCC, MINGW_OBJDUMP = "x86_64-w64-mingw32-gcc", "x86_64-w64-mingw32-objdump"
+WINE = shutil.which("wine64") or ("/usr/lib/wine/wine64" if Path("/usr/lib/wine/wine64").exists() else None)
+
+
+def extracted_binary(fmu, platform, tmp_path):
+    import zipfile
+    with zipfile.ZipFile(fmu) as archive:
+        names = [n for n in archive.namelist() if n.startswith(f"binaries/{platform}/")]
+        if not names:
+            pytest.skip(f"the FMU has no {platform} binary (build_fmu.py builds it where mingw-w64 is installed: "
+                        "apt-get install gcc-mingw-w64-x86-64)")
+        archive.extractall(tmp_path)
+    return tmp_path / names[0]
+
+
+@pytest.mark.skipif(shutil.which(MINGW_OBJDUMP) is None,
+                    reason="needs mingw-w64's objdump (Debian: apt-get install gcc-mingw-w64-x86-64)")
+def test_the_win64_dll_is_pe32_plus_exports_fmi2_and_imports_no_python(native_fmus, tmp_path):
+    dll = extracted_binary(native_fmus["proposed"], "win64", tmp_path)
+    headers = subprocess.run([MINGW_OBJDUMP, "-p", str(dll)], capture_output=True, text=True, check=True).stdout
+    assert "Magic\t\t\t020b" in headers                      # PE32+ (64 bit)
+    imports = [line.split(":", 1)[1].strip() for line in headers.splitlines() if "DLL Name:" in line]
+    assert imports and not any("python" in name.lower() for name in imports), imports
+    for function in ("fmi2Instantiate", "fmi2DoStep", "fmi2GetDerivatives", "fmi2SerializeFMUstate"):
+        assert f"] {function}\n" in headers + "\n", function
+
+
+@pytest.mark.skipif(shutil.which(MINGW_GCC) is None or WINE is None or shutil.which("gcc") is None,
+                    reason="needs gcc, mingw-w64 and wine (Debian: apt-get install gcc-mingw-w64-x86-64 wine64)")
+def test_the_win64_dll_under_wine_gives_the_forces_of_linux64(native_fmus, tmp_path):
+    from test_c_host import HOST_SOURCE
+    path = native_fmus["proposed"]
+    description = read_model_description(str(path))
+    refs = {v.name: v.valueReference for v in description.modelVariables}
+    dll, so = extracted_binary(path, "win64", tmp_path), extracted_binary(path, "linux64", tmp_path)
+    subprocess.run([MINGW_GCC, "-O1", "-o", str(tmp_path / "host.exe"), str(HOST_SOURCE)], check=True)
+    subprocess.run(["gcc", "-O1", "-o", str(tmp_path / "host"), str(HOST_SOURCE), "-ldl", "-lm"], check=True)
+    arguments = [description.guid, "file:///", str(refs["x"]), str(refs["v"]), str(refs["F"]), "300", "0.001"]
+    windows = subprocess.run([WINE, str(tmp_path / "host.exe"), "-", str(dll), *arguments], capture_output=True,
+                             text=True, timeout=300, env={"WINEDEBUG": "-all", "HOME": str(Path.home()),
+                                                          "PATH": "/usr/bin:/bin"})
+    linux = subprocess.run([str(tmp_path / "host"), "-", str(so), *arguments], capture_output=True, text=True,
+                           timeout=60)
+    assert windows.returncode == 0 and linux.returncode == 0, windows.stderr[-2000:]
+    forces = [np.array([float(line.split()[1]) for line in run.stdout.splitlines()]) for run in (windows, linux)]
+    assert forces[0].size == forces[1].size == 300
+    # two C libraries' sin, cos and pow may differ in the last bit: 1e-12 of the peak force
+    assert np.max(np.abs(forces[0] - forces[1])) <= 1e-12 * np.max(np.abs(forces[1]))

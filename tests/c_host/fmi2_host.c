@@ -8,13 +8,27 @@
  * LIBPYTHON "-" loads none (a native FMU). It drives x = 2 mm * sin(2*pi*10*t) with the exact
  * velocity, prints "t F" after each step and every log message on stderr, and exits non-zero
  * on any status other than OK. On Linux it ends by saying on stderr whether libpython was
- * mapped into the process ("python in process: yes/no"). */
-#include <dlfcn.h>
+ * mapped into the process ("python in process: yes/no"). It builds for Windows too (mingw-w64),
+ * where it loads the FMU's DLL with LoadLibrary. */
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#ifdef _WIN32
+#include <windows.h>
+typedef HMODULE library;
+static library open_library(const char *path, int global) { (void)global; return LoadLibraryA(path); }
+static void *symbol(library handle, const char *name) { return (void *)(size_t)GetProcAddress(handle, name); }
+static const char *library_error(void) { return "LoadLibrary failed"; }
+#else
+#include <dlfcn.h>
+typedef void *library;
+static library open_library(const char *path, int global) { return dlopen(path, RTLD_NOW | (global ? RTLD_GLOBAL : RTLD_LOCAL)); }
+static void *symbol(library handle, const char *name) { return dlsym(handle, name); }
+static const char *library_error(void) { return dlerror(); }
+#endif
 
 typedef void *fmi2Component;
 typedef unsigned int fmi2ValueReference;
@@ -45,17 +59,17 @@ typedef fmi2Status (*GetReal)(fmi2Component, const fmi2ValueReference *, size_t,
 typedef fmi2Status (*DoStep)(fmi2Component, fmi2Real, fmi2Real, fmi2Boolean);
 typedef void (*FreeInstance)(fmi2Component);
 
-#define LOAD(type, name) type name = (type)dlsym(fmu, #name); if (!name) { fprintf(stderr, "missing %s\n", #name); return 3; }
+#define LOAD(type, name) type name = (type)symbol(fmu, #name); if (!name) { fprintf(stderr, "missing %s\n", #name); return 3; }
 #define CHECK(call) do { fmi2Status s_ = (call); if (s_ != fmi2OK) { fprintf(stderr, "%s returned %d\n", #call, s_); return 4; } } while (0)
 
 int main(int argc, char **argv) {
     if (argc != 10) { fprintf(stderr, "usage: see source\n"); return 1; }
-    if (strcmp(argv[1], "-") != 0 && !dlopen(argv[1], RTLD_NOW | RTLD_GLOBAL)) {
-        fprintf(stderr, "libpython: %s\n", dlerror());
+    if (strcmp(argv[1], "-") != 0 && !open_library(argv[1], 1)) {
+        fprintf(stderr, "libpython: %s\n", library_error());
         return 2;
     }
-    void *fmu = dlopen(argv[2], RTLD_NOW | RTLD_LOCAL);
-    if (!fmu) { fprintf(stderr, "fmu: %s\n", dlerror()); return 2; }
+    library fmu = open_library(argv[2], 0);
+    if (!fmu) { fprintf(stderr, "fmu: %s\n", library_error()); return 2; }
     LOAD(Instantiate, fmi2Instantiate)
     LOAD(SetupExperiment, fmi2SetupExperiment)
     LOAD(Transition, fmi2EnterInitializationMode)

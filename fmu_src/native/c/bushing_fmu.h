@@ -21,15 +21,16 @@ typedef enum { BW_OK = 0, BW_WARNING = 1, BW_DISCARD = 2, BW_ERROR = 3, BW_FATAL
 
 /* What a variable of the FMU is (fmu_src/variables.py). */
 typedef enum {
-    BW_PARAMETER, BW_DISPLACEMENT, BW_VELOCITY, BW_OUTPUT, BW_STATE, BW_DERIVATIVE
+    BW_PARAMETER, BW_DISPLACEMENT, BW_VELOCITY, BW_OUTPUT, BW_STATE, BW_DERIVATIVE, BW_INDICATOR
 } bw_kind;
 
 typedef struct {
     const char *name;
     bw_kind kind;
     int axis;          /* position of its axis */
-    int index;         /* parameter: position in spec order; state and derivative: kernel state index */
-    double scale;      /* port value = scale * kernel value (states, derivatives) */
+    int index;         /* parameter: position in spec order; state and derivative: kernel state index;
+                          indicator: position in the model's switches */
+    double scale;      /* port value = scale * kernel value (states, derivatives, indicators) */
 } bw_variable;
 
 /* A parameter's allowed range (bushing_params.ParameterSpec): value >= minimum (> if

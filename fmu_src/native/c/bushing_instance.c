@@ -350,6 +350,7 @@ static bw_status bw_set_real(bw_instance *inst, unsigned int reference, double v
 }
 
 static double bw_rate(bw_instance *inst, int a, int index);
+static double bw_switch(bw_instance *inst, int a, int index);
 
 static bw_status bw_get_real(bw_instance *inst, unsigned int reference, double *value) {
     const bw_variable *var;
@@ -368,6 +369,7 @@ static bw_status bw_get_real(bw_instance *inst, unsigned int reference, double *
     case BW_OUTPUT: *value = bw_output(inst, var->axis); break;
     case BW_STATE: *value = axis->state[var->index] * var->scale; break;
     case BW_DERIVATIVE: *value = bw_rate(inst, var->axis, var->index) * var->scale; break;
+    case BW_INDICATOR: *value = bw_switch(inst, var->axis, var->index) * var->scale; break;
     }
     return BW_OK;
 }
@@ -489,6 +491,15 @@ static double bw_rate(bw_instance *inst, int a, int index) {
     return rates[index];
 }
 
+static double bw_switch(bw_instance *inst, int a, int index) {
+    const bw_axis_spec *spec = &bw_axis_specs[a];
+    bw_axis *axis = &inst->data.axes[a];
+    double values[BW_MAX_SWITCHES];
+    if (!axis->usable) return 0.0;
+    spec->model->switch_values(&axis->constants, axis->state, axis->x_now, axis->v * spec->to_kernel, values);
+    return values[index];
+}
+
 static bw_status bw_wrong_count(bw_instance *inst, const char *what, size_t count, int expected) {
     bw_log(inst, BW_ERROR, "logStatusError", "%s %lu values: this FMU has %d", what, (unsigned long)count, expected);
     return BW_ERROR;
@@ -544,18 +555,15 @@ static bw_status bw_derivatives(bw_instance *inst, double *values, size_t count)
 
 static bw_status bw_event_indicators(bw_instance *inst, double *values, size_t count) {
     size_t k = 0;
-    int a, i;
+    int i;
     if (count != BW_EVENT_INDICATORS) return bw_wrong_count(inst, "event indicators: asked for", count, BW_EVENT_INDICATORS);
     if (!bw_check_parameters(inst)) {
         bw_error(inst, "%s", "the event indicators cannot be computed: the parameters are invalid");
         return BW_ERROR;
     }
-    for (a = 0; a < BW_AXES; a++) {
-        const bw_axis_spec *spec = &bw_axis_specs[a];
-        bw_axis *axis = &inst->data.axes[a];
-        double switches[BW_MAX_SWITCHES + 1];
-        spec->model->switch_values(&axis->constants, axis->state, axis->x_now, axis->v * spec->to_kernel, switches);
-        for (i = 0; i < spec->model->switches; i++) values[k++] = switches[i];
+    for (i = 0; i < BW_VARIABLES && k < count; i++) {
+        const bw_variable *var = &bw_variables[i];
+        if (var->kind == BW_INDICATOR) values[k++] = bw_switch(inst, var->axis, var->index) * var->scale;
     }
     return BW_OK;
 }
