@@ -98,6 +98,7 @@ UNIT_DEFINITIONS: dict[str, dict[str, str] | None] = {
     # name -> SI base-unit exponents and factor (value_SI = factor * value), as FMI and SSP
     # write them; None: no SI form.
     "m": {"m": "1"},
+    "s": {"s": "1"},
     "m/s": {"m": "1", "s": "-1"},
     "N": {"kg": "1", "m": "1", "s": "-2"},
     "N/mm": {"kg": "1", "s": "-2", "factor": "1000"},

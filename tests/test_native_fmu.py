@@ -205,3 +205,85 @@ def test_the_win64_dll_under_wine_gives_the_forces_of_linux64(native_fmus, tmp_p
     assert forces[0].size == forces[1].size == 300
     # two C libraries' sin, cos and pow may differ in the last bit: 1e-12 of the peak force
     assert np.max(np.abs(forces[0] - forces[1])) <= 1e-12 * np.max(np.abs(forces[1]))
+
+
+@pytest.fixture(scope="module")
+def native_fmi3_fmus(tmp_path_factory):
+    """Each model's native FMU as FMI 3.0."""
+    folder = tmp_path_factory.mktemp("native_fmi3")
+    return {name: build_fmu.build_native_fmu(out_dir=folder, model=name, fmi_version=3).path for name in FMUS}
+
+
+@pytest.mark.parametrize("name", FMUS)
+def test_fmi3_fmu_validates_and_declares_the_fmi2_fmus_variables(native_fmus, native_fmi3_fmus, name):
+    assert validate_fmu(str(native_fmi3_fmus[name])) == []
+    fmi3, fmi2 = (read_model_description(str(fmus[name])) for fmus in (native_fmi3_fmus, native_fmus))
+    assert fmi3.fmiVersion == "3.0" and not fmi3.coSimulation.needsExecutionTool
+    assert [(v.name, v.valueReference, v.causality, v.unit) for v in fmi3.modelVariables] == \
+        [(v.name, v.valueReference, v.causality, v.unit) for v in fmi2.modelVariables]
+    assert fmi3.numberOfEventIndicators == fmi2.numberOfEventIndicators
+
+
+@pytest.mark.parametrize("signal", ["sine", "jumps"])
+@pytest.mark.parametrize("name", MODELS)
+def test_fmi3_co_simulation_equals_fmi2(native_fmus, native_fmi3_fmus, name, signal):
+    t = sample_times(0.4, 1000.0)
+    x, v = SIGNALS[signal](t)
+    fmi2 = simulate_with_fmpy(native_fmus[name], t, x, v)
+    fmi3 = simulate_with_fmpy(native_fmi3_fmus[name], t, x, v)
+    assert np.max(np.abs(fmi3 - fmi2)) <= 1e-12 * np.max(np.abs(fmi2))
+
+
+def test_fmi3_six_axis_co_simulation_equals_fmi2(native_fmus, native_fmi3_fmus):
+    t = np.arange(0.0, 0.3, 1e-3)
+    signals = axis_signals(t)
+    fmi2, fmi3 = run_with_fmpy(native_fmus["six_axis"], t, signals), run_with_fmpy(native_fmi3_fmus["six_axis"], t,
+                                                                                   signals)
+    for output, values in fmi2.items():
+        assert np.max(np.abs(fmi3[output] - values)) <= 1e-12 * np.max(np.abs(values)), output
+
+
+def test_fmi3_model_exchange_equals_fmi2s_and_follows_radau(native_fmus, native_fmi3_fmus):
+    displacement, velocity = sine_functions(2.0, 10.0)
+    t = sample_times(0.3, 1000.0)
+    runs = [simulate_model_exchange(fmus["proposed"], t, lambda s: displacement(s) * MM,
+                                    lambda s: float(velocity(s)) * MM) for fmus in (native_fmus, native_fmi3_fmus)]
+    np.testing.assert_array_equal(runs[1].force_N, runs[0].force_N)      # the same C, the same integrator
+    assert (runs[1].events, runs[1].steps) == (runs[0].events, runs[0].steps)
+    reference = paper_force(paper_parameters("table5"), t, displacement, velocity, rtol=1e-10, atol=1e-10)
+    assert np.max(np.abs(runs[1].force_N - reference)) <= 1e-3 * np.max(np.abs(reference))
+
+
+def test_fmi3_state_is_saved_restored_and_serialized_bit_for_bit(native_fmi3_fmus):
+    from fmpy import extract
+    from fmpy.fmi3 import FMU3Slave
+    path = native_fmi3_fmus["proposed"]
+    description = read_model_description(str(path))
+    refs = {v.name: v.valueReference for v in description.modelVariables}
+    fmu = FMU3Slave(guid=description.guid, unzipDirectory=extract(str(path)),
+                    modelIdentifier=description.coSimulation.modelIdentifier, instanceName="fmi3")
+    fmu.instantiate()
+    fmu.enterInitializationMode()
+    fmu.exitInitializationMode()
+    t = np.arange(0.0, 0.1, 1e-3)
+    x, v = Sine(2.0, 10.0).signals(t)
+
+    def drive(first, count):
+        forces = []
+        for k in range(first, first + count):
+            fmu.setFloat64([refs["x"], refs["v"]], [x[k] * MM, v[k] * MM])
+            fmu.doStep(currentCommunicationPoint=t[k], communicationStepSize=1e-3)
+            forces.append(fmu.getFloat64([refs["F"], refs["z1"], refs["w"]]))
+        return forces
+
+    drive(0, 40)
+    saved = fmu.getFMUState()
+    serialized = fmu.serializeFMUState(saved)
+    first = drive(40, 40)
+    fmu.setFMUState(saved)
+    assert drive(40, 40) == first
+    fmu.setFMUState(fmu.deserializeFMUState(serialized))
+    assert drive(40, 40) == first
+    fmu.freeFMUState(saved)
+    fmu.terminate()
+    fmu.freeInstance()

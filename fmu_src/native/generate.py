@@ -26,7 +26,8 @@ from ..variables import FmuVariable, derivative_variables, fmu_variables, indica
 from .python_to_c import DOUBLE, INT, Translation, describe
 
 KINDS = {"parameter": "BW_PARAMETER", "displacement": "BW_DISPLACEMENT", "velocity": "BW_VELOCITY",
-         "output": "BW_OUTPUT", "state": "BW_STATE", "derivative": "BW_DERIVATIVE", "indicator": "BW_INDICATOR"}
+         "output": "BW_OUTPUT", "state": "BW_STATE", "derivative": "BW_DERIVATIVE", "indicator": "BW_INDICATOR",
+         "time": "BW_TIME"}
 NOMINAL_DISPLACEMENT = {"m": 1e-3, "rad": 1e-2}
 """Nominal values of displacement states (a bushing's travel: millimetres, or 0.6 degrees), so
 that a host's error control sees them at their size in m or rad."""
@@ -146,11 +147,13 @@ class ModelCode:
 
 
 def all_variables(axis_models) -> list[FmuVariable]:
-    """The native FMU's variables: the pythonfmu FMU's, then the states' derivatives and the
-    event indicators."""
+    """The native FMU's variables: the pythonfmu FMU's, then the states' derivatives, the event
+    indicators and the time (FMI 3 requires the independent variable)."""
     variables = fmu_variables(axis_models)
     variables += derivative_variables(variables)
-    return variables + indicator_variables(len(variables), axis_models)
+    variables += indicator_variables(len(variables), axis_models)
+    return variables + [FmuVariable("time", len(variables), "independent", "continuous", "s",
+                                    "simulation time [s]", 0, "time", 0)]
 
 
 def nominal(variable: FmuVariable) -> float:

@@ -108,3 +108,58 @@ def fmi2(axis_models, identifier: str, token: str, interfaces=INTERFACES, event_
         if v.kind == "output" or ("me" in interfaces and v.kind in ("state", "derivative")):
             ET.SubElement(initial, "Unknown", index=str(index[v.value_reference]))
     return _pretty(root)
+
+
+def fmi3(axis_models, identifier: str, token: str) -> bytes:
+    """FMI 3.0 modelDescription.xml, co-simulation and model exchange."""
+    variables = all_variables(axis_models)
+    root = ET.Element("fmiModelDescription", _common_attributes(identifier, "instantiationToken", token, axis_models,
+                                                                "3.0"))
+    capabilities = {"modelIdentifier": identifier, "needsExecutionTool": "false",
+                    "canBeInstantiatedOnlyOncePerProcess": "false", "canGetAndSetFMUState": "true",
+                    "canSerializeFMUState": "true", "providesDirectionalDerivatives": "false"}
+    ET.SubElement(root, "ModelExchange", dict(capabilities, needsCompletedIntegratorStep="false"))
+    ET.SubElement(root, "CoSimulation", dict(capabilities, canHandleVariableCommunicationStepSize="true",
+                                             maxOutputDerivativeOrder="0"))
+    _units(root, variables, len(root))
+    categories = ET.SubElement(root, "LogCategories")
+    for name, description in LOG_CATEGORIES:
+        ET.SubElement(categories, "Category", name=name, description=description)
+    ET.SubElement(root, "DefaultExperiment", startTime="0.0", stopTime="1.0", stepSize="0.001")
+    model_variables = ET.SubElement(root, "ModelVariables")
+    for v in variables:
+        attributes = {"name": v.name, "valueReference": str(v.value_reference), "description": v.description,
+                      "causality": v.causality, "variability": v.variability, "unit": v.unit}
+        if v.start is not None:
+            attributes["start"] = c_double(v.start)
+        if v.kind == "derivative":
+            attributes["derivative"] = str(v.state)
+        if v.kind == "state":
+            attributes["nominal"] = c_double(nominal(v))
+        ET.SubElement(model_variables, "Float64", attributes)
+    structure = ET.SubElement(root, "ModelStructure")
+    for v in variables:
+        if v.kind == "output":
+            knowns = _state_dependencies(variables, v.axis)
+            ET.SubElement(structure, "Output", valueReference=str(v.value_reference),
+                          dependencies=" ".join(str(k.value_reference) for k in knowns),
+                          dependenciesKind=" ".join("dependent" for _ in knowns))
+    for v in variables:
+        if v.kind == "derivative":
+            ET.SubElement(structure, "ContinuousStateDerivative", valueReference=str(v.value_reference))
+    for v in variables:
+        if v.kind in ("output", "state", "derivative"):
+            ET.SubElement(structure, "InitialUnknown", valueReference=str(v.value_reference))
+    for v in variables:
+        if v.kind == "indicator":
+            ET.SubElement(structure, "EventIndicator", valueReference=str(v.value_reference))
+    return _pretty(root)
+
+
+def build_description(identifier: str) -> bytes:
+    """FMI 3.0 sources/buildDescription.xml: the one C99 translation unit."""
+    root = ET.Element("fmiBuildDescription", fmiVersion="3.0")
+    configuration = ET.SubElement(root, "BuildConfiguration", modelIdentifier=identifier)
+    files = ET.SubElement(configuration, "SourceFileSet", language="C99")
+    ET.SubElement(files, "SourceFile", name=f"{identifier}.c")
+    return _pretty(root)

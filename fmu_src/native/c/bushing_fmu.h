@@ -21,7 +21,7 @@ typedef enum { BW_OK = 0, BW_WARNING = 1, BW_DISCARD = 2, BW_ERROR = 3, BW_FATAL
 
 /* What a variable of the FMU is (fmu_src/variables.py). */
 typedef enum {
-    BW_PARAMETER, BW_DISPLACEMENT, BW_VELOCITY, BW_OUTPUT, BW_STATE, BW_DERIVATIVE, BW_INDICATOR
+    BW_PARAMETER, BW_DISPLACEMENT, BW_VELOCITY, BW_OUTPUT, BW_STATE, BW_DERIVATIVE, BW_INDICATOR, BW_TIME
 } bw_kind;
 
 typedef struct {

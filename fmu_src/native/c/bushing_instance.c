@@ -370,6 +370,7 @@ static bw_status bw_get_real(bw_instance *inst, unsigned int reference, double *
     case BW_STATE: *value = axis->state[var->index] * var->scale; break;
     case BW_DERIVATIVE: *value = bw_rate(inst, var->axis, var->index) * var->scale; break;
     case BW_INDICATOR: *value = bw_switch(inst, var->axis, var->index) * var->scale; break;
+    case BW_TIME: *value = inst->data.time; break;
     }
     return BW_OK;
 }
