@@ -62,6 +62,7 @@ def test_the_momentum_check_sees_a_lost_or_reversed_moment(road_runs):
         assert engine_mount.momentum_balance(altered, STEP, body)["angular momentum"] > 1e-3
 
 
+@pytest.mark.slow
 def test_kelvin_voigt_natural_frequencies_match_the_linearised_system(tmp_path):
     step = 5e-4
     measured, linearised, run = engine_mount.free_decay(tmp_path, step, 2.0)

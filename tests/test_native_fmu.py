@@ -56,7 +56,8 @@ def test_native_fmu_validates_needs_no_python_and_has_the_pythonfmu_fmus_interfa
     derivatives = [v for v in extra if v.name.startswith("der(") and v.derivative is not None]
     indicators = [v for v in extra if v.name.startswith("event.") or ".event." in v.name]
     assert len(derivatives) == native.numberOfContinuousStates and len(indicators) == native.numberOfEventIndicators
-    assert len(extra) == len(derivatives) + len(indicators)
+    assert [v.causality for v in extra if v not in derivatives + indicators] == ["independent"]   # time
+    assert len(extra) == len(derivatives) + len(indicators) + 1
     assert all(v.valueReference > max(p.valueReference for p in python.modelVariables) for v in extra)
 
 
@@ -98,7 +99,7 @@ def ramp_functions(amplitude_mm, rise_s):
 
 
 @pytest.mark.parametrize("case, functions, duration_s", [
-    ("sine 2 mm 10 Hz", sine_functions(2.0, 10.0), 0.5),
+    pytest.param("sine 2 mm 10 Hz", sine_functions(2.0, 10.0), 0.5, marks=pytest.mark.slow),
     ("step 2 mm, rise 0.4 s", ramp_functions(2.0, 0.4), 1.0),
 ])
 def test_model_exchange_with_cvode_follows_radau_on_the_papers_equations(native_fmus, case, functions, duration_s,
@@ -184,6 +185,7 @@ def test_the_win64_dll_is_pe32_plus_exports_fmi2_and_imports_no_python(native_fm
         assert f"] {function}\n" in headers + "\n", function
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(shutil.which(MINGW_GCC) is None or WINE is None or shutil.which("gcc") is None,
                     reason="needs gcc, mingw-w64 and wine (Debian: apt-get install gcc-mingw-w64-x86-64 wine64)")
 def test_the_win64_dll_under_wine_gives_the_forces_of_linux64(native_fmus, tmp_path):
@@ -245,7 +247,7 @@ def test_fmi3_six_axis_co_simulation_equals_fmi2(native_fmus, native_fmi3_fmus):
 
 def test_fmi3_model_exchange_equals_fmi2s_and_follows_radau(native_fmus, native_fmi3_fmus):
     displacement, velocity = sine_functions(2.0, 10.0)
-    t = sample_times(0.3, 1000.0)
+    t = sample_times(0.12, 1000.0)      # through the first reversal of both blocks
     runs = [simulate_model_exchange(fmus["proposed"], t, lambda s: displacement(s) * MM,
                                     lambda s: float(velocity(s)) * MM) for fmus in (native_fmus, native_fmi3_fmus)]
     np.testing.assert_array_equal(runs[1].force_N, runs[0].force_N)      # the same C, the same integrator
