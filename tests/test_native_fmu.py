@@ -289,3 +289,37 @@ def test_fmi3_state_is_saved_restored_and_serialized_bit_for_bit(native_fmi3_fmu
     fmu.freeFMUState(saved)
     fmu.terminate()
     fmu.freeInstance()
+
+
+def sanitizers_work(tmp_path) -> bool:
+    probe = tmp_path / "probe.c"
+    probe.write_text("int main(void) { return 0; }\n")
+    result = subprocess.run(["gcc", "-fsanitize=address,undefined", "-o", str(tmp_path / "probe"), str(probe)],
+                            capture_output=True)
+    return result.returncode == 0 and subprocess.run([str(tmp_path / "probe")], capture_output=True).returncode == 0
+
+
+@pytest.mark.skipif(shutil.which("gcc") is None, reason="needs gcc")
+def test_a_sanitizer_build_survives_bad_inputs_state_restores_and_1000_instances(tmp_path):
+    from fmu_src.native.build import FLAGS, WARNINGS, write_sources
+    from test_c_host import HOST_SOURCE
+    if not sanitizers_work(tmp_path):
+        pytest.skip("gcc here cannot build and run with -fsanitize=address,undefined (libasan, libubsan)")
+    identifier, _, axes, _ = build_fmu.fmu_axes()
+    generated = write_sources(tmp_path / "sources", axes, identifier, 2)
+    sanitize = ["-fsanitize=address,undefined", "-fno-sanitize-recover=all", "-fno-omit-frame-pointer", "-g"]
+    library = tmp_path / f"{identifier}.so"
+    subprocess.run(["gcc", *WARNINGS, *[f for f in FLAGS if f != "-O2"], "-O1", *sanitize, "-shared", "-I",
+                    str(tmp_path / "sources"), "-o", str(library), str(tmp_path / "sources" / f"{identifier}.c"), "-lm"],
+                   check=True)
+    master = tmp_path / "native_checks"
+    subprocess.run(["gcc", "-std=c99", "-Wall", "-Wextra", "-Werror", *sanitize, "-I", str(tmp_path / "sources"), "-o",
+                    str(master), str(HOST_SOURCE.with_name("native_checks.c")), "-ldl", "-lm"], check=True)
+    refs = {v.name: v.value_reference for v in __import__("fmu_src.native.generate", fromlist=["all_variables"])
+            .all_variables(axes)}
+    result = subprocess.run([str(master), str(library), generated.token, str(refs["x"]), str(refs["v"]),
+                             str(refs["F"]), str(refs["c1"])], capture_output=True, text=True, timeout=300,
+                            env={"PATH": "/usr/bin:/bin", "ASAN_OPTIONS": "detect_leaks=1:abort_on_error=0",
+                                 "UBSAN_OPTIONS": "print_stacktrace=1"})
+    assert result.returncode == 0, result.stderr[-4000:]
+    assert "all checks passed" in result.stdout and "runtime error" not in result.stderr
