@@ -74,3 +74,16 @@ def test_an_invalid_parameter_fails_libcosims_run_and_reaches_its_log(rig_runs, 
     log = result.stdout + result.stderr  # libcosim's console sink writes to stdout
     assert "category=logStatusError" in log and "c1 = 0.0 [N.s/mm] must be > 0" in log
     assert result.returncode == 0    # a failed step, not an aborted process
+
+
+def test_with_native_bushing_fmus_libcosim_and_fmpy_agree_and_give_the_pythonfmu_systems_outputs(rig_runs,
+                                                                                              tmp_path):
+    # The same rig with the compiled bushing FMU (the body stays a pythonfmu FMU)
+    _, libcosim_python, _ = rig_runs
+    bushing_fmu, body_fmu = shaker_rig.build_fmus(tmp_path / "fmus", native=True)
+    system_dir = tmp_path / "ShakerRig"
+    shaker_rig.write_ssp(system_dir, bushing_fmu, body_fmu, STOP)
+    libcosim = shaker_rig.run_libcosim(system_dir, STEP, STOP)
+    fmpy_run = shaker_rig.run_fmpy(bushing_fmu, body_fmu, system_dir, STEP, STOP)
+    assert max(shaker_rig.largest_difference(libcosim, fmpy_run).values()) <= 1e-12
+    assert max(shaker_rig.largest_difference(libcosim, libcosim_python).values()) <= 1e-12

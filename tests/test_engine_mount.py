@@ -43,6 +43,18 @@ def test_libcosim_and_fmpy_agree_on_the_engine(road_runs):
             assert np.max(np.abs(libcosim[f"bushing_{mount}.{name}"])) > 1e-3
 
 
+def test_with_native_six_axis_fmus_libcosim_and_fmpy_agree_and_give_the_pythonfmu_systems_outputs(road_runs,
+                                                                                                  tmp_path):
+    _, libcosim_python, _ = road_runs
+    bushing_fmu, body_fmu = engine_mount.build_fmus(tmp_path / "fmus", native=True)
+    body = engine_mount.body_parameters()
+    parts = engine_mount.write_system(tmp_path / "EngineMount", bushing_fmu, body_fmu, STOP, body)
+    libcosim = ssp_system.run_libcosim(tmp_path / "EngineMount", parts, STEP, STOP)
+    fmpy_run = ssp_system.run_fmpy(parts, engine_mount.connections(), STEP, STOP)
+    assert max(ssp_system.largest_difference(libcosim, fmpy_run).values()) <= 1e-12
+    assert max(ssp_system.largest_difference(libcosim, libcosim_python).values()) <= 1e-12
+
+
 def test_momentum_changes_by_the_bushing_impulses(road_runs):
     body, _, fmpy_run = road_runs
     balance = engine_mount.momentum_balance(fmpy_run, STEP, body)

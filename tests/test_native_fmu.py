@@ -323,3 +323,30 @@ def test_a_sanitizer_build_survives_bad_inputs_state_restores_and_1000_instances
                                  "UBSAN_OPTIONS": "print_stacktrace=1"})
     assert result.returncode == 0, result.stderr[-4000:]
     assert "all checks passed" in result.stdout and "runtime error" not in result.stderr
+
+
+@pytest.mark.slow
+def test_a_fresh_environment_with_fmpy_and_without_pythonfmu_runs_the_native_fmu(native_fmus, tmp_path):
+    import venv
+    from fmpy import __version__ as fmpy_version
+    environment = tmp_path / "venv"
+    venv.EnvBuilder(with_pip=True).create(environment)
+    python = environment / "bin" / "python"
+    installed = subprocess.run([str(python), "-m", "pip", "install", "-q", f"fmpy=={fmpy_version}"],
+                               capture_output=True, text=True, timeout=900)
+    assert installed.returncode == 0, installed.stderr[-3000:]
+    script = ("import importlib.util, sys, numpy as np\n"
+              "from fmpy import simulate_fmu\n"
+              "assert importlib.util.find_spec('pythonfmu') is None, 'pythonfmu is installed'\n"
+              "t = np.arange(0, 0.201, 1e-3)\n"
+              "table = np.array(list(zip(t, 2e-3*np.sin(20*np.pi*t), 2e-3*20*np.pi*np.cos(20*np.pi*t))),\n"
+              "                 dtype=[('time', float), ('x', float), ('v', float)])\n"
+              "result = simulate_fmu(sys.argv[1], stop_time=0.2, step_size=1e-3, input=table, output=['F'])\n"
+              "print('peak', np.max(np.abs(result['F'])))\n")
+    run = subprocess.run([str(python), "-c", script, str(native_fmus["proposed"])], capture_output=True, text=True,
+                         timeout=300, cwd=tmp_path)
+    assert run.returncode == 0, run.stderr[-3000:]
+    t = sample_times(0.2, 1000.0)
+    x, v = Sine(2.0, 10.0).signals(t)
+    here = simulate_with_fmpy(native_fmus["proposed"], t, x, v)
+    assert float(run.stdout.split()[-1]) == pytest.approx(np.max(np.abs(here)), rel=1e-9)

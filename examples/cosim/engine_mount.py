@@ -1,7 +1,7 @@
 """Engine on three six-axis bushings: a multibody co-simulation that checks the bushing's frames.
 
     python examples/cosim/engine_mount.py [--stop 1.0] [--step 0.001] [--decay 3.0] [--decay-step 0.0005]
-                                          [--out out/engine_mount]
+                                          [--out out/engine_mount] [--native]
 
 The system: a 160 kg engine (``EngineBody`` in ``engine_body.py``, its own pythonfmu FMU: mass,
 full inertia tensor, 6 DOF) on three ``SixAxisBushing`` FMUs at different positions and
@@ -85,10 +85,14 @@ def kelvin_voigt_axes() -> dict:
             for axis, k in KELVIN_VOIGT_AXES.items()}
 
 
-def build_fmus(out_dir: Path, bushing_params: Path = BUSHING_SET) -> tuple[Path, Path]:
-    """The six-axis bushing FMU (defaults from ``bushing_params``) and the body FMU."""
+def build_fmus(out_dir: Path, bushing_params: Path = BUSHING_SET, native: bool = False) -> tuple[Path, Path]:
+    """The six-axis bushing FMU (defaults from ``bushing_params``; ``native``: the compiled one)
+    and the body FMU."""
     import build_fmu
-    bushing = build_fmu.build_fmu(params_file=bushing_params, out_dir=out_dir, model="six_axis")
+    if native:
+        bushing = build_fmu.build_native_fmu(params_file=bushing_params, out_dir=out_dir, model="six_axis").path
+    else:
+        bushing = build_fmu.build_fmu(params_file=bushing_params, out_dir=out_dir, model="six_axis")
     return bushing, ssp_system.build_pythonfmu(HERE / "engine_body.py", out_dir)
 
 
@@ -251,10 +255,11 @@ def main(argv=None) -> int:
     parser.add_argument("--decay-step", type=float, default=5e-4,
                         help="communication step of the free decay [s] (also run at twice this)")
     parser.add_argument("--out", type=Path, default=REPO / "out" / "engine_mount")
+    parser.add_argument("--native", action="store_true", help="the native (compiled C) six-axis bushing FMUs")
     args = parser.parse_args(argv)
     args.out.mkdir(parents=True, exist_ok=True)
     started = time.perf_counter()
-    bushing_fmu, body_fmu = build_fmus(args.out / "fmus")
+    bushing_fmu, body_fmu = build_fmus(args.out / "fmus", native=args.native)
     body = body_parameters()
     system_dir = args.out / "EngineMount"
     parts = write_system(system_dir, bushing_fmu, body_fmu, args.stop, body)

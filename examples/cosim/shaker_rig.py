@@ -1,6 +1,6 @@
 """Co-simulation example: a 300 kg body on four bushing FMUs over a shaker table (2 mm, 12 Hz).
 
-    python examples/cosim/shaker_rig.py [--stop 1.0] [--step 0.001] [--out out/shaker_rig]
+    python examples/cosim/shaker_rig.py [--stop 1.0] [--step 0.001] [--out out/shaker_rig] [--native]
 
 The system (``RigBody`` in ``rig_body.py``, built with pythonfmu like the bushings): the body's
 displacement and velocity relative to the table go to the ``x`` and ``v`` of four instances
@@ -45,10 +45,11 @@ BUSHINGS = {  # component name -> parameter set of the proposed model
 BODY = "body"
 
 
-def build_fmus(out_dir: Path) -> tuple[Path, Path]:
-    """The bushing FMU (Table 5 defaults) and the body FMU."""
+def build_fmus(out_dir: Path, native: bool = False) -> tuple[Path, Path]:
+    """The bushing FMU (Table 5 defaults; ``native``: the compiled one) and the body FMU."""
     import build_fmu
-    return build_fmu.build_fmu(out_dir=out_dir), build_pythonfmu(HERE / "rig_body.py", out_dir)
+    bushing = build_fmu.build_native_fmu(out_dir=out_dir).path if native else build_fmu.build_fmu(out_dir=out_dir)
+    return bushing, build_pythonfmu(HERE / "rig_body.py", out_dir)
 
 
 def components(system_dir: Path, bushing_fmu: Path, body_fmu: Path) -> list[Component]:
@@ -117,9 +118,10 @@ def main(argv=None) -> int:
     parser.add_argument("--stop", type=float, default=1.0, help="stop time [s]")
     parser.add_argument("--step", type=float, default=1e-3, help="communication step [s]")
     parser.add_argument("--out", type=Path, default=REPO / "out" / "shaker_rig")
+    parser.add_argument("--native", action="store_true", help="the native (compiled C) bushing FMU")
     args = parser.parse_args(argv)
     args.out.mkdir(parents=True, exist_ok=True)
-    bushing_fmu, body_fmu = build_fmus(args.out / "fmus")
+    bushing_fmu, body_fmu = build_fmus(args.out / "fmus", args.native)
     system_dir = args.out / "ShakerRig"
     write_ssp(system_dir, bushing_fmu, body_fmu, args.stop)
     libcosim = run_libcosim(system_dir, args.step, args.stop)
