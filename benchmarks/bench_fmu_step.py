@@ -13,6 +13,11 @@ the median over the repeats of the FMU's time over its trivial FMU's timed just 
 (the pair sees the same machine state; a shared VM's speed drifts between repeats). Also
 printed: the model core alone (no FMI), and the real-time
 factor (simulated time / wall time) of one bushing.
+
+Then the native FMUs (``build_fmu.py --native``): through fmpy against a trivial native FMU of
+the same ports built from the same C layer (the stateless Kelvin-Voigt model, F = 2x) and
+against the pythonfmu bushing FMU, side by side; and in a plain C master
+(``c_master_timing.c``, 100 times the steps per run), where no Python is in the loop.
 """
 from __future__ import annotations
 
@@ -173,6 +178,72 @@ def measure(steps: int, repeats: int) -> dict:
     return result
 
 
+def measure_native(steps: int, repeats: int) -> dict:
+    """The native FMUs (build_fmu.py --native): seconds per step through fmpy, alternating with a
+    trivial native FMU of the same ports (the stateless Kelvin-Voigt model of the same C layer with
+    k = 0.002 N/mm, c = 0: F = 2x) and with the pythonfmu bushing FMU; and in a plain C master
+    (benchmarks/c_master_timing.c)."""
+    import statistics
+
+    import build_fmu
+    from fmu_src.native.build import fmi_header_directory
+    from fmu_src.parameter_files import load_parameters, save_parameters, save_six_axis
+
+    with tempfile.TemporaryDirectory() as work:
+        work = Path(work)
+        table5 = load_parameters(REPO / "data" / "params_table5_combined.json")
+        gain = {"k": 0.002, "c": 0.0, "preload": 0.0}
+        all_proposed = save_six_axis(work / "six_proposed.json", {a: ("proposed", table5) for a in
+                                                                 ("x", "y", "z", "rx", "ry", "rz")})
+        # on the rotational axes the same model gives N.mm for rad: 2 N.mm/rad is 2e-3 N.m/rad
+        all_gain = save_six_axis(work / "six_gain.json", {a: ("kelvin_voigt", gain if len(a) == 1 else
+                                                              dict(gain, k=2.0)) for a in
+                                                          ("x", "y", "z", "rx", "ry", "rz")})
+        gain_file = save_parameters(work / "gain.json", gain, "kelvin_voigt")
+        fmus = {"native_trivial": build_fmu.build_native_fmu(gain_file, work / "a", "kelvin_voigt").path,
+                "native": build_fmu.build_native_fmu(out_dir=work / "b").path,
+                "pythonfmu": build_fmu.build_fmu(out_dir=work / "c"),
+                "native_trivial_six": build_fmu.build_native_fmu(all_gain, work / "d", "six_axis").path,
+                "native_six": build_fmu.build_native_fmu(all_proposed, work / "e", "six_axis").path}
+        omega = 2 * math.pi * 10.0
+        inputs_m = [[2e-3 * math.sin(omega * k * STEP_S), 2e-3 * omega * math.cos(omega * k * STEP_S)]
+                    for k in range(steps)]
+        inputs_six = [row * 3 + [10.0 * row[0], 10.0 * row[1]] * 3 for row in inputs_m]
+        runs = {key: [] for key in fmus}
+        for _ in range(repeats):
+            for key in ("native_trivial", "native", "pythonfmu"):
+                runs[key].append(time_fmu(fmus[key], inputs_m))
+            for key in ("native_trivial_six", "native_six"):
+                runs[key].append(time_fmu(fmus[key], inputs_six, SIX_AXIS_PORTS))
+        result = {f"fmpy_{key}": statistics.median(values) for key, values in runs.items()}
+        result["fmpy_native_ratio"] = statistics.median(a / b for a, b in zip(runs["native"], runs["native_trivial"]))
+        result["fmpy_native_six_ratio"] = statistics.median(a / b for a, b in zip(runs["native_six"],
+                                                                                  runs["native_trivial_six"]))
+        result["fmpy_native_over_pythonfmu"] = statistics.median(a / b for a, b in zip(runs["native"],
+                                                                                       runs["pythonfmu"]))
+        master = work / "c_master_timing"
+        subprocess.run(["cc", "-O2", "-std=c99", "-I", str(fmi_header_directory()), "-o", str(master),
+                        str(Path(__file__).with_name("c_master_timing.c")), "-ldl", "-lm"], check=True)
+        for key in ("native_trivial", "native", "native_trivial_six", "native_six"):
+            result[f"c_{key}"] = statistics.median(_c_master(master, fmus[key], work / key, 100 * steps, repeats))
+    return result
+
+
+def _c_master(master: Path, fmu: Path, folder: Path, steps: int, repeats: int) -> list[float]:
+    """Seconds per step of each repeat in the C master."""
+    from fmpy import extract, read_model_description
+    description = read_model_description(str(fmu))
+    refs = {v.name: v.valueReference for v in description.modelVariables}
+    ports = [p for p in SIX_AXIS_PORTS[0]] if "dx" in refs else ["x", "v"]
+    outputs = SIX_AXIS_PORTS[1] if "dx" in refs else ("F",)
+    library = Path(extract(str(fmu), str(folder))) / "binaries" / "linux64" / f"{description.coSimulation.modelIdentifier}.so"
+    arguments = [str(master), str(library), description.guid, str(steps), str(repeats), str(len(outputs))]
+    for a, output in enumerate(outputs):
+        arguments += [str(refs[ports[2 * a]]), str(refs[ports[2 * a + 1]]), str(refs[output])]
+    run = subprocess.run(arguments, capture_output=True, text=True, check=True)
+    return [float(line) * 1e-9 for line in run.stdout.split()]
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--steps", type=int, default=2000, help="steps per run (default 2000 = 2 s)")
@@ -207,6 +278,21 @@ def main() -> None:
     print(f"substeps per 1 ms step (core): {compiled['substeps']:.2f}")
     print(f"real-time factor of one bushing FMU at 1 ms: {STEP_S / compiled['bushing']:.0f}x (compiled), "
           f"{STEP_S / plain['bushing']:.0f}x (pure Python) faster than real time")
+
+    native = measure_native(args.steps, args.repeats)
+    print("\nnative FMU (build_fmu.py --native), against a trivial native FMU of the same ports and C layer "
+          "(Kelvin-Voigt, F = 2x), us/step, median; ratios as above")
+    print(f"{'what':46s} {'fmpy':>9s} {'ratio':>6s} {'C master':>9s}")
+    for key, label, ratio in (("native_trivial", "trivial native FMU, one axis", 1.0),
+                              ("native", "native bushing FMU, one axis (<= 1.15x)", native["fmpy_native_ratio"]),
+                              ("native_trivial_six", "trivial native FMU, six axes", 1.0),
+                              ("native_six", "native six-axis FMU, six proposed axes", native["fmpy_native_six_ratio"])):
+        print(f"{label:46s} {native['fmpy_' + key] * 1e6:9.2f} {ratio:6.2f} {native['c_' + key] * 1e6:9.3f}")
+    print(f"native bushing FMU over the pythonfmu bushing FMU (compiled step) through fmpy, side by side: "
+          f"{native['fmpy_native_over_pythonfmu']:.2f} ({native['fmpy_pythonfmu'] * 1e6:.1f} us/step)")
+    print(f"C master: one bushing {native['c_native'] * 1e6:.3f} us/step (target <= 1 us), six axes "
+          f"{native['c_native_six'] * 1e6:.3f} us/step (target <= 3 us); 20 bushings "
+          f"{STEP_S / (20 * native['c_native']):.0f}x faster than real time at 1 ms (target >= 50x)")
 
 
 if __name__ == "__main__":

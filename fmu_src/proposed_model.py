@@ -28,7 +28,7 @@ import math
 
 from .bushing_params import DAMPING, EXPONENT, GAIN, SPRING, WEIGHT, Constraint, ParameterSpec
 from .integration import (DEFAULT_MAX_SUBSTEPS, HEUN_JUMP_LIMIT, NOT_FINITE, OK, THETA_JUMP, TOO_MANY_SUBSTEPS,
-                          block_gain, block_step, substeps_needed, walk_along_xi)
+                          block_gain, block_power, block_step, substeps_needed, walk_along_xi)
 from .model_definition import BushingModel, StateSpec
 
 IDENTIFIER = "BoucWenBushing"
@@ -126,13 +126,14 @@ def integrate(m, state, x, v, h, max_substeps):
         x_now = x + v * elapsed
         u1 = -(k1 * (x_now - y) - k0 * y + alpha1 * z1) / c1
         u2 = (c0 * v - k2 * (x_now - w) - alpha2 * z2) / C
-        count = max(substeps_needed(u1, z1, remaining, a1, blk1),
-                    substeps_needed(u2, z2, remaining, 0.0, blk2))
+        zn1, zn2 = block_power(z1, blk1), block_power(z2, blk2)
+        count = max(substeps_needed(u1, z1, zn1, remaining, a1, blk1),
+                    substeps_needed(u2, z2, zn2, remaining, 0.0, blk2))
         if used + 1 > max_substeps or count > max_substeps:
             return (y, z1, w, z2), used, TOO_MANY_SUBSTEPS
         sub = remaining if count == 1 else remaining / count
-        u1, z1, xi1 = block_step(u1, z1, sub, a1, blk1)
-        u2, z2, xi2 = block_step(u2, z2, sub, 0.0, blk2)
+        u1, z1, xi1 = block_step(u1, z1, zn1, sub, a1, blk1)
+        u2, z2, xi2 = block_step(u2, z2, zn2, sub, 0.0, blk2)
         elapsed = h if count == 1 else elapsed + sub
         x_now = x + v * elapsed
         # The invariant keeps y consistent with u1; the stiff k/c1 coupling would amplify

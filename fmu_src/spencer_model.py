@@ -20,7 +20,7 @@ import math
 
 from .bushing_params import DAMPING, EXPONENT, GAIN, SPRING, WEIGHT, Constraint, ParameterSpec
 from .integration import (DEFAULT_MAX_SUBSTEPS, HEUN_JUMP_LIMIT, NOT_FINITE, OK, THETA_JUMP, TOO_MANY_SUBSTEPS,
-                          block_gain, block_step, substeps_needed, walk_along_xi)
+                          block_gain, block_power, block_step, substeps_needed, walk_along_xi)
 from .model_definition import BushingModel, StateSpec
 
 PARAMETER_SPECS = (
@@ -88,11 +88,12 @@ def integrate(m, state, x, v, h, max_substeps):
     while True:
         remaining = h - elapsed
         u = (c1 * v - k0 * (x + v * elapsed - y) - alpha * z) / C
-        count = substeps_needed(u, z, remaining, 0.0, blk)
+        zn = block_power(z, blk)
+        count = substeps_needed(u, z, zn, remaining, 0.0, blk)
         if used + 1 > max_substeps or count > max_substeps:
             return (y, z), used, TOO_MANY_SUBSTEPS
         sub = remaining if count == 1 else remaining / count
-        u, z, xi = block_step(u, z, sub, 0.0, blk)
+        u, z, xi = block_step(u, z, zn, sub, 0.0, blk)
         elapsed = h if count == 1 else elapsed + sub
         y = y + v * sub - xi
         used += 1

@@ -30,7 +30,7 @@ HAND_WRITTEN = ("bushing_fmu.h", "bushing_instance.c")
 FMI_HEADERS = {2: ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h"),
                3: ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h")}
 WARNINGS = ("-std=c99", "-pedantic", "-Wall", "-Wextra", "-Werror")
-FLAGS = ("-O2", "-fPIC", "-ffp-contract=off", "-fvisibility=hidden")
+FLAGS = ("-O3", "-fPIC", "-ffp-contract=off", "-fvisibility=hidden")
 """-ffp-contract=off: no fused multiply-add, so the C gives the Python kernels' floats;
 -fvisibility=hidden: only the FMI functions are exported."""
 MINGW = "x86_64-w64-mingw32-gcc"

@@ -105,8 +105,8 @@ static int bw_check_axis(bw_instance *inst, int a) {
     for (i = 0; i < model->parameters; i++) {
         const bw_parameter_spec *p = &model->specs[i];
         double x = axis->parameters[i];
-        bw_format_double(value, sizeof value, x);
         if (!isfinite(x)) {
+            bw_format_double(value, sizeof value, x);
             bw_log(inst, BW_ERROR, "logStatusError", "%s%s = %s [%s] must be a finite number", spec->label, p->name,
                    value, p->unit);
             errors++;
@@ -262,12 +262,13 @@ static bw_status bw_set_displacement(bw_instance *inst, int a, double value) {
     axis->x = value;
     axis->x_now = value * spec->to_kernel;
     axis->output_is_current = 0;
-    bw_format_double(text, sizeof text, value);
     if (!isfinite(value)) {
+        bw_format_double(text, sizeof text, value);
         bw_log(inst, BW_ERROR, "logStatusError", "input %s = %s %s is not a finite number; the next doStep will "
                "be refused", spec->displacement, text, spec->rotational ? "rad" : "m");
     } else if (fabs(value) > spec->travel_limit && !axis->travel_warned) {
         axis->travel_warned = 1;
+        bw_format_double(text, sizeof text, value);
         if (spec->rotational) {
             bw_log(inst, BW_WARNING, "logStatusWarning", "input %s = %s rad exceeds %g rad: the bushing takes "
                    "rotations as small angles (each component of the rotation vector about its own axis), which "
@@ -391,11 +392,10 @@ static bw_status bw_refuse(bw_instance *inst, const char *format, ...) {
    (BW_DISCARD) and leaves every axis as it was. */
 static bw_status bw_do_step(bw_instance *inst, double current_time, double h) {
     double states[BW_AXES][BW_MAX_STATES], x_end[BW_AXES], outputs[BW_AXES];
-    char t_text[40], h_text[40];
+    char t_text[40], h_text[40];      /* formatted only for a message: the step's hot path does no text */
     int a;
-    bw_format_double(t_text, sizeof t_text, current_time);
-    bw_format_double(h_text, sizeof h_text, h);
     if (!(h > 0.0 && h < HUGE_VAL)) {
+        bw_format_double(h_text, sizeof h_text, h);
         return bw_refuse(inst, "communication step size %s s must be a finite number > 0", h_text);
     }
     if (!bw_check_parameters(inst)) {
@@ -425,12 +425,10 @@ static bw_status bw_do_step(bw_instance *inst, double current_time, double h) {
         const bw_axis_spec *spec = &bw_axis_specs[a];
         bw_axis *axis = &inst->data.axes[a];
         double x = axis->x_now, v = axis->v * spec->to_kernel;
-        char x_text[40], v_text[40];
         int status;
         memcpy(states[a], axis->state, sizeof states[a]);
         status = spec->model->step(&axis->constants, states[a], axis->state_x, x, v, h, BW_MAX_SUBSTEPS);
-        bw_format_double(x_text, sizeof x_text, x);
-        bw_format_double(v_text, sizeof v_text, v);
+        if (status != BW_KERNEL_OK) bw_format_double(t_text, sizeof t_text, current_time);
         if (status == BW_KERNEL_TOO_MANY_SUBSTEPS) {
             return bw_refuse(inst, "doStep at t = %s s refused: %sthe step of %g s would need more than %d substeps "
                              "(x = %g mm, v = %g mm/s); check the units of the inputs (the FMU takes metres and m/s) "
@@ -445,6 +443,7 @@ static bw_status bw_do_step(bw_instance *inst, double current_time, double h) {
         outputs[a] = spec->model->force(&axis->constants, states[a], x_end[a], v) * spec->from_kernel;
         if (!isfinite(outputs[a])) {
             char x_port[40], v_port[40];
+            bw_format_double(t_text, sizeof t_text, current_time);
             bw_format_double(x_port, sizeof x_port, axis->x);
             bw_format_double(v_port, sizeof v_port, axis->v);
             return bw_refuse(inst, "doStep at t = %s s refused: %s would be %g %s (%s = %s %s, %s = %s %s); check the "
