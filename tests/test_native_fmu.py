@@ -350,3 +350,28 @@ def test_a_fresh_environment_with_fmpy_and_without_pythonfmu_runs_the_native_fmu
     x, v = Sine(2.0, 10.0).signals(t)
     here = simulate_with_fmpy(native_fmus["proposed"], t, x, v)
     assert float(run.stdout.split()[-1]) == pytest.approx(np.max(np.abs(here)), rel=1e-9)
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(shutil.which("cmake") is None or shutil.which("cc") is None, reason="needs cmake and a C compiler")
+@pytest.mark.parametrize("fmi_version", [2, 3])
+def test_any_tool_can_build_the_binary_from_the_fmus_sources(native_fmus, native_fmi3_fmus, fmi_version, tmp_path):
+    # What a user on macOS or ARM does: fmpy compiles sources/ as the modelDescription (FMI 2) or
+    # buildDescription.xml (FMI 3) lists them, with its own CMake project and no flags of ours.
+    import zipfile
+    from fmpy.build import build_platform_binary
+    path = (native_fmus if fmi_version == 2 else native_fmi3_fmus)["proposed"]
+    unzipped = tmp_path / "unzipped"
+    with zipfile.ZipFile(path) as archive:
+        archive.extractall(unzipped)
+    shutil.rmtree(unzipped / "binaries")
+    (tmp_path / "build").mkdir()
+    build_platform_binary(unzipped, tmp_path / "build")
+    rebuilt = tmp_path / "rebuilt.fmu"
+    with zipfile.ZipFile(rebuilt, "w") as archive:
+        for file in unzipped.rglob("*"):
+            archive.write(file, file.relative_to(unzipped).as_posix())
+    t = sample_times(0.3, 1000.0)
+    x, v = SIGNALS["jumps"](t)
+    original, own = simulate_with_fmpy(path, t, x, v), simulate_with_fmpy(rebuilt, t, x, v)
+    assert np.max(np.abs(own - original)) <= 1e-12 * np.max(np.abs(original))
