@@ -87,3 +87,25 @@ def test_with_native_bushing_fmus_libcosim_and_fmpy_agree_and_give_the_pythonfmu
     fmpy_run = shaker_rig.run_fmpy(bushing_fmu, body_fmu, system_dir, STEP, STOP)
     assert max(shaker_rig.largest_difference(libcosim, fmpy_run).values()) <= 1e-12
     assert max(shaker_rig.largest_difference(libcosim, libcosim_python).values()) <= 1e-12
+
+
+def test_an_invalid_start_value_stops_libcosim_with_the_native_fmus_reason(tmp_path):
+    # The native FMU answers an invalid start value with fmi2Error at fmi2ExitInitializationMode;
+    # libcosim (libcosimpy 0.0.6) ends its process on that (terminate after a cosim::error),
+    # after its log has the reason.
+    import re
+    import subprocess
+    bushing_fmu, body_fmu = shaker_rig.build_fmus(tmp_path / "fmus", native=True)
+    system_dir = tmp_path / "ShakerRig"
+    shaker_rig.write_ssp(system_dir, bushing_fmu, body_fmu, STOP)
+    ssv = system_dir / "resources" / "bushing_front_left.ssv"
+    ssv.write_text(re.sub(r'(<ssv:Parameter name="c1">\s*<ssv:Real value=")[^"]*', r"\g<1>0.0", ssv.read_text()))
+    script = ("from libcosimpy.CosimExecution import CosimExecution\n"
+              "from libcosimpy.CosimLogging import CosimLogLevel, log_output_level\n"
+              "log_output_level(CosimLogLevel.WARNING)\n"
+              f"execution = CosimExecution.from_ssp_file({str(system_dir)!r}, step_size={int(STEP * 1e9)})\n"
+              "print('step', execution.step(), flush=True)\n")
+    result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+    log = result.stdout + result.stderr
+    assert result.returncode != 0 and "step True" not in log
+    assert "c1 = 0.0 [N.s/mm] must be > 0 (it divides eq. 3)" in log and "the simulation cannot start" in log
