@@ -16,15 +16,19 @@ STEP = 1e-3
 STOP = 0.15
 
 
-@pytest.fixture(scope="module")
-def rig_runs(tmp_path_factory):
-    out = tmp_path_factory.mktemp("rig")
-    bushing_fmu, body_fmu = shaker_rig.build_fmus(out / "fmus")
+def run_rig(out: Path, native: bool = False):
+    """The rig written as SSP in ``out`` and run in libcosim and fmpy: (system_dir, libcosim, fmpy)."""
+    bushing_fmu, body_fmu = shaker_rig.build_fmus(out / "fmus", native)
     system_dir = out / "ShakerRig"
     shaker_rig.write_ssp(system_dir, bushing_fmu, body_fmu, STOP)
     libcosim = shaker_rig.run_libcosim(system_dir, STEP, STOP)
     fmpy_run = shaker_rig.run_fmpy(bushing_fmu, body_fmu, system_dir, STEP, STOP)
     return system_dir, libcosim, fmpy_run
+
+
+@pytest.fixture(scope="module")
+def rig_runs(tmp_path_factory):
+    return run_rig(tmp_path_factory.mktemp("rig"))
 
 
 def test_libcosim_and_fmpy_agree_on_the_same_system(rig_runs):
@@ -80,11 +84,7 @@ def test_with_native_bushing_fmus_libcosim_and_fmpy_agree_and_give_the_pythonfmu
                                                                                               tmp_path):
     # The same rig with the compiled bushing FMU (the body stays a pythonfmu FMU)
     _, libcosim_python, _ = rig_runs
-    bushing_fmu, body_fmu = shaker_rig.build_fmus(tmp_path / "fmus", native=True)
-    system_dir = tmp_path / "ShakerRig"
-    shaker_rig.write_ssp(system_dir, bushing_fmu, body_fmu, STOP)
-    libcosim = shaker_rig.run_libcosim(system_dir, STEP, STOP)
-    fmpy_run = shaker_rig.run_fmpy(bushing_fmu, body_fmu, system_dir, STEP, STOP)
+    _, libcosim, fmpy_run = run_rig(tmp_path, native=True)
     assert max(shaker_rig.largest_difference(libcosim, fmpy_run).values()) <= 1e-12
     assert max(shaker_rig.largest_difference(libcosim, libcosim_python).values()) <= 1e-12
 

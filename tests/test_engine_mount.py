@@ -21,15 +21,19 @@ STEP = 1e-3
 STOP = 0.12
 
 
-@pytest.fixture(scope="module")
-def road_runs(tmp_path_factory):
-    out = tmp_path_factory.mktemp("engine")
-    bushing_fmu, body_fmu = engine_mount.build_fmus(out / "fmus")
+def run_road(out: Path, native: bool = False):
+    """The road case written as SSP in ``out`` and run in libcosim and fmpy: (body, libcosim, fmpy)."""
+    bushing_fmu, body_fmu = engine_mount.build_fmus(out / "fmus", native=native)
     body = engine_mount.body_parameters()
     parts = engine_mount.write_system(out / "EngineMount", bushing_fmu, body_fmu, STOP, body)
     libcosim = ssp_system.run_libcosim(out / "EngineMount", parts, STEP, STOP)
     fmpy_run = ssp_system.run_fmpy(parts, engine_mount.connections(), STEP, STOP)
     return body, libcosim, fmpy_run
+
+
+@pytest.fixture(scope="module")
+def road_runs(tmp_path_factory):
+    return run_road(tmp_path_factory.mktemp("engine"))
 
 
 def test_libcosim_and_fmpy_agree_on_the_engine(road_runs):
@@ -46,11 +50,7 @@ def test_libcosim_and_fmpy_agree_on_the_engine(road_runs):
 def test_with_native_six_axis_fmus_libcosim_and_fmpy_agree_and_give_the_pythonfmu_systems_outputs(road_runs,
                                                                                                   tmp_path):
     _, libcosim_python, _ = road_runs
-    bushing_fmu, body_fmu = engine_mount.build_fmus(tmp_path / "fmus", native=True)
-    body = engine_mount.body_parameters()
-    parts = engine_mount.write_system(tmp_path / "EngineMount", bushing_fmu, body_fmu, STOP, body)
-    libcosim = ssp_system.run_libcosim(tmp_path / "EngineMount", parts, STEP, STOP)
-    fmpy_run = ssp_system.run_fmpy(parts, engine_mount.connections(), STEP, STOP)
+    _, libcosim, fmpy_run = run_road(tmp_path, native=True)
     assert max(ssp_system.largest_difference(libcosim, fmpy_run).values()) <= 1e-12
     assert max(ssp_system.largest_difference(libcosim, libcosim_python).values()) <= 1e-12
 

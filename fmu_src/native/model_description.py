@@ -32,6 +32,13 @@ def _units(root: ET.Element, variables: list[FmuVariable], position: int) -> Non
     root.insert(position, definitions)
 
 
+def _categories_and_experiment(root: ET.Element) -> None:
+    categories = ET.SubElement(root, "LogCategories")
+    for name, description in LOG_CATEGORIES:
+        ET.SubElement(categories, "Category", name=name, description=description)
+    ET.SubElement(root, "DefaultExperiment", startTime="0.0", stopTime="1.0", stepSize="0.001")
+
+
 def _pretty(root: ET.Element) -> bytes:
     text = parseString(ET.tostring(root, encoding="UTF-8")).toprettyxml(indent="  ", encoding="UTF-8")
     return b"\n".join(line for line in text.splitlines() if line.strip()) + b"\n"
@@ -72,10 +79,7 @@ def fmi2(axis_models, identifier: str, token: str, interfaces=INTERFACES, event_
         if source_file:
             ET.SubElement(ET.SubElement(element, "SourceFiles"), "File", name=source_file)
     _units(root, variables, len(root))
-    categories = ET.SubElement(root, "LogCategories")
-    for name, description in LOG_CATEGORIES:
-        ET.SubElement(categories, "Category", name=name, description=description)
-    ET.SubElement(root, "DefaultExperiment", startTime="0.0", stopTime="1.0", stepSize="0.001")
+    _categories_and_experiment(root)
     model_variables = ET.SubElement(root, "ModelVariables")
     index = {v.value_reference: i + 1 for i, v in enumerate(variables)}
     for v in variables:
@@ -122,10 +126,7 @@ def fmi3(axis_models, identifier: str, token: str) -> bytes:
     ET.SubElement(root, "CoSimulation", dict(capabilities, canHandleVariableCommunicationStepSize="true",
                                              maxOutputDerivativeOrder="0"))
     _units(root, variables, len(root))
-    categories = ET.SubElement(root, "LogCategories")
-    for name, description in LOG_CATEGORIES:
-        ET.SubElement(categories, "Category", name=name, description=description)
-    ET.SubElement(root, "DefaultExperiment", startTime="0.0", stopTime="1.0", stepSize="0.001")
+    _categories_and_experiment(root)
     model_variables = ET.SubElement(root, "ModelVariables")
     for v in variables:
         attributes = {"name": v.name, "valueReference": str(v.value_reference), "description": v.description,

@@ -44,10 +44,15 @@ typedef struct {
     double time;
 } bw_data;
 
+#define BW_CATEGORIES 5
+static const char *const bw_categories[BW_CATEGORIES] = {
+    "logStatusWarning", "logStatusDiscard", "logStatusError", "logStatusFatal", "logAll"};
+
 typedef struct {
     bw_data data;
     int model_exchange;              /* 1: a model-exchange instance (the host integrates the states) */
     int logging_on;
+    int category_enabled[BW_CATEGORIES];
     int initialized;                 /* the exit of initialization mode succeeded */
     bw_log_function log;
     void *fmi_instance;              /* passed back to log */
@@ -78,10 +83,24 @@ static void bw_format_double(char *out, size_t size, double value) {
     if (!strchr(out, '.') && strlen(out) + 2 < size) strcat(out, ".0");
 }
 
+/* Whether a message goes to the host: warnings and errors always (a host that does not switch
+   logging on still learns why a call failed, as with the Reference-FMUs); other messages only
+   with logging on and their category enabled. */
+static int bw_log_wanted(const bw_instance *inst, bw_status status, const char *category) {
+    int k;
+    if (!inst->log) return 0;
+    if (status != BW_OK) return 1;
+    if (!inst->logging_on) return 0;
+    for (k = 0; k < BW_CATEGORIES; k++) {
+        if (strcmp(category, bw_categories[k]) == 0) return inst->category_enabled[k];
+    }
+    return 1;
+}
+
 static void bw_log(bw_instance *inst, bw_status status, const char *category, const char *format, ...) {
     char message[BW_MESSAGE];
     va_list arguments;
-    if (!inst->log) return;
+    if (!bw_log_wanted(inst, status, category)) return;
     va_start(arguments, format);
     vsnprintf(message, sizeof message, format, arguments);
     va_end(arguments);
@@ -185,7 +204,42 @@ static int bw_check_parameters(bw_instance *inst) {
     return usable;
 }
 
+/* fmi2/fmi3SetDebugLogging: logging on or off, for every category (none named) or the named ones. */
+static bw_status bw_set_debug_logging(bw_instance *inst, int on, size_t count, const char *const categories[]) {
+    size_t i;
+    int k;
+    inst->logging_on = on ? 1 : 0;
+    for (k = 0; k < BW_CATEGORIES; k++) inst->category_enabled[k] = count == 0 ? inst->logging_on : 0;
+    for (i = 0; i < count; i++) {
+        int known = 0;
+        for (k = 0; k < BW_CATEGORIES; k++) {
+            if (categories[i] && strcmp(categories[i], bw_categories[k]) == 0) {
+                inst->category_enabled[k] = inst->logging_on;
+                known = 1;
+            }
+        }
+        if (!known) {
+            bw_log(inst, BW_ERROR, "logStatusError", "unknown log category %s (this FMU's: logStatusWarning, "
+                   "logStatusDiscard, logStatusError, logStatusFatal, logAll)", categories[i] ? categories[i] : "(null)");
+            return BW_ERROR;
+        }
+    }
+    return BW_OK;
+}
+
 /* ------------------------------------------------------------------------------- life cycle */
+
+static void bw_reset(bw_instance *inst);
+
+/* A new instance's settings (the FMI layer allocated it, zeroed), then its start values. */
+static void bw_initialize(bw_instance *inst, int model_exchange, int logging_on, bw_log_function log,
+                          void *fmi_instance) {
+    inst->model_exchange = model_exchange;
+    inst->log = log;
+    inst->fmi_instance = fmi_instance;
+    bw_set_debug_logging(inst, logging_on, 0, NULL);
+    bw_reset(inst);
+}
 
 static void bw_reset(bw_instance *inst) {
     int a, i;

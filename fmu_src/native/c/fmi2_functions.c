@@ -9,28 +9,14 @@ typedef struct {
     bw_instance core;
     fmi2CallbackFunctions callbacks;
     char *name;
-    fmi2Boolean category_enabled[5];     /* logStatusWarning, ..., logAll (fmi2SetDebugLogging) */
 } fmi2_bushing;
 
-static const char *const bw_categories[5] = {
-    "logStatusWarning", "logStatusDiscard", "logStatusError", "logStatusFatal", "logAll"};
-
-/* A message for the host's logger. Warnings and errors always reach it (a host that does not
-   switch logging on still learns why a call failed); other messages only with logging on and
-   their category enabled. FMI 2 treats the message as a printf format: a literal percent sign
-   is doubled. */
+/* A message for the host's logger (bw_log decided it is wanted). FMI 2 treats the message as a
+   printf format: a literal percent sign is doubled. */
 static void bw_fmi2_log(void *fmi_instance, bw_status status, const char *category, const char *message) {
     fmi2_bushing *c = (fmi2_bushing *)fmi_instance;
     char escaped[2 * BW_MESSAGE];
     size_t i, k = 0;
-    int index;
-    if (!c->callbacks.logger) return;
-    if (status == BW_OK) {
-        if (!c->core.logging_on) return;
-        for (index = 0; index < 5; index++) {
-            if (strcmp(category, bw_categories[index]) == 0 && !c->category_enabled[index]) return;
-        }
-    }
     for (i = 0; message[i] && k + 2 < sizeof escaped; i++) {
         escaped[k++] = message[i];
         if (message[i] == '%') escaped[k++] = '%';
@@ -61,26 +47,9 @@ const char *fmi2GetVersion(void) { return fmi2Version; }
 
 fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories,
                                const fmi2String categories[]) {
-    fmi2_bushing *b = BW_INSTANCE(c);
-    size_t i;
-    int k;
     BW_NOT_NULL(c);
-    b->core.logging_on = loggingOn ? 1 : 0;
-    for (k = 0; k < 5; k++) b->category_enabled[k] = (nCategories == 0) ? loggingOn : fmi2False;
-    for (i = 0; i < nCategories; i++) {
-        int known = 0;
-        for (k = 0; k < 5; k++) {
-            if (categories[i] && strcmp(categories[i], bw_categories[k]) == 0) {
-                b->category_enabled[k] = loggingOn;
-                known = 1;
-            }
-        }
-        if (!known) {
-            bw_log(&b->core, BW_ERROR, "logStatusError", "unknown log category %s", categories[i] ? categories[i] : "(null)");
-            return fmi2Error;
-        }
-    }
-    return fmi2OK;
+    if (nCategories > 0 && !categories) return fmi2Error;
+    return bw_fmi2_status(bw_set_debug_logging(&BW_INSTANCE(c)->core, loggingOn, nCategories, categories));
 }
 
 fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
@@ -117,15 +86,7 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     }
     memcpy(b->name, instanceName, length);
     b->callbacks = *functions;
-    b->core.model_exchange = fmuType == fmi2ModelExchange;
-    b->core.logging_on = loggingOn ? 1 : 0;
-    b->core.log = bw_fmi2_log;
-    b->core.fmi_instance = b;
-    {
-        int k;
-        for (k = 0; k < 5; k++) b->category_enabled[k] = loggingOn;
-    }
-    bw_reset(&b->core);
+    bw_initialize(&b->core, fmuType == fmi2ModelExchange, loggingOn, functions->logger ? bw_fmi2_log : NULL, b);
     return b;
 }
 

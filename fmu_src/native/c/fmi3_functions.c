@@ -12,24 +12,11 @@ typedef struct {
     fmi3InstanceEnvironment environment;
     fmi3LogMessageCallback log_message;
     char *name;
-    int category_enabled[5];
 } fmi3_bushing;
 
-static const char *const bw_fmi3_categories[5] = {
-    "logStatusWarning", "logStatusDiscard", "logStatusError", "logStatusFatal", "logAll"};
-
-/* Warnings and errors always reach the host's logger; other messages only with logging on
-   and their category enabled (as in fmi2_functions.c). FMI 3 messages are plain text. */
+/* A message for the host's logger (bw_log decided it is wanted); FMI 3 messages are plain text. */
 static void bw_fmi3_log(void *fmi_instance, bw_status status, const char *category, const char *message) {
     fmi3_bushing *b = (fmi3_bushing *)fmi_instance;
-    int index;
-    if (!b->log_message) return;
-    if (status == BW_OK) {
-        if (!b->core.logging_on) return;
-        for (index = 0; index < 5; index++) {
-            if (strcmp(category, bw_fmi3_categories[index]) == 0 && !b->category_enabled[index]) return;
-        }
-    }
     b->log_message(b->environment, (fmi3Status)status, category, message);
 }
 
@@ -53,26 +40,9 @@ const char *fmi3GetVersion(void) { return fmi3Version; }
 
 fmi3Status fmi3SetDebugLogging(fmi3Instance instance, fmi3Boolean loggingOn, size_t nCategories,
                                const fmi3String categories[]) {
-    fmi3_bushing *b = BW3(instance);
-    size_t i;
-    int k;
     BW3_NOT_NULL(instance);
-    b->core.logging_on = loggingOn ? 1 : 0;
-    for (k = 0; k < 5; k++) b->category_enabled[k] = nCategories == 0 ? loggingOn : 0;
-    for (i = 0; i < nCategories; i++) {
-        int known = 0;
-        for (k = 0; k < 5; k++) {
-            if (categories[i] && strcmp(categories[i], bw_fmi3_categories[k]) == 0) {
-                b->category_enabled[k] = loggingOn;
-                known = 1;
-            }
-        }
-        if (!known) {
-            bw_log(&b->core, BW_ERROR, "logStatusError", "unknown log category %s", categories[i] ? categories[i] : "(null)");
-            return fmi3Error;
-        }
-    }
-    return fmi3OK;
+    if (nCategories > 0 && !categories) return fmi3Error;
+    return bw_fmi3_status(bw_set_debug_logging(&BW3(instance)->core, loggingOn, nCategories, categories));
 }
 
 static fmi3Instance bw_fmi3_instantiate(fmi3String instanceName, fmi3String instantiationToken, fmi3Boolean loggingOn,
@@ -80,7 +50,6 @@ static fmi3Instance bw_fmi3_instantiate(fmi3String instanceName, fmi3String inst
                                         int model_exchange) {
     fmi3_bushing *b;
     size_t length;
-    int k;
     if (!instanceName || !instanceName[0]) {
         if (logMessage) logMessage(environment, fmi3Error, "logStatusError", "fmi3Instantiate: the instance needs a name");
         return NULL;
@@ -103,12 +72,7 @@ static fmi3Instance bw_fmi3_instantiate(fmi3String instanceName, fmi3String inst
     memcpy(b->name, instanceName, length);
     b->environment = environment;
     b->log_message = logMessage;
-    b->core.model_exchange = model_exchange;
-    b->core.logging_on = loggingOn ? 1 : 0;
-    b->core.log = bw_fmi3_log;
-    b->core.fmi_instance = b;
-    for (k = 0; k < 5; k++) b->category_enabled[k] = loggingOn;
-    bw_reset(&b->core);
+    bw_initialize(&b->core, model_exchange, loggingOn, logMessage ? bw_fmi3_log : NULL, b);
     return b;
 }
 
