@@ -4,7 +4,7 @@
 Writes ``DIR/<identifier>.fmu`` (FMI 2.0 co-simulation, pythonfmu; with ``--native``: compiled C,
 FMI 2.0 or 3.0, co-simulation and model exchange, see ``fmu_src/native``) of the model NAME
 (``proposed``, the default: ``BoucWenBushing.fmu``; ``spencer``: ``SpencerBushing``;
-``bouc_wen``: ``SingleBoucWenBushing``; ``kelvin_voigt``: ``KelvinVoigtBushing``; ``six_axis``:
+``single_bouc_wen``: ``SingleBoucWenBushing``; ``kelvin_voigt``: ``KelvinVoigtBushing``; ``six_axis``:
 ``SixAxisBushing``, six uncoupled axes each one of the four, see ``fmu_src/axes.py``) whose
 parameter start values are the set in FILE, project JSON or SSP 1.0 ``.ssv`` (default: the
 paper's Table 5 for the proposed model, the baselines' fits to the synthetic Table 5 tests
@@ -41,14 +41,14 @@ REPO = Path(__file__).resolve().parent
 LIBRARY_MODULES = ("bushing_params.py", "model_definition.py", "integration.py", "compiled_kernels.py", "axes.py",
                    "proposed_model.py",
                    "spencer_model.py", "bouc_wen_model.py", "kelvin_voigt_model.py", "bushing_models.py",
-                   "parameter_files.py", "variables.py")
+                   "parameter_files.py", "variables.py", "jit.py")
 SLAVE_MODULE = "bushing_slave.py"
 
 sys.path.insert(0, str(REPO))
 import fmu_src  # noqa: E402
 from fmu_src import __version__, bushing_params  # noqa: E402
 from fmu_src.axes import ONE_AXIS, SIX_AXIS_IDENTIFIER  # noqa: E402
-from fmu_src.bushing_models import MODEL_NAMES, get_model  # noqa: E402
+from fmu_src.bushing_models import MODEL_CHOICES, get_model  # noqa: E402
 from fmu_src.parameter_files import (parameter_document, read_parameter_set, read_six_axis,  # noqa: E402
                                      six_axis_document)
 
@@ -109,9 +109,33 @@ def fmu_axes(params_file: str | Path | None = None, model: str = "proposed"):
 
 def build_native_fmu(params_file: str | Path | None = None, out_dir: str | Path = "dist", model: str = "proposed",
                      fmi_version: int = 2, platforms: tuple[str, ...] | None = None):
-    """Build the native FMU (compiled C, FMI ``fmi_version``, co-simulation and model exchange)
-    of ``model`` with the parameter set in ``params_file`` as start values; returns a
-    ``fmu_src.native.build.NativeBuild`` (its path, the platforms built and those skipped)."""
+    """Build the native FMU: C generated from the model's definition, compiled, no Python needed
+    in the host; co-simulation and model exchange in one FMU.
+
+    Parameters
+    ----------
+    params_file : str or Path, optional
+        Parameter file whose values become the start values (default: the model's shipped set).
+    out_dir : str or Path
+        Directory for ``<Identifier>.fmu`` (created if missing).
+    model : str
+        ``proposed``, ``spencer``, ``single_bouc_wen``, ``kelvin_voigt`` or ``six_axis``.
+    fmi_version : int
+        2 or 3.
+    platforms : tuple of str, optional
+        Binaries to build (default: ``linux64``, and ``win64`` where mingw-w64 is installed);
+        the C sources are always included.
+
+    Returns
+    -------
+    NativeBuild
+        Its ``path``, the platforms built and those skipped (with why).
+
+    Raises
+    ------
+    BuildError
+        The FMU fails fmpy's validation; ``ParameterError`` for an invalid parameter file.
+    """
     from fmpy.validation import validate_fmu
     from fmu_src.native.build import build_native
     identifier, _, axes, _ = fmu_axes(params_file, model)
@@ -124,8 +148,28 @@ def build_native_fmu(params_file: str | Path | None = None, out_dir: str | Path 
 
 def build_fmu(params_file: str | Path | None = None, out_dir: str | Path = "dist",
               model: str = "proposed") -> Path:
-    """Build the pythonfmu FMU of ``model`` with the parameter set in ``params_file`` as start
-    values (default: :func:`default_parameter_file`); return its path."""
+    """Build the pythonfmu FMU (FMI 2.0 co-simulation; the host needs Python with pythonfmu).
+
+    Parameters
+    ----------
+    params_file : str or Path, optional
+        Parameter file whose values become the start values (default: the model's shipped set,
+        ``default_parameter_file``).
+    out_dir : str or Path
+        Directory for ``<Identifier>.fmu`` (created if missing).
+    model : str
+        ``proposed``, ``spencer``, ``single_bouc_wen``, ``kelvin_voigt`` or ``six_axis``.
+
+    Returns
+    -------
+    Path
+        The FMU written.
+
+    Raises
+    ------
+    BuildError
+        The FMU fails fmpy's validation; ``ParameterError`` for an invalid parameter file.
+    """
     from pythonfmu.builder import FmuBuilder
 
     identifier, title, axes, defaults_json = fmu_axes(params_file, model)
@@ -244,7 +288,7 @@ def _add_model_structure(root: ET.Element, axes) -> None:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="bushing-build-fmu", description=__doc__.splitlines()[0])
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
-    parser.add_argument("--model", default="proposed", choices=(*MODEL_NAMES, SIX_AXIS),
+    parser.add_argument("--model", default="proposed", choices=(*MODEL_CHOICES, SIX_AXIS),
                         help="which bushing model (default: proposed, the paper's eqs. 1-5); six_axis: the "
                              "six-axis bushing SixAxisBushing, each axis one of the models")
     parser.add_argument("--params", help="parameter set of the model, project JSON or SSP 1.0 .ssv "

@@ -55,7 +55,11 @@ def main() -> None:
     print(f"  step 2 mm, rise 0.4 s         : F at 0.4 s {f_step[at_rise]:8.1f} N, "
           f"F at 10 s {f_step[-1]:8.1f} N (relaxation {f_step[at_rise] - f_step[-1]:.1f} N)")
 
-    import matplotlib
+    try:
+        import matplotlib
+    except ImportError:
+        print("no plot: matplotlib is not installed (pip install 'boucwen-bushing[plot]')")
+        return
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     figure, (loops, response) = plt.subplots(1, 2, figsize=(11, 4.2))

@@ -78,8 +78,8 @@ def switches(m, state, x, v):
 
 
 MODEL = BushingModel(
-    "bouc_wen", "SingleBoucWenBushing", "single Bouc-Wen", PARAMETER_SPECS,
-    (StateSpec("z", 0, "N", "hysteretic force"),), "params_bouc_wen_fit_synthetic_table5.json",
+    "single_bouc_wen", "SingleBoucWenBushing", "single Bouc-Wen", PARAMETER_SPECS,
+    (StateSpec("z", 0, "N", "hysteretic force"),), "params_single_bouc_wen_fit_synthetic_table5.json",
     prepare, initial_state, jump, integrate, force,
     derivatives, switches, constraints=SINGLE_BLOCK_CONSTRAINTS,
     switch_specs=(StateSpec("v", 0, "m/s", "the velocity input, which drives the element"),

@@ -30,6 +30,8 @@ from pathlib import Path
 from . import integration
 
 CACHE_ENVIRONMENT = "BUSHING_CACHE_DIR"
+_NUMBA_IMPORT = f"from {__package__}.jit import numba\n\n"
+"""numba or its plain-Python stand-in (``jit``), from this package (``fmu_src`` or the FMU's packed copy)."""
 
 _JIT_KERNELS = (
     # error_model="numpy": a division by zero gives inf/nan (caught as NOT_FINITE) instead of an
@@ -83,7 +85,7 @@ def load_generated(name: str, source: str) -> types.ModuleType:
 def integration_module() -> str:
     """The name of the compiled copy of the shared machinery (generated and loaded)."""
     source = (inspect.getsource(integration) + "\n\n# ---- appended by fmu_src/compiled_kernels.py ----\n"
-              + "import numba\n\n" + _JIT_KERNELS)
+              + _NUMBA_IMPORT + _JIT_KERNELS)
     name = module_name("bushing_integration", source)
     load_generated(name, source)
     return name
@@ -97,7 +99,7 @@ def model_source(model, machinery: str, appendix: str = "") -> str:
     source = inspect.getsource(module)
     source = source.replace("from .integration import", f"from {machinery} import")
     source = source.replace("from .", f"from {module.__package__}.")
-    return (source + "\n\n# ---- appended by fmu_src/compiled_kernels.py ----\nimport numba\n\n" + _JIT_KERNELS
+    return (source + "\n\n# ---- appended by fmu_src/compiled_kernels.py ----\n" + _NUMBA_IMPORT + _JIT_KERNELS
             + "\n\n" + inspect.getsource(integration.step)
             + "\n\nstep = numba.njit(error_model='numpy', cache=True)(step)\n" + appendix)
 

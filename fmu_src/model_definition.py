@@ -57,7 +57,7 @@ class StateSpec:
 
 @dataclass(frozen=True)
 class BushingModel:
-    name: str                    # command-line name: proposed, spencer, bouc_wen, kelvin_voigt
+    name: str                    # command-line name: proposed, spencer, single_bouc_wen, kelvin_voigt
     identifier: str              # FMI modelIdentifier and the "model" of parameter files
     title: str
     specs: tuple[ParameterSpec, ...]

@@ -58,6 +58,28 @@ def load_parameters(path: str | Path, model: str | None = None) -> dict[str, flo
 
 
 def read_parameter_set(path: str | Path, model: str | None = None) -> ParameterSet:
+    """Read and validate one parameter set.
+
+    Parameters
+    ----------
+    path : str or Path
+        A JSON parameter file (as ``save_parameters`` or a fit writes it) or an SSP 1.0
+        ``.ssv`` ParameterValues file. Values are in the paper's N-mm-s units.
+    model : str, optional
+        The model it must be for (name such as ``"spencer"`` or FMI identifier); default: the
+        model the file names, else the proposed one.
+
+    Returns
+    -------
+    ParameterSet
+        The model, the validated values and the file's provenance (a fit's record).
+
+    Raises
+    ------
+    ParameterError
+        A missing file, another model, or a value out of its allowed range (named, with its
+        unit and range).
+    """
     path = Path(path)
     if not path.exists():
         raise ParameterError(f"parameter file {path} does not exist")
@@ -76,8 +98,26 @@ def read_parameter_set(path: str | Path, model: str | None = None) -> ParameterS
 
 
 def read_ensemble(path: str | Path, model: str | None = None) -> ParameterEnsemble:
-    """The members of an ensemble file (best first), or the one set of a parameter file
-    (JSON or .ssv), each validated like :func:`read_parameter_set`."""
+    """Read an ensemble: the parameter sets a fit could not tell apart, best first.
+
+    Parameters
+    ----------
+    path : str or Path
+        An ensemble file (``fit --ensemble``, ``save_ensemble``); a parameter file (JSON or
+        ``.ssv``) reads as an ensemble of its one set.
+    model : str, optional
+        The model it must be for; default: the model the file names.
+
+    Returns
+    -------
+    ParameterEnsemble
+        The model, the members (each validated like ``read_parameter_set``) and the provenance.
+
+    Raises
+    ------
+    ParameterError
+        An invalid member (numbered), or a first member that differs from the file's best set.
+    """
     path = Path(path)
     best = read_parameter_set(path, model)
     if path.suffix.lower() == ".ssv":
@@ -100,7 +140,29 @@ def read_ensemble(path: str | Path, model: str | None = None) -> ParameterEnsemb
 
 
 def save_ensemble(path: str | Path, members, model: str = "proposed", provenance: Mapping | None = None) -> Path:
-    """Write an ensemble (best member first) as JSON; see the module docstring."""
+    """Write an ensemble as JSON: the best member as the file's parameter set, all members after.
+
+    Parameters
+    ----------
+    path : str or Path
+        A ``.json`` file (SSP holds one set only: ``.ssv`` is refused).
+    members : iterable of mappings
+        Parameter sets in the paper's N-mm-s units, the best first.
+    model : str
+        The model's name or FMI identifier (default ``"proposed"``).
+    provenance : mapping, optional
+        What made the ensemble (a fit's record).
+
+    Returns
+    -------
+    Path
+        The file written.
+
+    Raises
+    ------
+    ParameterError
+        An ``.ssv`` path, no members, or an invalid member.
+    """
     path = Path(path)
     if path.suffix.lower() == ".ssv":
         raise ParameterError(f"{path}: an ensemble is written as JSON (.json), SSP holds one parameter set")
@@ -188,7 +250,30 @@ def parameter_document(params: Mapping[str, float], model: str = "proposed",
 
 def save_parameters(path: str | Path, params: Mapping[str, float], model: str = "proposed",
                     provenance: Mapping | None = None) -> Path:
-    """Write a validated parameter set: ``.ssv`` as SSP 1.0 ParameterValues, else JSON."""
+    """Write a validated parameter set, which ``build_fmu.py --params`` and every reader take.
+
+    Parameters
+    ----------
+    path : str or Path
+        ``.ssv``: SSP 1.0 ParameterValues (values and units only); anything else: JSON with the
+        model, the unit system and ``provenance``.
+    params : mapping of str to float
+        The model's parameters in the paper's N-mm-s units.
+    model : str
+        The model's name or FMI identifier (default ``"proposed"``).
+    provenance : mapping, optional
+        What made the set (a fit's record), stored under ``"fit"`` in JSON.
+
+    Returns
+    -------
+    Path
+        The file written.
+
+    Raises
+    ------
+    ParameterError
+        A missing, unknown or out-of-range parameter (nothing is written).
+    """
     path = Path(path)
     if path.suffix.lower() == ".ssv":
         _write_ssv(path, params, get_model(model))

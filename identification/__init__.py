@@ -1,26 +1,41 @@
 """Identification of the bushing models' parameters from rig tests.
 
-The front door::
+The front door (run from the repository, whose data/ holds synthetic Table 5 tests; a fit takes
+about a minute on two cores)::
 
-    from identification import fit, simulate, predict, load_measurement
+    import numpy as np
+    from identification import characterise, fit, predict, simulate, training_tests
 
-    tests = training_tests(sine=["sine.csv"], step=["step.csv"], rise_times_s=[0.4])
-    result = fit(tests, model="proposed", seed=0)          # FitResult
-    print(result.summary())                                 # noise, NRMSE, agreement, identifiability
-    result.save("params.json", ensemble="ensemble.json")   # what build_fmu.py --params takes
-    force_N = simulate(result.parameters, time_s, displacement_mm)
-    band = predict(result, time_s, displacement_mm)         # best force and the ensemble's envelope
-    table = characterise(result, [0.5, 1, 2], [1, 10, 30])  # dynamic stiffness and loss angle per case
+    if __name__ == "__main__":
+        tests = training_tests(sine=["data/synthetic_table5_sine_2mm_10Hz.csv"],
+                               step=["data/synthetic_table5_step_2mm_rise0.4s.csv"], rise_times_s=[0.4])
+        result = fit(tests, model="proposed", seed=0)          # FitResult
+        print(result.summary())                                 # noise, NRMSE, agreement, identifiability
+        result.save("params.json", ensemble="ensemble.json")   # what build_fmu.py --params takes
+        time_s = np.arange(0.0, 1.0, 1e-3)
+        displacement_mm = 3.0 * np.sin(2 * np.pi * 5.0 * time_s)
+        force_N = simulate(result, time_s, displacement_mm)    # the best set
+        band = predict(result, time_s, displacement_mm)         # best force and the ensemble's envelope
+        table = characterise(result, [0.5, 1, 2], [1, 10, 30])  # dynamic stiffness and loss angle per case
+        print(table.format())
 
 Units: s, mm, mm/s, N; parameters in the paper's N-mm-s units. With ``workers`` > 1 the fit
 starts worker processes: guard a script's top level with ``if __name__ == "__main__":``.
 """
+from fmu_src.bushing_params import ParameterError
+from fmu_src.parameter_files import (ParameterEnsemble, ParameterSet, read_ensemble, read_parameter_set,
+                                     save_ensemble, save_parameters)
 from identification.dynamic_stiffness import characterise
-from identification.fitting import FitNotConvergedWarning, FitResult, fit
-from identification.measurements import load_measurement
+from identification.errors import IdentificationError
+from identification.extras import MissingExtraError
+from identification.fit_result import FitNotConvergedWarning, FitResult
+from identification.fitting import fit
+from identification.measurements import MeasurementError, load_measurement
 from identification.predict import predict
 from identification.rig_tests import RigTest, load_manifest, training_tests
 from identification.simulate import simulate
 
 __all__ = ["fit", "FitResult", "FitNotConvergedWarning", "simulate", "predict", "characterise", "load_measurement",
-           "RigTest", "training_tests", "load_manifest"]
+           "RigTest", "training_tests", "load_manifest",
+           "read_parameter_set", "save_parameters", "read_ensemble", "save_ensemble", "ParameterSet", "ParameterEnsemble",
+           "IdentificationError", "MeasurementError", "ParameterError", "MissingExtraError"]

@@ -18,7 +18,7 @@ from fmu_src.bushing_models import get_model
 from identification.engine import make_engine
 from identification.fitting import FitNotConvergedWarning, fit
 from identification.measurements import load_measurement
-from identification.objectives import nrmse, rms_error
+from identification.objectives import nrmse, rms_level_error
 from identification.rig_tests import RigTest
 from identification.plots import plot_comparison
 from identification.simulate import simulate
@@ -51,7 +51,7 @@ def compare_models(models: Sequence[str], tests: Sequence[RigTest], validation_f
                                        model=model)
                        for model in models}
         for model, predicted in predictions.items():
-            errors[name, model] = (nrmse(predicted, m.force_N), rms_error(predicted, m.force_N))
+            errors[name, model] = (nrmse(predicted, m.force_N), rms_level_error(predicted, m.force_N))
         plot_comparison(m, predictions, out_dir / f"compare_{Path(m.source).stem}.png")
 
     print(format_comparison(errors, models, [Path(m.source).name for m in validation]))

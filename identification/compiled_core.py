@@ -17,7 +17,7 @@ import inspect
 import types
 from typing import Mapping
 
-import numba
+from fmu_src.jit import numba
 import numpy as np
 
 from fmu_src import compiled_kernels as _kernels, integration

@@ -21,6 +21,7 @@ import numpy as np
 
 from identification.compiled_core import parameter_matrix
 from identification.errors import IdentificationError
+from identification.progress import bar as progress_bar
 from identification.forward_model import prepare_input
 from identification.predict import members_of
 from identification.protocols import Sine, Step, sample_times
@@ -115,11 +116,10 @@ def design(ensemble, noise_N: float | None = None, candidates: list[Candidate] |
     candidates = candidates or candidate_tests()
     matrix = parameter_matrix(sets, bushing.name)
     ranked = []
-    iterator = candidates
-    if progress:
-        from tqdm import tqdm
-        iterator = tqdm(candidates, desc="candidate tests", unit="test", leave=False)
-    for candidate in iterator:
+    bar = progress_bar(len(candidates), "candidate tests", "test", progress)
+    for candidate in candidates:
+        if bar is not None:
+            bar.update(1)
         protocol = candidate.protocol
         t = sample_times(protocol.duration_s, RATE_HZ)
         x, v = protocol.signals(t)
@@ -133,6 +133,8 @@ def design(ensemble, noise_N: float | None = None, candidates: list[Candidate] |
         spread = float(np.sqrt(np.average(np.var(forces[runs], axis=0), weights=weights)))
         rms = float(np.sqrt(np.average(forces[0] ** 2, weights=weights)))
         ranked.append(Ranked(candidate, spread, rms))
+    if bar is not None:
+        bar.close()
     if not ranked:
         raise IdentificationError("the ensemble's best member cannot be simulated on any candidate test")
     ranked.sort(key=lambda r: -r.spread_N)

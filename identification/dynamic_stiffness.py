@@ -145,16 +145,45 @@ def characterise(parameters, amplitudes_mm: Sequence[float] = DEFAULT_AMPLITUDES
                  frequencies_hz: Sequence[float] = DEFAULT_FREQUENCIES_HZ, model: str | None = None,
                  preload_mm: float = 0.0, steps_per_cycle: int = STEPS_PER_CYCLE, tolerance: float = TOLERANCE,
                  max_cycles: int = MAX_CYCLES) -> DynamicStiffness:
-    """Dynamic stiffness and loss angle on the grid amplitudes x frequencies (every pair; see the
-    module docstring). ``parameters``: a mapping of ``model``'s parameters (paper units), a
-    ``ParameterSet``, a ``ParameterEnsemble`` or a fit result (then the best set's table with the
-    members' min/max). Cases are ordered amplitude-major. Warns (CharacterisationWarning) about
-    a case that reaches the cycle cap; raises IdentificationError for invalid input or a
-    simulation that fails."""
+    """Dynamic stiffness |K*| and loss angle on every pair of amplitudes and frequencies: the
+    data sheet a supplier gives.
+
+    Parameters
+    ----------
+    parameters : mapping, ParameterSet, ParameterEnsemble, FitResult, str or Path
+        A set or an ensemble (paper's N-mm-s units), in any form ``parameter_input`` accepts;
+        an ensemble adds the members' min/max.
+    amplitudes_mm : sequence of float
+        Sine amplitudes [mm].
+    frequencies_hz : sequence of float
+        Frequencies [Hz].
+    model : str, optional
+        The model the parameters must be for.
+    preload_mm : float
+        Static displacement [mm] the sines are about.
+    steps_per_cycle : int
+        Integration steps per cycle (>= 16).
+    tolerance : float
+        Relative change of |K*| between cycles that counts as the steady state.
+    max_cycles : int
+        Cycle cap per case.
+
+    Returns
+    -------
+    DynamicStiffness
+        Per case (amplitude-major): |K*| [N/mm], loss angle [deg], K', K'' and, for an
+        ensemble, their min/max; ``to_csv``, ``format`` and ``summary``.
+
+    Raises
+    ------
+    IdentificationError
+        Invalid grid values or a simulation that fails. Warns ``CharacterisationWarning``
+        about a case that reaches the cycle cap.
+    """
     # here, not at the top: the command line imports this module for its defaults
     from identification.compiled_core import parameter_matrix
-    from identification.predict import members_of
-    bushing, sets = members_of(parameters, model)
+    from identification.parameter_input import parameter_sets
+    bushing, sets = parameter_sets(parameters, model)
     amplitudes = _grid_values(amplitudes_mm, "amplitude", "mm", PLAUSIBLE_AMPLITUDE_MM)
     frequencies = _grid_values(frequencies_hz, "frequency", "Hz", PLAUSIBLE_FREQUENCY_HZ)
     if not math.isfinite(preload_mm):

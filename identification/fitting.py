@@ -7,7 +7,7 @@
    halving of bounded trust-region least squares on the misfit (``identification.objectives``),
    every start a task of the engine (``identification.engine``: this process, local worker
    processes, or a Dask cluster; the same seed gives the same bits on each);
-3. the evidence (pyPESTO's multi-start practice): how many of the last stage's starts reach
+3. the evidence (pyPESTO's multi-start practice, ``identification.fit_result``): how many of the last stage's starts reach
    the best misfit within the ensemble threshold, and whether every training test is at its
    noise floor (NRMSE <= FLOOR_FACTOR x its noise level). A fit that is not both is
    ``converged = False`` and says why (``FitResult.warning``);
@@ -22,286 +22,39 @@ optimum is exact, so only the floor is checked).
 """
 from __future__ import annotations
 
-import sys
 import time
 import warnings
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from pathlib import Path
-from typing import Sequence
 
 import numpy as np
 
 from fmu_src.bushing_models import get_model
-from fmu_src.parameter_files import ParameterSet, save_ensemble, save_parameters
+from fmu_src.parameter_files import ParameterSet
 from identification.compiled_core import parameter_matrix
 from identification.engine import make_engine
-from identification.errors import IdentificationError
 from identification.ensemble import (PROBES, PROFILE_EVALUATIONS, PROFILE_ROUNDS, PUSH, STEPS, WALKERS,
-                                     Identifiability, SamplerReport, identifiability, misfit_threshold,
-                                     posterior_samples, profile_extremes, push_to_boundary, select_members,
-                                     threshold_scale)
-from identification.kdyn_table import FIT_CYCLES, KDYN_UNCERTAINTY, LOSS_ANGLE_UNCERTAINTY_DEG, KdynTable, load_kdyn_table
+                                     identifiability, misfit_threshold, posterior_samples, profile_extremes,
+                                     push_to_boundary, select_members, threshold_scale)
+from identification.errors import IdentificationError
+from identification.extras import require
+from identification.fit_result import (FLOOR_FACTOR, MIN_AGREEING, FitNotConvergedWarning, FitResult,  # noqa: F401
+                                       RigTestFit, TableFit, agreeing_starts)
+from identification.kdyn_table import KdynTable, load_kdyn_table
 from identification.measurements import Measurement
-from identification.multistart import (Problem, SearchSettings, StartRecord, first_records, jacobian, run_stages,
-                                       screen)
+from identification.multistart import Problem, StartRecord, first_records, jacobian, run_stages, screen
 from identification.noise import NoiseEstimate, estimate_noise
-from identification.objectives import MIN_NOISE_FRACTION, Objective, nrmse
+from identification.objectives import Objective, nrmse
+from identification.presets import PAPER_GA, PRESETS, SearchSettings
+from identification.progress import SearchProgress
 from identification.refinement import refine_steps
 from identification.rig_tests import Manifest, RigTest
 from identification.search_space import KelvinVoigtFit, SearchSpace
 from identification.simulate import simulate
 
-PRESETS = {
-    "default": SearchSettings(screening=8192, stages=((128, 10), (24, 30), (6, 300))),
-    # the paper's GA as the global stage (its final population ranks the starts)
-    "paper": SearchSettings(screening=300, stages=((128, 10), (24, 30), (6, 300))),
-}
-PAPER_GA = {"population": 300, "generations": 200, "crossover_probability": 0.8, "mutation_probability": 0.05}
-FLOOR_FACTOR = 1.25
-"""A test is at its noise floor when the fit's NRMSE on it is at most this times its noise level."""
-MIN_AGREEING = 2
 MIN_FINAL_STARTS = 3
 """A reduced budget (``starts``) keeps at least this many starts to the end: with two, one
 stray start already makes the agreement fail."""
-
-
-class FitNotConvergedWarning(UserWarning):
-    """A fit that ended above the noise floor or whose starts do not agree."""
-
-
-@dataclass
-class TestFit:
-    """One training test at the fitted parameters."""
-    name: str
-    kind: str
-    noise: NoiseEstimate
-    nrmse: float
-
-    @property
-    def noise_fraction(self) -> float:
-        """The noise level the fit works with: the estimate, at least MIN_NOISE_FRACTION of
-        the rms force (what the objective divides by)."""
-        return max(self.noise.relative, MIN_NOISE_FRACTION)
-
-    @property
-    def ratio(self) -> float:
-        return self.nrmse / self.noise_fraction
-
-    @property
-    def at_floor(self) -> bool:
-        return bool(self.ratio <= FLOOR_FACTOR)
-
-    def as_dict(self) -> dict:
-        return {"file": self.name, "kind": self.kind, "noise_N": _round(self.noise_fraction * self.noise.rms_force_N),
-                "noise_fraction": _round(self.noise_fraction), "nrmse": _round(self.nrmse),
-                "nrmse_over_noise": _round(self.ratio), "at_floor": self.at_floor}
-
-
-@dataclass
-class TableFit:
-    """A dynamic-stiffness table at the fitted parameters: the converged characterisation
-    (``dynamic_stiffness.characterise``) against the table's rows of weight > 0."""
-    name: str
-    kdyn_errors: np.ndarray          # relative |K*| error per row
-    angle_errors_deg: np.ndarray     # loss-angle error per row [deg]
-    weight: np.ndarray
-    cycles_error: float              # largest |K*| difference of the fit's fixed-cycle loop from its steady state
-
-    @property
-    def ratio(self) -> float:
-        """The rms of the weighted errors in uncertainty units (KDYN_UNCERTAINTY,
-        LOSS_ANGLE_UNCERTAINTY_DEG): 1 where the fit matches the table to its uncertainty."""
-        scaled = np.concatenate([self.kdyn_errors / KDYN_UNCERTAINTY, self.angle_errors_deg / LOSS_ANGLE_UNCERTAINTY_DEG])
-        return float(np.sqrt(np.mean((np.tile(self.weight, 2) * scaled) ** 2)))
-
-    @property
-    def at_floor(self) -> bool:
-        return bool(self.ratio <= FLOOR_FACTOR)
-
-    def as_dict(self) -> dict:
-        return {"file": self.name, "kind": "kdyn", "rows": int(self.weight.size),
-                "rms_kdyn_error": _round(float(np.sqrt(np.mean(self.kdyn_errors ** 2)))),
-                "largest_kdyn_error": _round(float(np.max(np.abs(self.kdyn_errors)))),
-                "rms_loss_angle_error_deg": _round(float(np.sqrt(np.mean(self.angle_errors_deg ** 2)))),
-                "largest_loss_angle_error_deg": _round(float(np.max(np.abs(self.angle_errors_deg)))),
-                "uncertainty": {"kdyn": KDYN_UNCERTAINTY, "loss_angle_deg": LOSS_ANGLE_UNCERTAINTY_DEG},
-                "fit_loop_kdyn_difference": _round(self.cycles_error),
-                "error_over_uncertainty": _round(self.ratio), "at_floor": self.at_floor}
-
-    def format(self) -> str:
-        d = self.as_dict()
-        return (f"{self.name:44s} {'kdyn':7s} |K*| rms {d['rms_kdyn_error']:.2%} (largest {d['largest_kdyn_error']:.2%}), "
-                f"loss angle rms {d['rms_loss_angle_error_deg']:.2f} deg (largest {d['largest_loss_angle_error_deg']:.2f}); "
-                f"{self.ratio:.2f}x the uncertainty ({KDYN_UNCERTAINTY:.0%}, {LOSS_ANGLE_UNCERTAINTY_DEG:g} deg)  "
-                f"{'yes' if self.at_floor else 'NO'}")
-
-
-@dataclass
-class FitResult:
-    parameters: ParameterSet               # the best fit, with its provenance
-    misfit: float                          # chi^2/n, 1 at the noise floor
-    tests: list[TestFit]
-    records: list[StartRecord]             # every start, the last stage's first, by misfit
-    threshold: float                       # misfit increase within the 95 % confidence region
-    ensemble: list[dict[str, float]]       # the best first
-    identifiability: Identifiability | None
-    preset: str
-    seed: int
-    evaluations: int
-    seconds: float
-    engine: str = "1 process"
-    space: SearchSpace | None = None
-    final_starts: int = 1
-    sampler: SamplerReport | None = None
-    notes: list[str] = field(default_factory=list)
-    steps_per_sample: list[int] = field(default_factory=list)   # the forward model's, per test
-    table: TableFit | None = None          # the dynamic-stiffness table, if one was fitted
-    added_starts: int = 0                  # starts that ran the last stage because one alone reached the best
-    agreed_before_added: int | None = None  # the agreement count when the last stage ended, before any added start
-    ensemble_sampled: bool = True          # False: fit(ensemble=False), the ensemble is the best fit alone
-
-    @property
-    def model(self) -> str:
-        return self.parameters.model.name
-
-    @property
-    def agreeing(self) -> int:
-        """Starts of the last stage whose misfit is within the threshold of the best."""
-        return _agreeing(self.records, self.records[0].stage, self.misfit, self.threshold) if self.records else 1
-
-    @property
-    def at_floor(self) -> bool:
-        return all(t.at_floor for t in self.tests) and (self.table is None or self.table.at_floor)
-
-    @property
-    def converged(self) -> bool:
-        enough = self.agreeing >= MIN_AGREEING or self.space is None   # Kelvin-Voigt: exact optimum
-        return self.at_floor and enough
-
-    @property
-    def warning(self) -> str | None:
-        """The ``not converged`` message with its figures, or None."""
-        if self.converged:
-            return None
-        reasons = []
-        worst = max(self.tests, key=lambda t: t.ratio) if self.tests else None
-        if worst is not None and not worst.at_floor:
-            reasons.append(f"training NRMSE {worst.nrmse:.2%} on {worst.name} is {worst.ratio:.2f}x "
-                           f"its noise level {worst.noise_fraction:.2%} (the floor is {FLOOR_FACTOR}x)")
-        if self.table is not None and not self.table.at_floor:
-            reasons.append(f"the table {self.table.name} is matched to {self.table.ratio:.2f}x its uncertainty "
-                           f"({KDYN_UNCERTAINTY:.0%} on |K*|, {LOSS_ANGLE_UNCERTAINTY_DEG:g} deg; the floor is "
-                           f"{FLOOR_FACTOR}x)")
-        if self.space is not None and self.agreeing < MIN_AGREEING:
-            reasons.append(f"only {self.agreeing} of {self.final_starts} final starts reach the best misfit")
-        edges = self.at_box_edge()
-        if edges:
-            hint = (f"the best fit lies on the search box's bound in {', '.join(edges)}: the parameters that "
-                    "describe these data may lie outside the box (see identification/search_space.py)")
-        elif self.space is not None and self.agreeing < MIN_AGREEING:
-            hint = "more starts (--starts, --screening) may find a better optimum"
-        else:
-            hint = ("the starts agree, so the model may not describe these data to their noise level "
-                    "(or the noise estimate is low: correlated noise reads low)")
-        return f"not converged: {'; '.join(reasons)}; {hint}"
-
-    def at_box_edge(self, tolerance: float = 1e-3) -> list[str]:
-        """The searched coordinates of the best fit within ``tolerance`` of the box's size from
-        an upper bound, or from a lower bound that is a limit of the search (the time constants'
-        floor, n >= 0.1). Other lower bounds stand for a physical limit a fit may rightly sit on:
-        no spring or dashpot (1e-3 k_ref, 1e-4 c_ref), A >= 1, beta >= 0 and the shape sums >= 0."""
-        if self.space is None:
-            return []
-        theta = self.space.to_coordinates(self.parameters.parameters)
-        edges = []
-        for c, value, (low, high) in zip(self.space.coordinates, theta, self.space.bounds()):
-            margin = tolerance * (high - low)
-            if value >= high - margin or (value <= low + margin and c.kind in ("time_constant", "exponent")):
-                edges.append(c.parameter)
-        return edges
-
-    def provenance(self) -> dict:
-        """What the parameter file records of the fit: everything but timings and engine, so
-        that the same seed gives the same file on any engine."""
-        out = {"method": self._method(), "preset": self.preset, "seed": self.seed,
-               "converged": self.converged, "misfit_chi2_per_residual": _round(self.misfit),
-               "tests": [t.as_dict() for t in self.tests] + ([self.table.as_dict()] if self.table else [])}
-        if self.space is not None:
-            out.update({"starts_agreeing": self.agreeing, "final_starts": self.final_starts,
-                        "starts_added_for_agreement": self.added_starts,
-                        "starts_agreeing_before_added": self.agreed_before_added,
-                        "agreement_threshold_misfit": _round(self.threshold),
-                        "ensemble_members": len(self.ensemble), "ensemble_sampled": self.ensemble_sampled,
-                        "steps_per_sample": list(self.steps_per_sample),
-                        "search_space": {"k_ref_N_per_mm": _round(self.space.k_ref),
-                                         "c_ref_Ns_per_mm": _round(self.space.c_ref),
-                                         "F_ref_N": _round(self.space.F_ref),
-                                         "shortest_time_constant_s": _round(self.space.shortest_time_constant_s)},
-                        "note": "alpha = 1 in every Bouc-Wen block: the (alpha, A, beta, gamma) redundancy "
-                                "(search_space.rescale_hysteresis gives the equivalent sets)"})
-        if self.sampler is not None:
-            out["posterior_sampling"] = {"acceptance": _round(self.sampler.acceptance),
-                                         "autocorrelation_steps": _round(self.sampler.autocorrelation_steps),
-                                         "kept_steps": self.sampler.kept_steps}
-        if self.identifiability is not None:
-            out["weak_directions"] = [{k: (_round(v) if not isinstance(v, dict) else {n: _round(x) for n, x in v.items()})
-                                       for k, v in entry.items()} for entry in self.identifiability.weakest()]
-        return out
-
-    def _method(self) -> str:
-        if self.space is None:
-            return "linear least squares F = k*x + c*v on the tests other than steps"
-        stages = ", ".join(f"{s} x {e}" for s, e in PRESETS[self.preset].stages)
-        first = ("the paper's GA (pymoo, population 300, 200 generations)" if self.preset == "paper"
-                 else f"{PRESETS[self.preset].screening} scrambled Sobol points")
-        return (f"{first}, then successive halving of bounded trust-region least squares "
-                f"(starts x evaluations: {stages}) on chi^2/n over every sample")
-
-    def summary(self) -> str:
-        """A report like lmfit's fit_report: figures first, then the warnings."""
-        fitted = f"{len(self.tests)} test(s)" + (f" and the table {self.table.name}" if self.table else "")
-        lines = [f"{self.parameters.model.title} fitted to {fitted}, preset {self.preset!r}, "
-                 f"seed {self.seed}, {self.evaluations} simulations in {self.seconds:.1f} s on {self.engine}",
-                 f"misfit chi^2/n = {self.misfit:.4f} (1 = the noise floor)"]
-        lines.append(f"{'test':44s} {'kind':7s} {'noise':>8s} {'NRMSE':>8s} {'ratio':>6s}  floor")
-        for t in self.tests:
-            lines.append(f"{t.name:44s} {t.kind:7s} {t.noise_fraction:8.2%} {t.nrmse:8.2%} "
-                         f"{t.ratio:6.2f}  {'yes' if t.at_floor else 'NO'}")
-        if self.table is not None:
-            lines.append(self.table.format())
-            if self.table.cycles_error > 0.1 * KDYN_UNCERTAINTY:
-                lines.append(f"note: the fit's {FIT_CYCLES}-cycle loop differs from the steady state by up to "
-                             f"{self.table.cycles_error:.2%} in |K*| at the fitted set (a slow transient); more than "
-                             "a tenth of the table's uncertainty")
-        if self.space is not None:
-            lines.append(f"starts: {self.agreeing} of {self.final_starts} final starts agree (misfit within "
-                         f"{self.threshold:.2e} of the best: delta chi^2 at 95 % for {len(self.space.names)} parameters); "
-                         + (f"ensemble: {len(self.ensemble)} parameter sets" if self.ensemble_sampled
-                            else "ensemble: not sampled (ensemble=False), the best fit alone"))
-        if self.steps_per_sample:
-            lines.append("forward model: " + ", ".join(f"{m} step{'s' if m > 1 else ''} per sample on {t.name}"
-                                                       for m, t in zip(self.steps_per_sample, self.tests)))
-        if self.identifiability is not None:
-            lines.append(self.identifiability.format())
-        if self.sampler is not None:
-            lines.append(self.sampler.format())
-        lines += self.notes
-        lines.append("converged: yes" if self.converged else f"converged: no ({self.warning})")
-        return "\n".join(lines)
-
-    def save(self, path: str | Path, ssv: str | Path | None = None, ensemble: str | Path | None = None,
-             data: Sequence[str] = ()) -> list[Path]:
-        """Write the parameter file (JSON with provenance), optionally an .ssv and the ensemble."""
-        provenance = dict(self.provenance(), data=[str(d) for d in data])
-        written = [save_parameters(path, self.parameters.parameters, self.model, provenance)]
-        if ssv is not None:
-            written.append(save_parameters(ssv, self.parameters.parameters, self.model))
-        if ensemble is not None:
-            if not self.ensemble_sampled:
-                raise IdentificationError(f"no ensemble to write to {ensemble}: this fit ran with ensemble=False "
-                                          "(--no-ensemble); fit again without it for the ensemble")
-            written.append(save_ensemble(ensemble, self.ensemble, self.model, provenance))
-        return written
 
 
 def as_tests(measurements) -> list[RigTest]:
@@ -327,19 +80,63 @@ def as_tests(measurements) -> list[RigTest]:
 def fit(measurements, model: str = "proposed", preset: str = "default", seed: int = 0, workers: int | None = None,
         scheduler=None, engine=None, progress: bool = True, screening: int | None = None,
         starts: int | None = None, kdyn=None, ensemble: bool = True) -> FitResult:
-    """Identify ``model``'s parameters from training tests (see the module docstring).
+    """Identify a model's parameters from rig tests, and say how sure the fit is.
 
-    ``measurements``: a ``rig_tests.Manifest``, ``RigTest``s, ``Measurement``s or CSV paths.
-    ``workers``/``scheduler``: where the starts run (default: every local core); ``engine``: an
-    engine to reuse (not closed). ``screening``, ``starts``: override the preset's number of
-    Sobol points and of first-stage starts (later stages shrink in proportion, at least
-    MIN_FINAL_STARTS remain). ``kdyn``: a dynamic-stiffness table (a CSV path or a
-    ``kdyn_table.KdynTable``) fitted with the tests, or alone (``measurements`` empty).
-    ``ensemble=False`` skips the prediction profiles and the posterior sampling (a third to
-    half of a fit's time): the result's ensemble is then the best fit alone, so ``predict``
-    gives no band and ``save(ensemble=...)`` refuses.
-    Emits a ``FitNotConvergedWarning`` when the fit is not converged.
+    Parameters
+    ----------
+    measurements : Manifest, sequence of RigTest, Measurement, str or Path
+        The training tests (``training_tests``, ``load_manifest``); a Measurement or a CSV path
+        counts as a random-input test. May be empty when ``kdyn`` is given.
+    model : str
+        ``proposed`` (default), ``spencer``, ``single_bouc_wen`` or ``kelvin_voigt`` (linear
+        least squares).
+    preset : str
+        ``default`` (Sobol screening) or ``paper`` (the paper's GA); see ``presets``.
+    seed : int
+        Root seed (>= 0); the same seed gives the same bits on any engine.
+    workers : int, optional
+        Local worker processes (default: every core).
+    scheduler : str or dask.distributed.Client, optional
+        Run on a Dask cluster instead (the ``dask`` extra).
+    engine : optional
+        An engine to reuse (not closed).
+    progress : bool
+        Progress bars on stderr (drawn only where stderr is a terminal).
+    screening, starts : int, optional
+        Override the preset's Sobol points and first-stage starts (later stages shrink in
+        proportion, at least ``MIN_FINAL_STARTS`` remain).
+    kdyn : str, Path or KdynTable, optional
+        A dynamic-stiffness table (CSV amplitude_mm, frequency_hz, kdyn_N_per_mm,
+        loss_angle_deg) fitted with the tests, or alone.
+    ensemble : bool
+        False skips the profiles and the posterior sampling (a third to half of the time): no
+        band then, and ``FitResult.save(ensemble=...)`` refuses.
+
+    Returns
+    -------
+    FitResult
+        The best set with its provenance, each test's NRMSE against its noise level, the
+        agreement of the starts, ``converged`` and, if not, ``warning``; ``summary()``,
+        ``save()``.
+
+    Raises
+    ------
+    IdentificationError
+        No tests, a bad seed or preset, or a test whose noise cannot be estimated.
+    MissingExtraError
+        The ``fit`` extra is not installed.
+
+    Warns
+    -----
+    FitNotConvergedWarning
+        The fit is not at the noise floor or its starts do not agree (the message says which).
+
+    Notes
+    -----
+    Units: time s, displacement mm, force N; parameters in the paper's N-mm-s units. With
+    ``workers`` > 1, guard a script's top level with ``if __name__ == "__main__":``.
     """
+    require("fit", "identification.fit")
     from threadpoolctl import threadpool_limits
     started = time.perf_counter()
     table = kdyn if kdyn is None or isinstance(kdyn, KdynTable) else load_kdyn_table(kdyn)
@@ -398,7 +195,7 @@ def _search(tests, noise, model, preset, settings, seed, engine, progress, start
     # with a table, the screening and the early stages run its coarser loop (kdyn_table)
     problem = Problem(Objective(tests, noise, model=space.model, table=table, search=table is not None), space)
     ga_evaluations = PAPER_GA["population"] * PAPER_GA["generations"]
-    bars = _Progress(progress, settings, ga_evaluations if preset == "paper" else settings.screening)
+    bars = SearchProgress(progress, settings, ga_evaluations if preset == "paper" else settings.screening)
     if preset == "paper":
         from identification.multistart import genetic_algorithm
         theta, misfits = genetic_algorithm(problem, engine, seed, bars.screening, **PAPER_GA)
@@ -509,7 +306,7 @@ def _extend_if_alone(problem: Problem, engine, records: list[StartRecord], last:
     not converged. Returns the records (sorted as ``run_stages`` sorts them), how many starts
     were added and how many agreed before."""
     best = min(r.misfit for r in records if r.stage == stage)
-    agreeing = _agreeing(records, stage, best, misfit_threshold(best, n, d))
+    agreeing = agreeing_starts(records, stage, best, misfit_threshold(best, n, d))
     waiting = sorted((r for r in records if r.stage < stage), key=lambda r: (-r.stage, r.misfit, r.start))[:last[0]]
     if agreeing >= MIN_AGREEING or not waiting:
         return records, 0, agreeing
@@ -517,12 +314,6 @@ def _extend_if_alone(problem: Problem, engine, records: list[StartRecord], last:
                lambda s, k: bars.stage(s, k, more=True, total=len(waiting)), first_stage=stage)
     records.sort(key=lambda r: (-r.stage, r.misfit, r.start))
     return records, len(waiting), agreeing
-
-
-def _agreeing(records: list[StartRecord], stage: int, best_misfit: float, threshold: float) -> int:
-    """Starts that ran ``stage`` and reached ``best_misfit`` within ``threshold``: the agreement
-    count, the convergence evidence."""
-    return int(sum(r.misfit <= best_misfit + threshold for r in records if r.stage == stage))
 
 
 def _check_steps(problem: Problem, tests, records, n: int, d: int):
@@ -533,7 +324,7 @@ def _check_steps(problem: Problem, tests, records, n: int, d: int):
                         misfit_threshold(best.misfit, n, d) * n)
 
 
-def _test_fits(tests, noise, parameters: ParameterSet, steps=None) -> list[TestFit]:
+def _test_fits(tests, noise, parameters: ParameterSet, steps=None) -> list[RigTestFit]:
     """Each test's noise and NRMSE at ``parameters``, simulated with ``steps`` per sample (per
     test; default: chosen from the signal)."""
     fits = []
@@ -541,7 +332,7 @@ def _test_fits(tests, noise, parameters: ParameterSet, steps=None) -> list[TestF
         m = test.measurement
         predicted = simulate(parameters, m.time_s, m.displacement_mm, m.measured_velocity_mm_s,
                              steps_per_sample=m_steps)
-        fits.append(TestFit(test.name, test.kind, level, nrmse(predicted, m.force_N)))
+        fits.append(RigTestFit(test.name, test.kind, level, nrmse(predicted, m.force_N)))
     return fits
 
 
@@ -575,44 +366,3 @@ def _table_fit(table: KdynTable | None, parameters: ParameterSet) -> TableFit | 
     converged_fit_steps, _ = steady(prepared.steps_per_cycle)
     return TableFit(table.name, kdyn / rows.kdyn_N_per_mm - 1.0, angle - rows.loss_angle_deg, rows.weight,
                     float(np.max(np.abs(fixed[0] / converged_fit_steps - 1.0))))
-
-
-def _round(value):
-    """Floats as the parameter file stores them (12 significant digits: stable text)."""
-    return float(f"{value:.12g}") if isinstance(value, float) else value
-
-
-class _Progress:
-    """tqdm bars for the screening and each least-squares stage (on stderr)."""
-
-    def __init__(self, enabled: bool, settings: SearchSettings, screening_total: int):
-        self.enabled = enabled and sys.stderr is not None
-        self.settings = settings
-        self.screening_total = screening_total
-        self._bar = None
-        self._stage = None
-
-    def screening(self, count: int):
-        self._advance("screening", self.screening_total, "points", count)
-
-    def stage(self, index: int, count: int, again: bool = False, more: bool = False, total: int | None = None):
-        starts, evaluations = self.settings.stages[index]
-        starts = total or starts
-        self._advance(f"stage {index + 1}/{len(self.settings.stages)} ({starts} starts x {evaluations})"
-                      + (" again, finer steps" if again else "") + (" on more starts" if more else ""),
-                      starts, "starts", count)
-
-    def _advance(self, name, total, unit, count):
-        if not self.enabled:
-            return
-        from tqdm import tqdm
-        if self._stage != name:
-            self.close()
-            self._bar = tqdm(total=total, desc=name, unit=unit, leave=False, file=sys.stderr)
-            self._stage = name
-        self._bar.update(count)
-
-    def close(self):
-        if self._bar is not None:
-            self._bar.close()
-            self._bar = None

@@ -19,17 +19,17 @@ from __future__ import annotations
 
 import csv
 import json
-import sys
 import time
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from fmu_src.bushing_models import MODEL_NAMES
+from fmu_src.bushing_models import MODEL_CHOICES
 from fmu_src.bushing_params import ParameterError
 from fmu_src.parameter_files import parameter_document
 from identification.engine import make_engine
 from identification.measurements import MeasurementError
+from identification.progress import bar as progress_bar
 from identification.rig_tests import load_manifest
 
 MANIFEST = "tests.json"
@@ -97,17 +97,15 @@ def fit_many(folder: str | Path, out_dir: str | Path, workers: int | None = None
         try:
             manifest = load_manifest(path / MANIFEST)
             model = manifest.model or "proposed"
-            if model not in MODEL_NAMES:
-                raise MeasurementError(f"{path / MANIFEST}: model {model!r} is not one of {', '.join(MODEL_NAMES)}")
+            if model not in MODEL_CHOICES:
+                raise MeasurementError(f"{path / MANIFEST}: model {model!r} is not one of {', '.join(MODEL_CHOICES)}")
             labels = [_label(t.measurement.source, path) for t in manifest.tests]
             jobs.append(_Job(path.name, manifest.tests, labels, model, preset, seed, screening, starts, ensemble))
         except (MeasurementError, ParameterError, OSError, UnicodeDecodeError) as exc:
             rows[path.name] = FleetRow(path.name, error=f"{type(exc).__name__}: {exc}")
 
-    bar = None
-    if progress:
-        from tqdm import tqdm
-        bar = tqdm(total=len(bushings), desc="bushings", unit="bushing", file=sys.stderr)
+    bar = progress_bar(len(bushings), "bushings", "bushing", progress, leave=True)
+    if bar is not None:
         bar.update(len(rows))
 
     def finished(index, result):

@@ -11,7 +11,7 @@ KDYN_UNCERTAINTY and the loss-angle error over LOSS_ANGLE_UNCERTAINTY_DEG, each 
 weight: the table's errors in units of a typical forced-vibration test's uncertainty (ISO
 4664-1 rigs quote about 1 % on |K*| and a few tenths of a degree on delta), as a time series's
 residuals are in units of its noise. A fit at the table's floor has an rms of both at most
-``fitting.FLOOR_FACTOR``.
+``fit_result.FLOOR_FACTOR``.
 
 Model side: the compiled sine loop (``identification.steady_state``) with FIT_STEPS_PER_CYCLE
 steps per cycle for exactly FIT_CYCLES cycles from rest at the preload (a fixed count keeps the

@@ -86,8 +86,28 @@ def _column_factor(path: Path, header: str, quantity: str, table: dict[str, floa
 
 
 def load_measurement(path: str | Path, force_optional: bool = False) -> Measurement:
-    """Load a measurement CSV; raise MeasurementError naming what is wrong and where.
-    ``force_optional``: accept a file without a force column (an input to predict)."""
+    """Load a measured (or synthetic) rig test from a CSV file.
+
+    Parameters
+    ----------
+    path : str or Path
+        CSV with a header line naming ``time_s``, ``displacement_<unit>`` (mm, m, in),
+        ``force_<unit>`` (N, kN, lbf) and optionally ``velocity_<unit>`` columns; ``#`` lines
+        are comments.
+    force_optional : bool
+        Accept a file without a force column (an input to ``predict``).
+
+    Returns
+    -------
+    Measurement
+        Time [s], displacement [mm], force [N] and, if given, velocity [mm/s], converted from
+        the file's units.
+
+    Raises
+    ------
+    MeasurementError
+        Naming what is wrong and where (file, line, column).
+    """
     path = Path(path)
     try:
         lines = path.read_text(encoding="utf-8").splitlines()

@@ -58,25 +58,6 @@ class Problem:
             return np.sum(self.residuals(theta) ** 2, axis=1)
 
 
-@dataclass(frozen=True)
-class SearchSettings:
-    screening: int = 8192
-    stages: tuple[tuple[int, int], ...] = ((128, 10), (24, 30), (6, 300))
-    """(starts, largest number of least-squares evaluations of each) per stage."""
-
-    def __post_init__(self):
-        if self.screening < 1:
-            raise ValueError(f"screening = {self.screening} points: give 1 or more")
-        if not self.stages:
-            raise ValueError("at least one least-squares stage is needed")
-        for starts, evaluations in self.stages:
-            if starts < 1 or evaluations < 1:
-                raise ValueError(f"stage ({starts} starts, {evaluations} evaluations): both must be >= 1")
-        counts = [starts for starts, _ in self.stages]
-        if counts != sorted(counts, reverse=True):
-            raise ValueError(f"stage start counts {counts} must not grow")
-
-
 @dataclass
 class StartRecord:
     """One start's last state: pyPESTO's per-start record."""

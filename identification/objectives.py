@@ -174,7 +174,11 @@ def nrmse(predicted: np.ndarray, measured: np.ndarray) -> float:
     return float(np.sqrt(np.mean((predicted - measured) ** 2)) / np.sqrt(np.mean(measured ** 2)))
 
 
-def rms_error(predicted: np.ndarray, measured: np.ndarray) -> float:
-    """The paper's eq. 10: (RMS(F_exp) - RMS(F_pre)) / RMS(F_exp)."""
+def rms_level_error(predicted: np.ndarray, measured: np.ndarray) -> float:
+    """The paper's eq. 10: (RMS(F_exp) - RMS(F_pre)) / RMS(F_exp), a difference of RMS *levels*.
+
+    It compares only the two signals' RMS values, so it is blind to phase and sign (a force of
+    the wrong sign scores 0); :func:`nrmse` is the error the fit uses. Kept to compare with
+    the paper's tables."""
     rms_measured = np.sqrt(np.mean(measured ** 2))
     return float((rms_measured - np.sqrt(np.mean(predicted ** 2))) / rms_measured)

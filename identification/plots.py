@@ -11,7 +11,7 @@ from fmu_src.bushing_models import get_model
 from identification.measurements import Measurement
 from identification.objectives import nrmse
 
-MODEL_STYLES = {"proposed": ("C0", "-"), "spencer": ("C2", "-."), "bouc_wen": ("C1", ":"),
+MODEL_STYLES = {"proposed": ("C0", "-"), "spencer": ("C2", "-."), "single_bouc_wen": ("C1", ":"),
                 "kelvin_voigt": ("C3", "--")}
 
 

@@ -6,23 +6,22 @@ member, in one compiled population call. The band is the members' envelope (min,
 every sample: the spread of the parameter sets the training tests cannot tell apart (a
 confidence band). Add the noise level for where a measurement may fall (a prediction band).
 
-``parameters``: a ``parameter_files.ParameterEnsemble`` or ``ParameterSet``, a fit's
-``FitResult``, a mapping of one set, or a list of mappings (best first).
+``parameters``: anything ``identification.parameter_input`` accepts (a mapping, a
+``ParameterSet`` or ``ParameterEnsemble``, a ``FitResult``, a parameter file's path, a list of
+mappings, best first).
 """
 from __future__ import annotations
 
 import csv
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Mapping
 
 import numpy as np
 
-from fmu_src.bushing_models import BushingModel, get_model
-from fmu_src.parameter_files import ParameterEnsemble, ParameterSet
 from identification.compiled_core import parameter_matrix
 from identification.errors import IdentificationError
 from identification.forward_model import prepare_input
+from identification.parameter_input import parameter_sets
 from identification.simulate import simulate_driven
 
 
@@ -56,30 +55,35 @@ class Prediction:
         return path
 
 
-def members_of(parameters, model: str | None = None) -> tuple[BushingModel, list[dict[str, float]]]:
-    """The model and the validated parameter sets (best first) of any accepted ``parameters``."""
-    if hasattr(parameters, "ensemble") and hasattr(parameters, "parameters") and hasattr(parameters, "misfit"):
-        bushing = parameters.parameters.model          # a FitResult
-        sets = parameters.ensemble
-    elif isinstance(parameters, ParameterEnsemble):
-        bushing, sets = parameters.model, parameters.members
-    elif isinstance(parameters, ParameterSet):
-        bushing, sets = parameters.model, [parameters.parameters]
-    elif isinstance(parameters, Mapping):
-        bushing, sets = get_model(model or "proposed"), [parameters]
-    else:
-        sets = list(parameters)
-        if not sets or not all(isinstance(s, Mapping) for s in sets):
-            raise TypeError("parameters must be a parameter set, an ensemble, a fit result or a list of mappings")
-        bushing = get_model(model or "proposed")
-    if model is not None and get_model(model) is not bushing:
-        raise IdentificationError(f"the parameters are for the {bushing.name} model, not {model}")
-    return bushing, [bushing.check(s) for s in sets]
+members_of = parameter_sets
+"""The model and the validated sets of any accepted ``parameters`` (``parameter_input``)."""
 
 
 def predict(parameters, time_s, displacement_mm, velocity_mm_s=None, model: str | None = None) -> Prediction:
-    """Force [N] of the best set and the ensemble's envelope at every sample (see the module
-    docstring). Units: s, mm, mm/s, N."""
+    """Predict a test: the best set's force and the ensemble's band at every sample.
+
+    Parameters
+    ----------
+    parameters : mapping, ParameterSet, ParameterEnsemble, FitResult, str or Path
+        A set or an ensemble (paper's N-mm-s units), in any form ``parameter_input`` accepts.
+    time_s, displacement_mm : array_like
+        Sample times [s] and displacement [mm].
+    velocity_mm_s : array_like, optional
+        Measured velocity [mm/s] at the samples.
+    model : str, optional
+        The model the parameters must be for.
+
+    Returns
+    -------
+    Prediction
+        ``force_N`` of the best set, ``lower_N``/``upper_N`` the members' envelope (a
+        confidence band; add the noise level for where a measurement may fall).
+
+    Raises
+    ------
+    IdentificationError
+        The best set's simulation fails (overflow), with the time it fails from.
+    """
     bushing, sets = members_of(parameters, model)
     driven = prepare_input(time_s, displacement_mm, velocity_mm_s)
     forces = simulate_driven(parameter_matrix(sets, bushing.name), driven, model=bushing.name)

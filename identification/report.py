@@ -15,7 +15,7 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from identification.measurements import Measurement
-from identification.objectives import nrmse, rms_error
+from identification.objectives import nrmse, rms_level_error
 from identification.protocols import Random, Sine, Step, sample_times
 from identification.search_space import KelvinVoigtFit
 from identification.plots import plot_comparison
@@ -50,7 +50,7 @@ def grid_protocols():
 
 def _case(name: str, prediction, expected) -> CaseError:
     band = prediction.band_width_N if prediction.members > 1 else None
-    return CaseError(name, nrmse(prediction.force_N, expected), rms_error(prediction.force_N, expected),
+    return CaseError(name, nrmse(prediction.force_N, expected), rms_level_error(prediction.force_N, expected),
                      None if band is None else float(np.mean(band)), None if band is None else float(np.max(band)))
 
 
@@ -79,7 +79,7 @@ def data_errors(parameters, measurements: Sequence[Measurement], kelvin_voigt: K
         baseline = None
         if kelvin_voigt is not None:
             linear = kelvin_voigt.force(m.displacement_mm, m.velocity_mm_s)
-            baseline = CaseError(name, nrmse(linear, m.force_N), rms_error(linear, m.force_N))
+            baseline = CaseError(name, nrmse(linear, m.force_N), rms_level_error(linear, m.force_N))
         rows.append((_case(name, prediction, m.force_N), baseline))
     return rows
 

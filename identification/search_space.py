@@ -108,7 +108,7 @@ MODEL_SPACES = {
                  Coordinate("beta", "shape_sum", 0.0, 40.0, "n", partner="gamma", sign=1.0),
                  Coordinate("n", "exponent", 0.1, 1.5)),
                 ("alpha",), ("x0",)),
-    "bouc_wen": ((Coordinate("k0", "stiffness", -3.0, 1.0), Coordinate("c0", "damping", -4.0, 2.0),
+    "single_bouc_wen": ((Coordinate("k0", "stiffness", -3.0, 1.0), Coordinate("c0", "damping", -4.0, 2.0),
                   Coordinate("A", "gain", -4.0, 1.0), Coordinate("beta", "shape", 0.0, 20.0, "n"),
                   Coordinate("gamma", "shape_sum", 0.0, 40.0, "n", partner="beta", sign=1.0),
                   Coordinate("n", "exponent", 0.1, 1.5)),

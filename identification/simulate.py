@@ -13,26 +13,46 @@ paper's N-mm-s units. The bushing starts in relaxed equilibrium at the first dis
 """
 from __future__ import annotations
 
-from typing import Mapping
-
 import numpy as np
 
-from fmu_src.bushing_models import get_model
 from identification.compiled_core import parameter_matrix, simulate_population_at
 from identification.forward_model import DrivenInput, prepare_input
+from identification.parameter_input import parameter_sets
 
 
 def simulate(parameters, time_s, displacement_mm, velocity_mm_s=None, model: str | None = None,
              steps_per_sample: int | None = None) -> np.ndarray:
-    """Force [N] at every sample.
+    """Simulate a model on a sampled displacement: the force at every sample.
 
-    ``parameters``: a mapping of the model's parameters (paper units), or a
-    ``parameter_files.ParameterSet`` (which names its model). ``model``: the model's name or
-    FMI identifier (default: the one of the ParameterSet, else ``"proposed"``).
-    ``velocity_mm_s``: the test's velocity at the samples, if known (else derived from the
-    interpolant). ``steps_per_sample``: communication steps per sample interval (default:
-    chosen from the signal, see ``forward_model``); more give a finer reference solution.
-    Raises ``ParameterError`` for an invalid set, ``ValueError`` for bad arrays.
+    Parameters
+    ----------
+    parameters : mapping, ParameterSet, ParameterEnsemble, FitResult, str or Path
+        The parameter set (paper's N-mm-s units), in any form ``parameter_input`` accepts; of
+        an ensemble or a fit, the best set.
+    time_s : array_like
+        Sample times [s], increasing.
+    displacement_mm : array_like
+        Displacement [mm] at the samples.
+    velocity_mm_s : array_like, optional
+        Velocity [mm/s] at the samples, if measured (else from the displacement's interpolant).
+    model : str, optional
+        The model's name or FMI identifier; default: the one the parameters name, else
+        ``"proposed"``.
+    steps_per_sample : int, optional
+        Communication steps per sample interval (default: chosen from the signal); more give a
+        finer reference solution.
+
+    Returns
+    -------
+    numpy.ndarray
+        Force [N] at every sample; the bushing starts in relaxed equilibrium at the first
+        displacement.
+
+    Raises
+    ------
+    ParameterError
+        An invalid parameter set; ``ValueError`` for arrays of different lengths or times that
+        do not increase.
     """
     values, bushing = _parameters_and_model(parameters, model)
     driven = prepare_input(time_s, displacement_mm, velocity_mm_s, steps=steps_per_sample)
@@ -50,11 +70,6 @@ def simulate_driven(matrix: np.ndarray, driven: DrivenInput, max_substeps: int |
 
 
 def _parameters_and_model(parameters, model):
-    if hasattr(parameters, "model") and hasattr(parameters, "parameters"):  # a ParameterSet
-        bushing = get_model(model) if model is not None else parameters.model
-        return bushing.check(parameters.parameters), bushing
-    if not isinstance(parameters, Mapping):
-        raise TypeError(f"parameters must be a mapping of names to values or a ParameterSet, "
-                        f"not {type(parameters).__name__}")
-    bushing = get_model(model or "proposed")
-    return bushing.check(parameters), bushing
+    """The best set of any accepted ``parameters`` (``parameter_input``) and its model."""
+    bushing, sets = parameter_sets(parameters, model)
+    return sets[0], bushing

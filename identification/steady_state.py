@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import math
 
-import numba
+from fmu_src.jit import numba
 
 ROUNDING = 1e-13
 

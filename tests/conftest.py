@@ -1,3 +1,4 @@
+import functools
 from pathlib import Path
 
 import numpy as np
@@ -50,6 +51,30 @@ def paper_force(p, time_s, displacement, velocity, rtol=1e-8, atol=1e-8):
     x, xd = displacement(time_s), velocity(time_s)
     wd = (p["c2"] * xd + p["k2"] * (x - w) + p["alpha2"] * z2) / (p["c0"] + p["c2"])
     return p["k0"] * y + p["c0"] * wd
+
+
+@functools.lru_cache(maxsize=64)
+def _paper_test_force(parameters: tuple, kind: str, duration_s: float, amplitude_mm: float, frequency_hz: float,
+                      rise_time_s: float) -> np.ndarray:
+    p = dict(parameters)
+    time_s = np.arange(round(duration_s * 1000.0) + 1) / 1000.0   # both ends, as protocols.sample_times
+    if kind == "sine":
+        omega = 2.0 * np.pi * frequency_hz
+        return paper_force(p, time_s, lambda t: amplitude_mm * np.sin(omega * t),
+                           lambda t: amplitude_mm * omega * np.cos(omega * t))
+    rate = amplitude_mm / rise_time_s
+    return paper_force(p, time_s, lambda t: np.minimum(rate * np.asarray(t), amplitude_mm),
+                       lambda t: np.where(np.asarray(t) < rise_time_s, rate, 0.0))
+
+
+def paper_test_force(p, kind, duration_s, amplitude_mm=2.0, frequency_hz=10.0, rise_time_s=0.1):
+    """The force [N] of the proposed model with parameters ``p`` on the paper's sine
+    (``amplitude_mm`` at ``frequency_hz``) or step (ramp to ``amplitude_mm`` over
+    ``rise_time_s``, then held), sampled at 1 kHz from t = 0 to ``duration_s``: scipy's Radau on the paper's
+    equations (:func:`paper_force`), independent of the project's kernels. Synthetic training
+    data made this way cannot share an error with the fitted model."""
+    return _paper_test_force(tuple(sorted(p.items())), kind, float(duration_s), amplitude_mm, frequency_hz,
+                             rise_time_s).copy()
 
 
 JUMP_RAMP_S = 1e-9

@@ -107,7 +107,7 @@ def test_spencer_beta_and_gamma_are_not_interchangeable():
 def test_single_bouc_wen_matches_radau_on_its_equations():
     t, x, v = secant_input(Sine(2.0, 10.0), 0.3)
     expected = bouc_wen_reference(BOUC_WEN, t, x, v)
-    predicted = simulate_model_held("bouc_wen", BOUC_WEN, t, x, v)
+    predicted = simulate_model_held("single_bouc_wen", BOUC_WEN, t, x, v)
     assert np.max(np.abs(predicted - expected)) < 1e-3 * np.max(np.abs(expected))
 
 
@@ -115,7 +115,7 @@ def test_single_bouc_wen_starts_with_its_spring_force_at_an_offset():
     # F = k0*x at rest with z = 0: the grounded spring carries the initial displacement.
     t = sample_times(0.1, 1000.0)
     x = np.full_like(t, 1.5)
-    forces = simulate_model_held("bouc_wen", BOUC_WEN, t, x, np.zeros_like(t))
+    forces = simulate_model_held("single_bouc_wen", BOUC_WEN, t, x, np.zeros_like(t))
     assert forces == pytest.approx(BOUC_WEN["k0"] * 1.5, rel=1e-9)
 
 
@@ -127,7 +127,7 @@ def test_kelvin_voigt_is_exactly_linear():
         p["k"] * (x[:-1] + v[:-1] * 1e-3) + p["c"] * v[:-1] + p["preload"], rel=1e-9, abs=1e-6)
 
 
-@pytest.mark.parametrize("model, params, block", [("bouc_wen", BOUC_WEN, ""), ("spencer", SPENCER, "")])
+@pytest.mark.parametrize("model, params, block", [("single_bouc_wen", BOUC_WEN, ""), ("spencer", SPENCER, "")])
 def test_the_alpha_redundancy_holds_for_the_baselines(model, params, block):
     t, x, v = secant_input(Sine(2.0, 10.0), 0.3)
     scaled = _rescale_block(params, block, 3.7)
@@ -136,7 +136,7 @@ def test_the_alpha_redundancy_holds_for_the_baselines(model, params, block):
                                rtol=1e-8, atol=1e-8 * np.max(np.abs(simulate_model_held(model, params, t, x, v))))
 
 
-@pytest.mark.parametrize("model, params", [("bouc_wen", BOUC_WEN), ("spencer", dict(SPENCER, x0=0.0))])
+@pytest.mark.parametrize("model, params", [("single_bouc_wen", BOUC_WEN), ("spencer", dict(SPENCER, x0=0.0))])
 def test_search_space_round_trip_for_the_baselines(model, params):
     space = SearchSpace(800.0, 5.0, 3000.0, 0.001, model=model)
     theta = space.to_coordinates(params)
@@ -145,10 +145,10 @@ def test_search_space_round_trip_for_the_baselines(model, params):
     assert space.inside(theta)[0]
 
 
-@pytest.mark.parametrize("model", ["spencer", "bouc_wen", "kelvin_voigt"])
+@pytest.mark.parametrize("model", ["spencer", "single_bouc_wen", "kelvin_voigt"])
 @pytest.mark.parametrize("suffix", [".json", ".ssv"])
 def test_baseline_parameter_files_round_trip_and_name_their_model(tmp_path, model, suffix):
-    params = {"spencer": SPENCER, "bouc_wen": BOUC_WEN, "kelvin_voigt": {"k": 1.0, "c": 2.0, "preload": 3.0}}[model]
+    params = {"spencer": SPENCER, "single_bouc_wen": BOUC_WEN, "kelvin_voigt": {"k": 1.0, "c": 2.0, "preload": 3.0}}[model]
     path = save_parameters(tmp_path / f"p{suffix}", params, model)
     parameter_set = read_parameter_set(path)
     assert parameter_set.model is MODELS[model] and parameter_set.parameters == params

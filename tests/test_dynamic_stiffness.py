@@ -135,7 +135,7 @@ def test_the_issue_figures_of_table5():
 
 
 def test_every_model_and_an_ensemble(tmp_path):
-    for name in ("spencer", "bouc_wen", "kelvin_voigt"):
+    for name in ("spencer", "single_bouc_wen", "kelvin_voigt"):
         parameters = load_parameters(REPO / "data" / f"params_{name}_fit_synthetic_table5.json")
         table = characterise(parameters, [0.5, 2.0], [1.0, 20.0], model=name)
         assert table.converged.all() and np.all(table.kdyn_N_per_mm > 0)

@@ -14,7 +14,7 @@ from fmu_src.bushing_models import MODELS
 from identification.forward_model import prepare_input
 from identification.measurements import Measurement, MeasurementError, MeasurementWarning, load_measurement
 from identification.noise import NoiseEstimate
-from identification.objectives import Objective, nrmse, rms_error
+from identification.objectives import Objective, nrmse, rms_level_error
 from identification.rig_tests import RigTest
 from identification.simulate import simulate
 from identification.protocols import Sine, Step, sample_times
@@ -149,8 +149,8 @@ def test_noise_levels_below_a_tenth_of_a_percent_count_as_a_tenth_of_a_percent()
 def test_error_measures():
     measured = np.array([3.0, -4.0, 3.0, -4.0])
     assert nrmse(0.5 * measured, measured) == pytest.approx(0.5)
-    assert rms_error(0.5 * measured, measured) == pytest.approx(0.5)  # eq. 10
-    assert rms_error(-measured, measured) == 0.0  # eq. 10 cannot see a sign error; NRMSE can
+    assert rms_level_error(0.5 * measured, measured) == pytest.approx(0.5)  # eq. 10
+    assert rms_level_error(-measured, measured) == 0.0  # eq. 10 cannot see a sign error; NRMSE can
     assert nrmse(-measured, measured) == pytest.approx(2.0)
 
 

@@ -169,7 +169,7 @@ def test_displacement_jump_is_the_limit_of_a_steep_ramp_of_the_papers_equations(
 @pytest.mark.parametrize("model, name, value, fragment", [
     ("spencer", "c0", -1.0, "c0 = -1.0 [N.s/mm] must be >= 0"),
     ("spencer", "alpha", -1.0, "alpha = -1.0 [1] must be >= 0"),
-    ("bouc_wen", "A", -5.0, "A = -5.0 [N/mm] must be >= 0"),
+    ("single_bouc_wen", "A", -5.0, "A = -5.0 [N/mm] must be >= 0"),
     ("kelvin_voigt", "c", -1.0, "c = -1.0 [N.s/mm] must be >= 0"),
     ("kelvin_voigt", "k", -1.0, "k = -1.0 [N/mm] must be >= 0"),
 ])

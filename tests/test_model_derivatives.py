@@ -12,7 +12,7 @@ CASES = {
     "proposed": (paper_parameters("table5"),
                  lambda p, s, x, v: paper_equations(0.0, s, p, lambda t: x, lambda t: v), (1.0, 500.0, 1.0, 50.0)),
     "spencer": (SPENCER, spencer_rhs, (1.0, 500.0)),
-    "bouc_wen": (BOUC_WEN, bouc_wen_rhs, (500.0,)),
+    "single_bouc_wen": (BOUC_WEN, bouc_wen_rhs, (500.0,)),
 }
 
 
@@ -38,7 +38,7 @@ def test_switches_are_the_blocks_relative_velocities_and_hysteretic_forces():
     dy, _, dw, _ = paper_equations(0.0, state, p, lambda t: x, lambda t: v)
     np.testing.assert_allclose(bushing.switches(constants, state, x, v), (v - dy, state[1], v - dw, state[3]),
                                rtol=1e-14)
-    assert MODELS["bouc_wen"].switches(MODELS["bouc_wen"].constants(BOUC_WEN), (7.0,), 0.1, -3.0) == (-3.0, 7.0)
+    assert MODELS["single_bouc_wen"].switches(MODELS["single_bouc_wen"].constants(BOUC_WEN), (7.0,), 0.1, -3.0) == (-3.0, 7.0)
 
 
 def test_kelvin_voigt_has_no_state_to_integrate():

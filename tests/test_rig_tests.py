@@ -122,7 +122,7 @@ def test_a_fit_whose_files_cannot_be_written_after_all_is_rescued_into_the_worki
     def vanishing_folder(path, *args, **kwargs):
         shutil.rmtree(out_dir, ignore_errors=True)
         return real_save(path, *args, **kwargs)
-    monkeypatch.setattr("identification.fitting.save_parameters", vanishing_folder)
+    monkeypatch.setattr("identification.fit_result.save_parameters", vanishing_folder)
     assert main(["fit", "--model", "kelvin_voigt", "--sine", str(SINE), "--out", str(out_dir / "p.json"),
                  "--quiet"]) == 0
     rescued, = work.glob("rescued_fit_*.json")

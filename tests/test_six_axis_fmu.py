@@ -209,7 +209,7 @@ def test_assemble_builds_the_six_axis_file_from_one_file_per_axis(tmp_path):
     from identification.__main__ import main
     files = {"x": DATA / "params_table5_combined.json", "y": DATA / "params_table2_sine.json",
              "z": DATA / "params_spencer_fit_synthetic_table5.json", "rx": DATA / "params_kelvin_voigt_fit_synthetic_table5.json",
-             "ry": DATA / "params_bouc_wen_fit_synthetic_table5.json", "rz": DATA / "params_table4_step.ssv"}
+             "ry": DATA / "params_single_bouc_wen_fit_synthetic_table5.json", "rz": DATA / "params_table4_step.ssv"}
     out = tmp_path / "six.json"
     assert main(["assemble", *(f"--axis={name}={path}" for name, path in files.items()), "--out", str(out)]) == 0
     six = read_six_axis(out)

@@ -1,0 +1,47 @@
+"""One reading of "the parameters" for the front door: ``simulate``, ``predict`` and
+``characterise`` accept the same things alike.
+
+Accepted: a mapping of one set (names to values in the paper's N-mm-s units), a
+``ParameterSet``, a ``ParameterEnsemble``, a ``FitResult`` (its ensemble, the best fit first),
+a path of a parameter or ensemble file (.json or .ssv, as ``read_ensemble`` reads it), or a
+list of mappings (best first).
+"""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Mapping
+
+from fmu_src.bushing_models import BushingModel, get_model
+from fmu_src.parameter_files import ParameterEnsemble, ParameterSet, read_ensemble
+from identification.errors import IdentificationError
+
+
+def parameter_sets(parameters, model: str | None = None) -> tuple[BushingModel, list[dict[str, float]]]:
+    """The model and the validated parameter sets (best first) of any accepted ``parameters``.
+
+    ``model``: the model's name or FMI identifier; for a mapping or a list of mappings it says
+    which model they are for (default ``"proposed"``), for the others it is checked against the
+    model they name. Raises ``ParameterError`` for an invalid set, ``IdentificationError`` for a
+    model that differs, ``TypeError`` for anything else.
+    """
+    if hasattr(parameters, "ensemble") and hasattr(parameters, "parameters") and hasattr(parameters, "misfit"):
+        bushing, sets = parameters.parameters.model, parameters.ensemble          # a FitResult
+    elif isinstance(parameters, (str, Path)):
+        ensemble = read_ensemble(parameters)
+        bushing, sets = ensemble.model, ensemble.members
+    elif isinstance(parameters, ParameterEnsemble):
+        bushing, sets = parameters.model, parameters.members
+    elif isinstance(parameters, ParameterSet):
+        bushing, sets = parameters.model, [parameters.parameters]
+    elif isinstance(parameters, Mapping):
+        bushing, sets = get_model(model or "proposed"), [parameters]
+    else:
+        sets = list(parameters) if isinstance(parameters, (list, tuple)) else []
+        if not sets or not all(isinstance(s, Mapping) for s in sets):
+            raise TypeError(f"parameters: give a mapping of names to values, a ParameterSet, a ParameterEnsemble, "
+                            f"a FitResult, a parameter file's path or a list of mappings, not "
+                            f"{type(parameters).__name__}")
+        bushing = get_model(model or "proposed")
+    if model is not None and get_model(model) is not bushing:
+        raise IdentificationError(f"the parameters are for the {bushing.name} model, not {model}")
+    return bushing, [bushing.check(s) for s in sets]

@@ -1,0 +1,165 @@
+"""The front door as a newcomer meets it: what the base install (no extras) can do, the
+one-line error when an extra is missing, one reading of "the parameters", the renamed single
+Bouc-Wen model and its old name, output directories refused before the work, warnings and
+progress bars that do not glue lines."""
+import json
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+from conftest import DATA, REPO
+
+SINE = DATA / "synthetic_table5_sine_2mm_10Hz.csv"
+
+# Runs Python with numba (and with it the "fit" extra) made unimportable, as in a base install.
+WITHOUT_NUMBA = "import sys; sys.modules['numba'] = None\n"
+
+
+def run_without_numba(code: str, timeout: float = 300) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-c", WITHOUT_NUMBA + code], cwd=REPO, capture_output=True, text=True,
+                          timeout=timeout)
+
+
+def test_simulate_runs_without_numba_and_equals_the_compiled_forward_model():
+    """The base install's simulate (the models' kernels as plain Python, fmu_src.jit) gives the
+    compiled forward model's forces: the same source, run two ways."""
+    from identification import load_measurement, simulate
+    m = load_measurement(SINE)
+    keep = slice(0, 200)     # 0.2 s: two cycles, enough to leave the initial state
+    compiled = simulate(DATA / "params_table5_combined.json", m.time_s[keep], m.displacement_mm[keep])
+    code = ("import json, numpy as np\n"
+            "from fmu_src import jit\n"
+            "assert not jit.AVAILABLE\n"
+            "from identification import load_measurement, simulate\n"
+            f"m = load_measurement({str(SINE)!r})\n"
+            f"f = simulate({str(DATA / 'params_table5_combined.json')!r}, m.time_s[:200], m.displacement_mm[:200])\n"
+            "print(json.dumps(f.tolist()))\n")
+    done = run_without_numba(code)
+    assert done.returncode == 0, done.stderr
+    plain = np.array(json.loads(done.stdout))
+    peak = np.max(np.abs(compiled))
+    assert peak > 1000.0
+    assert np.max(np.abs(plain - compiled)) <= 1e-12 * peak
+
+
+@pytest.mark.parametrize("arguments, extra", [
+    (["fit", "--sine", str(SINE), "--out", "p.json"], "fit"),
+    (["characterise", "--params", str(DATA / "params_table5_combined.json"), "--out", "k.csv"], "fit"),
+])
+def test_a_command_whose_extra_is_missing_says_which_extra_in_one_line(tmp_path, arguments, extra):
+    code = ("import sys\nfrom identification.cli import main\n"
+            f"sys.exit(main({[a if not a.endswith(('.json', '.csv')) or '/' in a else str(tmp_path / a) for a in arguments]!r}))\n")
+    done = run_without_numba(code, timeout=60)
+    assert done.returncode == 2
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in done.stderr
+    assert lines[0].startswith("error: the ") and f"needs the '{extra}' extra (numba is not installed)" in lines[0]
+    assert f"pip install 'boucwen-bushing[{extra}]'" in lines[0]
+    assert not list(tmp_path.iterdir())
+
+
+def test_fit_from_python_without_the_extra_raises_a_missing_extra_error():
+    done = run_without_numba("from identification import MissingExtraError, fit\n"
+                             "try:\n    fit([])\nexcept MissingExtraError as exc:\n    print(exc)\n", timeout=60)
+    assert done.returncode == 0, done.stderr
+    assert "identification.fit needs the 'fit' extra" in done.stdout
+
+
+def test_the_same_parameters_in_any_form_give_the_same_forces(tmp_path):
+    from fmu_src.parameter_files import read_parameter_set
+    from identification import characterise, predict, simulate
+    from identification.fit_result import FitResult
+    path = DATA / "params_table5_combined.json"
+    parameter_set = read_parameter_set(path)
+    mapping = dict(parameter_set.parameters)
+    result = FitResult(parameter_set, 1.0, [], [], 0.0, [mapping], None, "default", 0, 1, 0.0)
+    t = np.arange(0.0, 0.1, 1e-3)
+    x = 2.0 * np.sin(2 * np.pi * 10.0 * t)
+    reference = simulate(mapping, t, x)
+    for form in (parameter_set, result, path, str(path), [mapping]):
+        np.testing.assert_array_equal(simulate(form, t, x), reference)
+        np.testing.assert_array_equal(predict(form, t, x).force_N, reference)
+    sheet = characterise(result, [1.0], [10.0])
+    np.testing.assert_array_equal(sheet.kdyn_N_per_mm, characterise(path, [1.0], [10.0]).kdyn_N_per_mm)
+    with pytest.raises(TypeError, match="not int"):
+        simulate(5, t, x)
+
+
+def test_the_single_bouc_wen_model_keeps_its_old_name_as_an_alias(tmp_path):
+    from fmu_src.bushing_models import MODEL_NAMES, get_model
+    from fmu_src.parameter_files import read_parameter_set
+    single = get_model("single_bouc_wen")
+    assert "single_bouc_wen" in MODEL_NAMES and "bouc_wen" not in MODEL_NAMES
+    assert get_model("bouc_wen") is single and single.identifier == "SingleBoucWenBushing"
+    document = json.loads((DATA / "params_single_bouc_wen_fit_synthetic_table5.json").read_text())
+    document["model"] = "bouc_wen"
+    old = tmp_path / "old.json"
+    old.write_text(json.dumps(document))
+    assert read_parameter_set(old).model is single
+    from identification.cli import main
+    # the old name on the command line: accepted, and the file must be for that model
+    assert main(["characterise", "--params", str(old), "--model", "bouc_wen", "--amplitudes-mm", "1",
+                 "--frequencies-hz", "10", "--out", str(tmp_path / "k.csv"), "--json"]) == 0
+    assert main(["characterise", "--params", str(old), "--model", "proposed", "--amplitudes-mm", "1",
+                 "--frequencies-hz", "10", "--out", str(tmp_path / "k2.csv")]) == 2
+
+
+@pytest.mark.parametrize("plots", ["{file}/plots", "/proc/bushing_plots"])
+def test_an_unwritable_plots_directory_is_refused_before_the_fit(tmp_path, capsys, plots):
+    from identification.cli import main
+    (tmp_path / "file").write_text("a file, not a directory")
+    plots = plots.replace("{file}", str(tmp_path / "file"))
+    started = time.monotonic()
+    assert main(["fit", "--sine", str(SINE), "--out", str(tmp_path / "p.json"), "--plots", plots, "--quiet"]) == 2
+    assert time.monotonic() - started < 20    # refused, not fitted: a fit takes a minute
+    error = capsys.readouterr().err
+    assert f"--plots {plots}:" in error and "Traceback" not in error
+    assert not (tmp_path / "p.json").exists()
+
+
+def test_progress_bars_are_off_when_stderr_is_not_a_terminal_and_a_warning_has_its_own_line(capsys):
+    from identification.commands import print_warning
+    from identification.progress import SearchProgress, bar
+    from identification.presets import PRESETS
+    assert bar(10, "work", "items") is None          # pytest's captured stderr is not a terminal
+    progress = SearchProgress(True, PRESETS["default"], 100)
+    progress.screening(50)
+    progress.close()
+    print_warning("something to read")
+    assert capsys.readouterr().err == "WARNING: something to read\n"   # nothing before it on its line
+
+
+def test_the_command_line_offers_the_presets_defined_once():
+    from identification.cli import main
+    from identification.presets import PRESETS, describe
+    with pytest.raises(SystemExit):
+        main(["fit", "--preset", "no-such-preset", "--sine", str(SINE), "--out", "p.json"])
+    parser_help = subprocess.run([sys.executable, "-m", "identification", "fit", "--help"], cwd=REPO,
+                                 capture_output=True, text=True, timeout=60).stdout
+    assert "{" + ",".join(PRESETS) + "}" in parser_help
+    squashed = " ".join(parser_help.split())
+    for name in PRESETS:
+        assert " ".join(describe(name).split())[:40] in squashed
+    assert str(PRESETS["default"].screening) in squashed
+
+
+@pytest.mark.slow
+def test_the_example_in_the_packages_docstring_runs_as_written(tmp_path):
+    """identification/__init__.py's example, verbatim, in a folder where data/ is the repository's."""
+    import os
+    import textwrap
+
+    import identification
+    doc = identification.__doc__
+    example = textwrap.dedent(doc[doc.index("::\n") + 3:doc.index("\nUnits:")])
+    (tmp_path / "data").symlink_to(REPO / "data")
+    (tmp_path / "example.py").write_text(example)
+    environment = dict(os.environ, PYTHONPATH=str(REPO))
+    done = subprocess.run([sys.executable, "example.py"], cwd=tmp_path, capture_output=True, text=True,
+                          timeout=900, env=environment)
+    assert done.returncode == 0, done.stderr[-3000:]
+    assert "fitted to 2 test(s)" in done.stdout and "|K*|" in done.stdout
+    assert (tmp_path / "params.json").is_file() and (tmp_path / "ensemble.json").is_file()
