@@ -11,12 +11,13 @@ from fmu_src.bushing_models import MODELS
 from fmu_src.parameter_files import load_parameters
 from identification.compiled_core import simulate_model_held
 from identification.protocols import Sine, sample_times
+from paper_units import PARAMETER_UNITS
 from test_fmu_numerics import simulate_with_fmpy
 
-BASELINES = ("spencer", "bouc_wen", "kelvin_voigt")
+BASELINES = ("spencer", "single_bouc_wen", "kelvin_voigt")
 MM = 1e-3
 BAD_VALUES = {"spencer": ("c1", 0.0, "c1 = 0.0 [N.s/mm] must be > 0"),
-              "bouc_wen": ("n", -1.0, "n = -1.0 [1] must be > 0"),
+              "single_bouc_wen": ("n", -1.0, "n = -1.0 [1] must be > 0"),
               "kelvin_voigt": ("k", float("nan"), "k = nan [N/mm] is not a finite number")}
 
 
@@ -36,8 +37,9 @@ def test_baseline_fmu_validates_and_declares_its_own_identifier_and_units(baseli
     assert {"x", "v", "F"} <= set(variables)
     assert (variables["x"].unit, variables["v"].unit, variables["F"].unit) == ("m", "m/s", "N")
     defaults = load_parameters(build_fmu.default_parameter_file(model), model)
-    for name, unit in MODELS[model].units.items():
-        assert variables[name].unit == unit and float(variables[name].start) == defaults[name]
+    assert {v.name for v in description.modelVariables if v.causality == "parameter"} == set(PARAMETER_UNITS[model])
+    for name, unit in PARAMETER_UNITS[model].items():
+        assert variables[name].unit == unit and float(variables[name].start) == defaults[name], name
 
 
 @pytest.mark.parametrize("model", BASELINES)

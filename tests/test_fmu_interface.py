@@ -5,7 +5,9 @@ from fmpy import read_model_description
 from fmpy.validation import validate_fmu
 
 from conftest import paper_parameters
-from fmu_src.proposed_model import PARAMETER_NAMES, PARAMETER_UNITS
+from paper_units import PARAMETER_UNITS
+
+PROPOSED_UNITS = PARAMETER_UNITS["proposed"]
 
 
 def test_fmpy_validation_finds_no_problem(fmu_path):
@@ -22,10 +24,10 @@ def test_ports_are_si_and_parameters_in_paper_units(fmu_path):
         assert variables[name].unit == "N"
     for name in ("y", "w"):
         assert variables[name].unit == "m"
-    for name in PARAMETER_NAMES:
-        assert variables[name].causality == "parameter"
+    assert {v.name for v in description.modelVariables if v.causality == "parameter"} == set(PROPOSED_UNITS)
+    for name, unit in PROPOSED_UNITS.items():
         assert variables[name].variability == "tunable"
-        assert variables[name].unit == PARAMETER_UNITS[name]
+        assert variables[name].unit == unit, name
     defined = {unit.name: unit for unit in description.unitDefinitions}
     assert defined["N/mm"].baseUnit.kg == 1 and defined["N/mm"].baseUnit.s == -2
     assert defined["N/mm"].baseUnit.factor == 1000.0
@@ -34,7 +36,7 @@ def test_ports_are_si_and_parameters_in_paper_units(fmu_path):
 def test_parameter_start_values_are_table5_exactly(fmu_path):
     variables = {v.name: v for v in read_model_description(fmu_path).modelVariables}
     table5 = paper_parameters("table5")
-    for name in PARAMETER_NAMES:
+    for name in PROPOSED_UNITS:
         assert float(variables[name].start) == table5[name]
 
 

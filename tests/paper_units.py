@@ -1,0 +1,22 @@
+"""The parameters' units, written out here from the equations (not read from the model
+definitions under test), in the paper's N-mm-s system.
+
+Springs k [N/mm] and dashpots c [N.s/mm] by F = k*x + c*v; the Bouc-Wen variable z is a force
+[N], so in dz/dt = A*dx/dt - beta*|dx/dt|*|z|^(n-1)*z - gamma*dx/dt*|z|^n the gain A is N/mm and
+beta, gamma are N^(1-n)/mm; n and the weights alpha (F = alpha*z + ...) are dimensionless;
+Spencer's x0 is a length [mm]; the Kelvin-Voigt preload is a force [N].
+"""
+_BLOCK = {"A{}": "N/mm", "beta{}": "N^(1-n{})/mm", "gamma{}": "N^(1-n{})/mm", "n{}": "1", "alpha{}": "1"}
+
+
+def _block(suffix: str) -> dict[str, str]:
+    return {name.format(suffix): unit.format(suffix) for name, unit in _BLOCK.items()}
+
+
+PARAMETER_UNITS = {
+    "proposed": {"c0": "N.s/mm", "k0": "N/mm", "c1": "N.s/mm", "k1": "N/mm", "c2": "N.s/mm", "k2": "N/mm",
+                 **_block("1"), **_block("2")},
+    "spencer": {"c0": "N.s/mm", "k0": "N/mm", "c1": "N.s/mm", "k1": "N/mm", "x0": "mm", **_block("")},
+    "single_bouc_wen": {"c0": "N.s/mm", "k0": "N/mm", **_block("")},
+    "kelvin_voigt": {"k": "N/mm", "c": "N.s/mm", "preload": "N"},
+}
