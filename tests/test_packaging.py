@@ -102,3 +102,45 @@ def test_license_is_the_one_the_package_and_the_fmu_declare(fmu_path):
     assert (REPO / "LICENSE").read_text().startswith("MIT License")
     assert 'license = { text = "MIT" }' in (REPO / "pyproject.toml").read_text()
     assert read_model_description(str(fmu_path)).license == "MIT"
+
+
+@pytest.mark.slow
+def test_the_base_install_builds_runs_and_simulates_and_names_the_extra_it_lacks(tmp_path):
+    # `pip install .` alone, in a fresh environment: numpy, scipy, pythonfmu, fmpy and nothing
+    # of the extras. It builds the FMU and runs it through fmpy, simulates with the kernels as
+    # plain Python, and a fit says which extra to install (one line, exit 2).
+    import venv
+    environment = tmp_path / "venv"
+    venv.EnvBuilder(with_pip=True).create(environment)
+    python = environment / "bin" / "python"
+    source = tmp_path / "source"
+    shutil.copytree(REPO, source, ignore=shutil.ignore_patterns(".git", ".venv", "build", "dist", "out", "*.egg-info",
+                                                                 "__pycache__", ".pytest_cache", "site"))
+    installed = subprocess.run([str(python), "-m", "pip", "install", "-q", str(source)], capture_output=True,
+                               text=True, timeout=900)
+    assert installed.returncode == 0, installed.stderr[-3000:]
+    work = tmp_path / "work"
+    work.mkdir()
+    script = ("import importlib.util, sys\n"
+              "import numpy as np\n"
+              "for extra in ('numba', 'matplotlib', 'pymoo', 'emcee', 'distributed', 'libcosimpy'):\n"
+              "    assert importlib.util.find_spec(extra) is None, extra + ' is installed'\n"
+              "import build_fmu\n"
+              "from fmpy import simulate_fmu\n"
+              "from identification import simulate\n"
+              "path = build_fmu.build_fmu(out_dir='dist')\n"
+              "t = np.arange(0, 0.201, 1e-3)\n"
+              "table = np.array(list(zip(t, 2e-3*np.sin(20*np.pi*t), 2e-3*20*np.pi*np.cos(20*np.pi*t))),\n"
+              "                 dtype=[('time', float), ('x', float), ('v', float)])\n"
+              "fmu = simulate_fmu(str(path), stop_time=0.2, step_size=1e-3, input=table, output=['F'])\n"
+              "force = simulate(build_fmu.default_parameter_file(), t, 2*np.sin(20*np.pi*t))\n"
+              "print(np.max(np.abs(fmu['F'])), np.max(np.abs(force)))\n")
+    run = subprocess.run([str(python), "-c", script], capture_output=True, text=True, timeout=600, cwd=work)
+    assert run.returncode == 0, run.stderr[-3000:]
+    fmu_peak, simulated_peak = map(float, run.stdout.split()[-2:])
+    assert 4000.0 < fmu_peak < 5000.0 and 4000.0 < simulated_peak < 5000.0   # Table 5 on 2 mm / 10 Hz
+    fit = subprocess.run([str(environment / "bin" / "bushing-identify"), "fit", "--sine",
+                          str(REPO / "data" / "synthetic_table5_sine_2mm_10Hz.csv"), "--out", "p.json"],
+                         capture_output=True, text=True, timeout=120, cwd=work)
+    assert fit.returncode == 2 and fit.stderr.count("\n") == 1 and "Traceback" not in fit.stderr
+    assert "needs the 'fit' extra" in fit.stderr and "pip install 'boucwen-bushing[fit]'" in fit.stderr
