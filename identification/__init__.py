@@ -21,6 +21,23 @@ about a minute on two cores)::
 
 Units: s, mm, mm/s, N; parameters in the paper's N-mm-s units. With ``workers`` > 1 the fit
 starts worker processes: guard a script's top level with ``if __name__ == "__main__":``.
+
+The modules, in the order of the workflow:
+
+- reading the tests: ``measurements`` (CSV files), ``rig_tests`` (which file is which test, the
+  manifest), ``kdyn_table`` (a supplier's dynamic-stiffness table), ``noise`` (each test's noise
+  level), ``protocols`` (the paper's test signals);
+- the forward model: ``simulate`` (the front door), ``parameter_input`` (what counts as
+  parameters), ``forward_model`` (the input between samples), ``compiled_core`` and
+  ``steady_state`` (the models' kernels, compiled per model), ``refinement`` (finer steps where
+  needed);
+- fitting: ``fitting`` (``fit``), ``fit_result`` (what it returns), ``presets``, ``search_space``
+  (the box), ``objectives`` (the misfit), ``multistart`` (screening and least-squares stages),
+  ``ensemble`` (how sure), ``engine`` (where tasks run), ``progress``, ``fleet`` (many bushings);
+- analysis: ``predict`` (force and band), ``dynamic_stiffness`` (data sheet), ``design`` (the next
+  test), ``sensitivity``, ``report`` and ``compare`` (the paper's §5 tables and study),
+  ``six_axis`` (one file from six fits), ``plots``;
+- the command line: ``cli`` (arguments), ``commands`` (what each does), ``extras``, ``errors``.
 """
 from fmu_src.bushing_params import ParameterError
 from fmu_src.parameter_files import (ParameterEnsemble, ParameterSet, read_ensemble, read_parameter_set,
