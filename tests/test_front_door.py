@@ -163,3 +163,15 @@ def test_the_example_in_the_packages_docstring_runs_as_written(tmp_path):
     assert done.returncode == 0, done.stderr[-3000:]
     assert "fitted to 2 test(s)" in done.stdout and "|K*|" in done.stdout
     assert (tmp_path / "params.json").is_file() and (tmp_path / "ensemble.json").is_file()
+
+
+@pytest.mark.parametrize("script", ["examples/cosim/shaker_rig.py", "examples/cosim/engine_mount.py"])
+def test_the_cosimulation_examples_name_the_extra_they_lack(script, tmp_path):
+    code = ("import runpy, sys\nsys.modules['libcosimpy'] = None\n"
+            f"sys.argv = [{script!r}, '--out', {str(tmp_path / 'out')!r}]\n"
+            f"runpy.run_path({script!r}, run_name='__main__')\n")
+    done = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2 and "Traceback" not in done.stderr
+    assert done.stderr.strip() == (f"error: {script} needs the 'cosim' extra (libcosimpy is not installed): "
+                                   "pip install 'boucwen-bushing[cosim]'")
+    assert not (tmp_path / "out").exists()

@@ -257,6 +257,7 @@ def main(argv=None) -> int:
     parser.add_argument("--out", type=Path, default=REPO / "out" / "engine_mount")
     parser.add_argument("--native", action="store_true", help="the native (compiled C) six-axis bushing FMUs")
     args = parser.parse_args(argv)
+    ssp_system.require_extras("examples/cosim/engine_mount.py")
     args.out.mkdir(parents=True, exist_ok=True)
     started = time.perf_counter()
     bushing_fmu, body_fmu = build_fmus(args.out / "fmus", native=args.native)

@@ -120,6 +120,7 @@ def main(argv=None) -> int:
     parser.add_argument("--out", type=Path, default=REPO / "out" / "shaker_rig")
     parser.add_argument("--native", action="store_true", help="the native (compiled C) bushing FMU")
     args = parser.parse_args(argv)
+    ssp_system.require_extras("examples/cosim/shaker_rig.py")
     args.out.mkdir(parents=True, exist_ok=True)
     bushing_fmu, body_fmu = build_fmus(args.out / "fmus", args.native)
     system_dir = args.out / "ShakerRig"

@@ -25,6 +25,7 @@ the explicit loop.
 from __future__ import annotations
 
 import shutil
+import sys
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
@@ -32,6 +33,18 @@ from typing import Sequence
 from xml.etree import ElementTree as ET
 
 import numpy as np
+
+def require_extras(script: str) -> None:
+    """Stop with one line naming the extras to install (exit 2) if libcosimpy or matplotlib
+    is missing: the examples run libcosim and plot (``pip install 'boucwen-bushing[cosim,plot]'``)."""
+    from identification.extras import MissingExtraError, require
+    try:
+        require("cosim", script)
+        require("plot", script)
+    except MissingExtraError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        sys.exit(2)
+
 
 SSD_NS = {"ssd": "http://ssp-standard.org/SSP1/SystemStructureDescription",
           "ssc": "http://ssp-standard.org/SSP1/SystemStructureCommon"}
