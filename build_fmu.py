@@ -40,7 +40,7 @@ from xml.etree import ElementTree as ET
 REPO = Path(__file__).resolve().parent
 LIBRARY_MODULES = ("bushing_params.py", "model_definition.py", "integration.py", "compiled_kernels.py", "axes.py",
                    "proposed_model.py",
-                   "spencer_model.py", "bouc_wen_model.py", "kelvin_voigt_model.py", "bushing_models.py",
+                   "spencer_model.py", "single_bouc_wen_model.py", "kelvin_voigt_model.py", "bushing_models.py",
                    "parameter_files.py", "variables.py", "jit.py")
 SLAVE_MODULE = "bushing_slave.py"
 
@@ -48,7 +48,7 @@ sys.path.insert(0, str(REPO))
 import fmu_src  # noqa: E402
 from fmu_src import __version__, bushing_params  # noqa: E402
 from fmu_src.axes import ONE_AXIS, SIX_AXIS_IDENTIFIER  # noqa: E402
-from fmu_src.bushing_models import MODEL_CHOICES, get_model  # noqa: E402
+from fmu_src.bushing_models import MODEL_CHOICES, MODEL_NAMES, get_model  # noqa: E402
 from fmu_src.parameter_files import (parameter_document, read_parameter_set, read_six_axis,  # noqa: E402
                                      six_axis_document)
 
@@ -86,6 +86,18 @@ def default_parameter_file(model: str = "proposed") -> Path:
     except ModuleNotFoundError:
         raise BuildError(f"the default parameter set {name} is neither in {REPO / 'data'} nor installed "
                          "(package bushing_data); reinstall the project or give --params FILE") from None
+
+
+def model_of_file(params_file: str | Path) -> str:
+    """The model a parameter file is for: the one it names (a one-axis set) or ``six_axis``."""
+    try:
+        return read_parameter_set(params_file).model.name
+    except bushing_params.ParameterError as one_axis_error:
+        try:
+            read_six_axis(params_file)
+        except bushing_params.ParameterError:
+            raise one_axis_error from None
+        return SIX_AXIS
 
 
 def fmu_axes(params_file: str | Path | None = None, model: str = "proposed"):
@@ -286,11 +298,14 @@ def _add_model_structure(root: ET.Element, axes) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="bushing-build-fmu", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(
+        prog="bushing-build-fmu",
+        description="Build a bushing FMU (pythonfmu, FMI 2.0 co-simulation; or --native: compiled C, FMI 2.0 "
+                    "or 3.0, co-simulation and model exchange) with a parameter set as its start values.")
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
-    parser.add_argument("--model", default="proposed", choices=(*MODEL_CHOICES, SIX_AXIS),
-                        help="which bushing model (default: proposed, the paper's eqs. 1-5); six_axis: the "
-                             "six-axis bushing SixAxisBushing, each axis one of the models")
+    parser.add_argument("--model", choices=(*MODEL_CHOICES, SIX_AXIS), metavar="MODEL",
+                        help=f"{', '.join(MODEL_NAMES)} or {SIX_AXIS} (six uncoupled axes, each one of the models); "
+                             "default: the model --params is for, else proposed (the paper's eqs. 1-5)")
     parser.add_argument("--params", help="parameter set of the model, project JSON or SSP 1.0 .ssv "
                                          "(paper N-mm-s units); default: the paper's Table 5 for the "
                                          "proposed model, data/params_<model>_fit_synthetic_table5.json for the "
@@ -304,6 +319,8 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     from fmu_src.native.build import NativeBuildError
     try:
+        if args.model is None:
+            args.model = model_of_file(args.params) if args.params else "proposed"
         if args.native:
             build = build_native_fmu(args.params, args.out, args.model, args.fmi_version)
             path = build.path
@@ -315,6 +332,9 @@ def main(argv: list[str] | None = None) -> int:
             path = build_fmu(args.params, args.out, args.model)
     except (bushing_params.ParameterError, BuildError, NativeBuildError) as exc:
         print(f"error: {exc}", file=sys.stderr)
+        return 2
+    except OSError as exc:   # an output directory that cannot be made or written
+        print(f"error: --out {args.out}: {exc.strerror or exc}", file=sys.stderr)
         return 2
     print(f"wrote {path}")
     return 0

@@ -34,7 +34,7 @@ def main() -> None:
 
     from scipy.integrate import solve_ivp
     from fmu_src.integration import StepError
-    from fmu_src.proposed_model import MODEL, PARAMETER_NAMES, rhs
+    from fmu_src.proposed_model import MODEL, PARAMETER_NAMES
     from fmu_src.parameter_files import load_parameters
     from identification.compiled_core import simulate_population_held
     from identification.measurements import load_measurement
@@ -75,10 +75,12 @@ def main() -> None:
     ivp_sample = matrix[:args.ivp_candidates]
     started = time.perf_counter()
     for row in ivp_sample:
-        p = dict(zip(PARAMETER_NAMES, row))
-        state = np.array(MODEL.initial_state(MODEL.constants(p), x[0]))
+        constants = MODEL.constants(dict(zip(PARAMETER_NAMES, row)))
+        state = np.array(MODEL.initial_state(constants, x[0]))
         for k in range(t.size - 1):
-            state = solve_ivp(rhs, (0.0, t[k + 1] - t[k]), state, method="Radau", args=(x[k], v[k], p),
+            # eqs. 1-4 (the model's derivatives) with the input held as the FMU holds it
+            state = solve_ivp(lambda s, y, xk, vk: MODEL.derivatives(constants, tuple(y), xk + vk * s, vk),
+                              (0.0, t[k + 1] - t[k]), state, method="Radau", args=(x[k], v[k]),
                               rtol=1e-6, atol=1e-6).y[:, -1]
     ivp_cost = (time.perf_counter() - started) / len(ivp_sample)
 

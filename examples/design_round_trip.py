@@ -26,6 +26,7 @@ from fmu_src.parameter_files import load_parameters  # noqa: E402
 from generate_synthetic import generate, named_protocols  # noqa: E402
 from identification import FitNotConvergedWarning, fit, training_tests  # noqa: E402
 from identification.design import design  # noqa: E402
+from identification.extras import require_or_exit  # noqa: E402
 from identification.report import grid_errors  # noqa: E402
 
 DATA = REPO / "data"
@@ -38,6 +39,7 @@ def main() -> None:
     parser.add_argument("--workers", type=int)
     parser.add_argument("--out", type=Path, default=REPO / "out" / "design_round_trip")
     args = parser.parse_args()
+    require_or_exit("fit", "examples/design_round_trip.py")
     args.out.mkdir(parents=True, exist_ok=True)
     truth = load_parameters(TRUTH)
     prefix = "synthetic_table2_noise1pct"

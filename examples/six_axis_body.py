@@ -121,8 +121,10 @@ def run(fmu_path: Path):
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--fmu", type=Path, help="SixAxisBushing.fmu (default: build one with the illustrative set)")
-    parser.add_argument("--out", type=Path, default=REPO / "examples")
+    parser.add_argument("--out", type=Path, default=REPO / "out" / "six_axis_body")
     args = parser.parse_args()
+    from identification.extras import require_or_exit
+    require_or_exit("plot", "examples/six_axis_body.py")
     args.out.mkdir(parents=True, exist_ok=True)
     fmu_path = args.fmu
     if fmu_path is None:

@@ -3,19 +3,19 @@ model module gives).
 
 - ``proposed``: the paper's model, eqs. 1-5, 16 parameters (``proposed_model``);
 - ``spencer``: Spencer et al. (1997), Fig. 7 of the paper (``spencer_model``);
-- ``single_bouc_wen``: the classic single Bouc-Wen element, Fig. 6 of the paper (``bouc_wen_model``;
-  ``bouc_wen``, its name before 0.9, is accepted as an alias in files and on the command line);
+- ``single_bouc_wen``: the classic single Bouc-Wen element, Fig. 6 of the paper (``single_bouc_wen_model``;
+  ``bouc_wen``, its earlier name, is accepted as an alias in files and on the command line);
 - ``kelvin_voigt``: the linear bushing of ADAMS/RecurDyn, one axis (``kelvin_voigt_model``).
 """
 from __future__ import annotations
 
-from . import bouc_wen_model, kelvin_voigt_model, proposed_model, spencer_model
+from . import kelvin_voigt_model, proposed_model, single_bouc_wen_model, spencer_model
 from .bushing_params import ParameterError
 from .model_definition import BushingModel
 
 MODELS: dict[str, BushingModel] = {
     module.MODEL.name: module.MODEL
-    for module in (proposed_model, spencer_model, bouc_wen_model, kelvin_voigt_model)
+    for module in (proposed_model, spencer_model, single_bouc_wen_model, kelvin_voigt_model)
 }
 MODEL_NAMES = tuple(MODELS)
 ALIASES = {"bouc_wen": "single_bouc_wen"}

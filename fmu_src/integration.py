@@ -1,6 +1,6 @@
 """Integration machinery shared by the bushing models: no model's equations live here.
 
-A model (``proposed_model``, ``spencer_model``, ``bouc_wen_model``, ``kelvin_voigt_model``)
+A model (``proposed_model``, ``spencer_model``, ``single_bouc_wen_model``, ``kelvin_voigt_model``)
 writes its equations as five kernels and uses the pieces below to step them:
 
 - a Bouc-Wen block in the form the models share. Where a Bouc-Wen element (eq. 1 or 2 of the

@@ -25,5 +25,6 @@ except ImportError:   # the base install (no "fit" extra)
 
     numba = types.SimpleNamespace(njit=_njit, prange=range, set_num_threads=lambda count: None)
 
-MISSING = "numba is not installed: the models run as plain Python (slow); pip install 'boucwen-bushing[fit]' compiles them"
+MISSING = ("numba is not installed: the models run as plain Python, some 100 times slower "
+           "(pip install 'boucwen-bushing[fit]' compiles them)")
 """What to tell a user who simulates without numba."""

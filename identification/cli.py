@@ -12,7 +12,7 @@ import sys
 import warnings
 from pathlib import Path
 
-from fmu_src import __version__
+from fmu_src import __version__, jit
 from fmu_src.bushing_models import MODEL_CHOICES, MODEL_NAMES
 from fmu_src.bushing_params import ParameterError
 from identification import commands
@@ -169,6 +169,9 @@ def main(argv: list[str] | None = None) -> int:
         except (IdentificationError, ParameterError, EngineError, commands.UsageError, MissingExtraError) as exc:
             print(f"error: {exc}", file=sys.stderr)
             return 2
+        except OSError as exc:   # a file that could not be read or written after all
+            print(f"error: {exc}", file=sys.stderr)
+            return 2
 
 
 COMMANDS = {"fit": commands.fit_command, "sensitivity": commands.sensitivity_command,
@@ -176,14 +179,18 @@ COMMANDS = {"fit": commands.fit_command, "sensitivity": commands.sensitivity_com
             "predict": commands.predict_command, "design": commands.design_command,
             "fit-many": commands.fit_many_command, "assemble": commands.assemble_command,
             "characterise": commands.characterise_command}
-NEEDS_FIT_EXTRA = ("fit", "compare", "fit-many", "sensitivity", "report", "design", "characterise")
-"""Commands that fit or run many simulations: they need numba and the optimizers (the ``fit`` extra)."""
+NEEDS_FIT_EXTRA = ("fit", "compare", "fit-many")
+"""Commands that fit: they need numba and the optimizers (the ``fit`` extra). The others only
+simulate, which the base install does too, as plain Python (``fmu_src.jit``), slower."""
 
 
 def _require_extras(args) -> None:
-    """Refuse, before any work, a command whose extra is not installed (one line, exit 2)."""
+    """Refuse, before any work, a command whose extra is not installed (one line, exit 2); say
+    once that a simulating command runs uncompiled without numba."""
     if args.command in NEEDS_FIT_EXTRA:
         require("fit", f"the {args.command} command")
+    elif args.command != "assemble" and not jit.AVAILABLE:
+        print(f"note: {jit.MISSING}", file=sys.stderr)
     if getattr(args, "plots", None) is not None or getattr(args, "plot", None) is not None:
         require("plot", f"{'--plots' if getattr(args, 'plots', None) is not None else '--plot'}")
     if getattr(args, "scheduler", None) is not None:

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fmu_src.bushing_models import MODEL_CHOICES, MODEL_NAMES
+from fmu_src.bushing_models import MODEL_CHOICES, MODEL_NAMES, get_model
 from fmu_src.parameter_files import read_parameter_set
 from identification.measurements import load_measurement
 from identification.rig_tests import load_manifest, training_tests
@@ -55,6 +55,14 @@ def check_output(path: Path | None, option: str, directory: bool = False, suffix
     check = folder if folder.exists() else folder.parent
     if not os.access(check, os.W_OK) or (path.exists() and not os.access(path, os.W_OK)):
         raise UsageError(f"{option} {path}: not writable")
+    if check.is_dir():
+        # os.access says yes to root and on special file systems (/proc): try it
+        try:
+            with tempfile.TemporaryFile(dir=check):
+                pass
+        except OSError as exc:
+            raise UsageError(f"{option} {path}: cannot write in {check} ({exc.strerror or exc})") from None
+
 
 def prepare_directory(path: Path | None, option: str) -> None:
     """Create the output directory ``path`` now and write a file into it, so that one that
@@ -92,6 +100,7 @@ def fit_command(args) -> int:
     model = args.model or manifest_model or "proposed"
     if model not in MODEL_CHOICES:
         raise UsageError(f"the manifest's model {model!r} is not one of {', '.join(MODEL_NAMES)}")
+    model = get_model(model).name          # an alias (bouc_wen) under its name
     table = None
     if args.kdyn is not None:
         from identification.kdyn_table import load_kdyn_table
@@ -140,7 +149,6 @@ def _save_or_rescue(result, args, data) -> list[Path]:
     """Write the fit's files; if that fails after all (a disk filled up, a folder removed during
     the fit), write them into the working directory, or the temporary one, and say where: a
     finished fit is never lost."""
-    import tempfile
     import time
     try:
         return result.save(args.out, args.ssv, args.ensemble, data=data)
@@ -300,6 +308,7 @@ def compare_command(args) -> int:
     unknown = [name for name in models if name not in MODEL_CHOICES]
     if unknown:
         raise UsageError(f"unknown models {unknown}; choose from {', '.join(MODEL_NAMES)}")
+    models = [get_model(name).name for name in models]
     prepare_directory(args.out, "--out")
     validation = args.validate or [Path(t.measurement.source) for t in tests]
     compare_models(models, tests, validation, args.out, preset=args.preset, seed=args.seed, workers=args.workers,

@@ -57,7 +57,7 @@ def compare_models(models: Sequence[str], tests: Sequence[RigTest], validation_f
     print(format_comparison(errors, models, [Path(m.source).name for m in validation]))
     with open(out_dir / "comparison.csv", "w", newline="") as handle:
         writer = csv.writer(handle)
-        writer.writerow(["file", "model", "nrmse", "eq10_rms_error"])
+        writer.writerow(["file", "model", "nrmse", "eq10_rms_level_error"])
         for (name, model), (error, eq10) in errors.items():
             writer.writerow([name, model, f"{error:.6g}", f"{eq10:.6g}"])
     print(f"wrote {out_dir}/comparison.csv, params_<model>.json and compare_*.png", file=sys.stderr)

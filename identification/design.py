@@ -23,7 +23,7 @@ from identification.compiled_core import parameter_matrix
 from identification.errors import IdentificationError
 from identification.progress import bar as progress_bar
 from identification.forward_model import prepare_input
-from identification.predict import members_of
+from identification.parameter_input import parameter_sets
 from identification.protocols import Sine, Step, sample_times
 from identification.simulate import simulate_driven
 
@@ -108,7 +108,7 @@ def design(ensemble, noise_N: float | None = None, candidates: list[Candidate] |
     """Rank ``candidates`` (default: :func:`candidate_tests`) by the spread of ``ensemble``
     (anything ``predict`` takes with several members). ``noise_N``: the noise level to compare
     with (default: the largest of the training tests' in the ensemble's provenance)."""
-    bushing, sets = members_of(ensemble)
+    bushing, sets = parameter_sets(ensemble)
     if len(sets) < 2:
         raise IdentificationError("the design needs an ensemble of at least 2 parameter sets (fit --ensemble FILE)")
     if noise_N is None:

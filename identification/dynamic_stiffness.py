@@ -177,8 +177,12 @@ def characterise(parameters, amplitudes_mm: Sequence[float] = DEFAULT_AMPLITUDES
     Raises
     ------
     IdentificationError
-        Invalid grid values or a simulation that fails. Warns ``CharacterisationWarning``
-        about a case that reaches the cycle cap.
+        Invalid grid values or a simulation that fails.
+
+    Warns
+    -----
+    CharacterisationWarning
+        A case that reaches ``max_cycles`` without a steady state.
     """
     # here, not at the top: the command line imports this module for its defaults
     from identification.compiled_core import parameter_matrix

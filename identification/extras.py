@@ -35,6 +35,15 @@ def missing_modules(extra: str) -> list[str]:
     return missing
 
 
+def require_or_exit(extra: str, feature: str) -> None:
+    """For a script: :func:`require`, its error as one ``error:`` line on stderr and exit status 2."""
+    try:
+        require(extra, feature)
+    except MissingExtraError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        sys.exit(2)
+
+
 def require(extra: str, feature: str) -> None:
     """Raise :class:`MissingExtraError` if ``feature`` cannot run for want of ``extra``."""
     missing = missing_modules(extra)

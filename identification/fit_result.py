@@ -264,7 +264,7 @@ class FitResult:
             lines.append(f"starts: {self.agreeing} of {self.final_starts} final starts agree (misfit within "
                          f"{self.threshold:.2e} of the best: delta chi^2 at 95 % for {len(self.space.names)} parameters); "
                          + (f"ensemble: {len(self.ensemble)} parameter sets" if self.ensemble_sampled
-                            else "ensemble: not sampled (ensemble=False), the best fit alone"))
+                            else "ensemble: not sampled (ensemble=False, --no-ensemble), the best fit alone"))
         if self.steps_per_sample:
             lines.append("forward model: " + ", ".join(f"{m} step{'s' if m > 1 else ''} per sample on {t.name}"
                                                        for m, t in zip(self.steps_per_sample, self.tests)))
@@ -278,18 +278,43 @@ class FitResult:
 
     def save(self, path: str | Path, ssv: str | Path | None = None, ensemble: str | Path | None = None,
              data: Sequence[str] = ()) -> list[Path]:
-        """Write the parameter file (JSON with provenance), optionally an .ssv and the ensemble."""
+        """Write the fit's files: what ``build_fmu.py --params`` and ``predict`` read.
+
+        Parameters
+        ----------
+        path : str or Path
+            The parameter file: JSON with the best set (paper's N-mm-s units) and the fit's
+            provenance (method, seed, convergence evidence, each test's noise and NRMSE).
+        ssv : str or Path, optional
+            Also an SSP 1.0 ParameterValues file of the best set (values and units only).
+        ensemble : str or Path, optional
+            Also the ensemble (JSON, the best set first); refused for a fit run with
+            ``ensemble=False``.
+        data : sequence of str
+            The training files, recorded in the provenance.
+
+        Returns
+        -------
+        list of Path
+            The files written.
+
+        Raises
+        ------
+        IdentificationError
+            ``ensemble`` given for a fit without an ensemble (nothing is written).
+        OSError
+            A file that cannot be written.
+        """
+        if ensemble is not None and not self.ensemble_sampled:
+            raise IdentificationError(f"no ensemble to write to {ensemble}: this fit ran with ensemble=False "
+                                      "(--no-ensemble); fit again without it for the ensemble")
         provenance = dict(self.provenance(), data=[str(d) for d in data])
         written = [save_parameters(path, self.parameters.parameters, self.model, provenance)]
         if ssv is not None:
             written.append(save_parameters(ssv, self.parameters.parameters, self.model))
         if ensemble is not None:
-            if not self.ensemble_sampled:
-                raise IdentificationError(f"no ensemble to write to {ensemble}: this fit ran with ensemble=False "
-                                          "(--no-ensemble); fit again without it for the ensemble")
             written.append(save_ensemble(ensemble, self.ensemble, self.model, provenance))
         return written
-
 
 
 def agreeing_starts(records: list[StartRecord], stage: int, best_misfit: float, threshold: float) -> int:

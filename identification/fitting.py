@@ -104,7 +104,7 @@ def fit(measurements, model: str = "proposed", preset: str = "default", seed: in
         Progress bars on stderr (drawn only where stderr is a terminal).
     screening, starts : int, optional
         Override the preset's Sobol points and first-stage starts (later stages shrink in
-        proportion, at least ``MIN_FINAL_STARTS`` remain).
+        proportion; at least ``MIN_FINAL_STARTS`` remain, or ``starts`` if fewer).
     kdyn : str, Path or KdynTable, optional
         A dynamic-stiffness table (CSV amplitude_mm, frequency_hz, kdyn_N_per_mm,
         loss_angle_deg) fitted with the tests, or alone.

@@ -92,8 +92,8 @@ def load_measurement(path: str | Path, force_optional: bool = False) -> Measurem
     ----------
     path : str or Path
         CSV with a header line naming ``time_s``, ``displacement_<unit>`` (mm, m, in),
-        ``force_<unit>`` (N, kN, lbf) and optionally ``velocity_<unit>`` columns; ``#`` lines
-        are comments.
+        ``force_<unit>`` (N, kN, lbf, kip) and optionally ``velocity_<unit>`` columns; ``#``
+        lines are comments.
     force_optional : bool
         Accept a file without a force column (an input to ``predict``).
 

@@ -1,6 +1,6 @@
 """Predict a test with a parameter set or an ensemble: the force, and the ensemble's band.
 
-``predict(parameters, time_s, displacement_mm, velocity_mm_s=None)`` simulates (the forward
+``predict(parameters, time_s, displacement_mm, velocity_mm_s=None, model=None)`` simulates (the forward
 model, ``identification.simulate``) the best parameter set and, for an ensemble, every
 member, in one compiled population call. The band is the members' envelope (min, max) at
 every sample: the spread of the parameter sets the training tests cannot tell apart (a
@@ -27,6 +27,21 @@ from identification.simulate import simulate_driven
 
 @dataclass
 class Prediction:
+    """What ``predict`` returns.
+
+    Attributes
+    ----------
+    time_s : numpy.ndarray
+        Sample times [s].
+    displacement_mm : numpy.ndarray
+        Displacement [mm] at the samples.
+    force_N : numpy.ndarray
+        Force [N] of the best (first) parameter set.
+    lower_N, upper_N : numpy.ndarray
+        The envelope [N] of every member (equal to ``force_N`` for one set).
+    members : int
+        How many parameter sets were simulated.
+    """
     time_s: np.ndarray
     displacement_mm: np.ndarray
     force_N: np.ndarray              # the best (first) member
@@ -55,10 +70,6 @@ class Prediction:
         return path
 
 
-members_of = parameter_sets
-"""The model and the validated sets of any accepted ``parameters`` (``parameter_input``)."""
-
-
 def predict(parameters, time_s, displacement_mm, velocity_mm_s=None, model: str | None = None) -> Prediction:
     """Predict a test: the best set's force and the ensemble's band at every sample.
 
@@ -84,7 +95,7 @@ def predict(parameters, time_s, displacement_mm, velocity_mm_s=None, model: str 
     IdentificationError
         The best set's simulation fails (overflow), with the time it fails from.
     """
-    bushing, sets = members_of(parameters, model)
+    bushing, sets = parameter_sets(parameters, model)
     driven = prepare_input(time_s, displacement_mm, velocity_mm_s)
     forces = simulate_driven(parameter_matrix(sets, bushing.name), driven, model=bushing.name)
     failed = ~np.isfinite(forces[0])

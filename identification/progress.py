@@ -1,7 +1,8 @@
 """Progress bars of long work (tqdm, on stderr), shown only where someone watches.
 
-A bar draws only when stderr is a terminal: redirected to a file, its carriage-return
-redraws would fill the log and glue the next line (a ``WARNING:``) to the last bar.
+A bar draws only when stderr is a terminal (or in a Jupyter kernel): redirected to a file, its
+carriage-return redraws would fill the log and glue the next line (a ``WARNING:``) to the last
+bar. Without tqdm (the base install) there are no bars.
 """
 from __future__ import annotations
 
@@ -11,7 +12,10 @@ from identification.presets import SearchSettings
 
 
 def watched() -> bool:
-    """Whether stderr is a terminal (a person sees the bars)."""
+    """Whether someone sees the bars: stderr is a terminal, or this is a Jupyter kernel (whose
+    stderr is no terminal but shows the bars)."""
+    if "ipykernel" in sys.modules:
+        return True
     stream = sys.stderr
     try:
         return stream is not None and stream.isatty()
@@ -23,7 +27,10 @@ def bar(total: int, description: str, unit: str, enabled: bool = True, leave: bo
     """A tqdm bar on stderr, or None when disabled or nobody watches."""
     if not (enabled and watched()):
         return None
-    from tqdm import tqdm
+    try:
+        from tqdm import tqdm
+    except ImportError:   # the base install: work goes on without a bar
+        return None
     return tqdm(total=total, desc=description, unit=unit, leave=leave, file=sys.stderr)
 
 

@@ -19,7 +19,8 @@ from identification.objectives import nrmse, rms_level_error
 from identification.protocols import Random, Sine, Step, sample_times
 from identification.search_space import KelvinVoigtFit
 from identification.plots import plot_comparison
-from identification.predict import members_of, predict
+from identification.parameter_input import parameter_sets
+from identification.predict import predict
 from identification.simulate import simulate
 
 SINE_FREQUENCIES_HZ = (1.0, 10.0, 20.0, 30.0)
@@ -119,7 +120,7 @@ def plot_measurement(parameters, measurement: Measurement, path: Path,
     like the paper's Figs. 9-19; an ensemble's band shaded."""
     m = measurement
     prediction = predict(parameters, m.time_s, m.displacement_mm, m.measured_velocity_mm_s, model=model)
-    bushing, _ = members_of(parameters, model)
+    bushing, _ = parameter_sets(parameters, model)
     predictions = {bushing.name: prediction.force_N}
     if kelvin_voigt is not None:
         predictions["kelvin_voigt"] = kelvin_voigt.force(m.displacement_mm, m.velocity_mm_s)

@@ -64,8 +64,32 @@ def check_rise_time(rise_time_s, measurement: Measurement) -> None:
 
 def training_tests(sine: Sequence = (), step: Sequence = (), rise_times_s: Sequence[float] = (),
                    random: Sequence = ()) -> list[RigTest]:
-    """Tests from files or measurements of each kind; ``step`` and ``rise_times_s`` pair in
-    order (as the command line's repeated ``--step`` and ``--rise-time``)."""
+    """The training tests of a fit, from files or measurements of each kind.
+
+    Parameters
+    ----------
+    sine : sequence of str, Path or Measurement
+        Sine tests (CSV ``time_s,displacement_mm,force_N[,velocity_mm_s]``, see ``load_measurement``).
+    step : sequence of str, Path or Measurement
+        Step tests: a ramp, then held.
+    rise_times_s : sequence of float
+        The ramp's duration [s] of each step test, in the same order (as the command line's
+        repeated ``--step`` and ``--rise-time``).
+    random : sequence of str, Path or Measurement
+        Random-input tests.
+
+    Returns
+    -------
+    list of RigTest
+        What ``fit`` takes.
+
+    Raises
+    ------
+    ManifestError
+        No tests, a rise time per step missing, or a rise time not shorter than its test.
+    MeasurementError
+        A file that cannot be read as a measurement.
+    """
     if len(step) != len(rise_times_s):
         raise ManifestError(f"{len(step)} step test(s) but {len(rise_times_s)} rise time(s): give one "
                             "--rise-time per --step, in the same order")

@@ -1,6 +1,6 @@
 """Simulate any of the project's models on a sampled test: the identification's forward model.
 
-``simulate(parameters, time_s, displacement_mm, velocity_mm_s=None, model="proposed")``
+``simulate(parameters, time_s, displacement_mm, velocity_mm_s=None, model=None, steps_per_sample=None)``
 returns the force [N] at every sample of a parameter set of the proposed model, Spencer's,
 the single Bouc-Wen or Kelvin-Voigt (``fmu_src.bushing_models``), driven by a smooth
 interpolant of the sampled displacement (``identification.forward_model``): the
@@ -51,8 +51,9 @@ def simulate(parameters, time_s, displacement_mm, velocity_mm_s=None, model: str
     Raises
     ------
     ParameterError
-        An invalid parameter set; ``ValueError`` for arrays of different lengths or times that
-        do not increase.
+        An invalid parameter set (named, with its unit and allowed range).
+    ValueError
+        Arrays of different lengths, or times that do not increase.
     """
     values, bushing = _parameters_and_model(parameters, model)
     driven = prepare_input(time_s, displacement_mm, velocity_mm_s, steps=steps_per_sample)

@@ -13,7 +13,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from fmu_src.parameter_files import load_parameters, read_ensemble, save_ensemble
-from identification.__main__ import main
+from identification.cli import main
 from identification.dynamic_stiffness import COLUMNS, CharacterisationWarning, characterise
 from identification.compiled_core import parameter_matrix
 from identification.errors import IdentificationError

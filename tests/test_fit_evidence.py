@@ -7,7 +7,7 @@ import pytest
 
 from conftest import DATA, paper_parameters, paper_test_force
 from identification import FitNotConvergedWarning, fit, load_measurement, predict, simulate
-from identification.__main__ import main
+from identification.cli import main
 from identification.measurements import Measurement, write_measurement
 from identification.protocols import Sine, Step, sample_times
 from identification.rig_tests import RigTest

@@ -46,12 +46,12 @@ def test_simulate_runs_without_numba_and_equals_the_compiled_forward_model():
 
 
 @pytest.mark.parametrize("arguments, extra", [
-    (["fit", "--sine", str(SINE), "--out", "p.json"], "fit"),
-    (["characterise", "--params", str(DATA / "params_table5_combined.json"), "--out", "k.csv"], "fit"),
+    (["fit", "--sine", str(SINE), "--out", "{tmp}/p.json"], "fit"),
+    (["compare", "--sine", str(SINE), "--out", "{tmp}/cmp"], "fit"),
 ])
 def test_a_command_whose_extra_is_missing_says_which_extra_in_one_line(tmp_path, arguments, extra):
     code = ("import sys\nfrom identification.cli import main\n"
-            f"sys.exit(main({[a if not a.endswith(('.json', '.csv')) or '/' in a else str(tmp_path / a) for a in arguments]!r}))\n")
+            f"sys.exit(main({[a.replace('{tmp}', str(tmp_path)) for a in arguments]!r}))\n")
     done = run_without_numba(code, timeout=60)
     assert done.returncode == 2
     lines = done.stderr.strip().splitlines()
@@ -59,6 +59,17 @@ def test_a_command_whose_extra_is_missing_says_which_extra_in_one_line(tmp_path,
     assert lines[0].startswith("error: the ") and f"needs the '{extra}' extra (numba is not installed)" in lines[0]
     assert f"pip install 'boucwen-bushing[{extra}]'" in lines[0]
     assert not list(tmp_path.iterdir())
+
+
+def test_a_simulating_command_runs_without_numba_and_says_it_is_slower(tmp_path):
+    code = ("import sys\nfrom identification.cli import main\n"
+            f"sys.exit(main(['characterise', '--params', {str(DATA / 'params_table5_combined.json')!r}, "
+            f"'--amplitudes-mm', '1', '--frequencies-hz', '10', '--out', {str(tmp_path / 'k.csv')!r}]))\n")
+    done = run_without_numba(code)
+    assert done.returncode == 0, done.stderr
+    assert done.stderr.startswith("note: numba is not installed: the models run as plain Python")
+    assert "pip install 'boucwen-bushing[fit]'" in done.stderr
+    assert (tmp_path / "k.csv").is_file()
 
 
 def test_fit_from_python_without_the_extra_raises_a_missing_extra_error():

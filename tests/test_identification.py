@@ -199,7 +199,7 @@ def test_a_cli_fit_builds_an_fmu_that_carries_the_fitted_set(tmp_path, capsys):
     import json
 
     import build_fmu
-    from identification.__main__ import main
+    from identification.cli import main
     from test_fmu_numerics import simulate_with_fmpy
 
     out, ssv = tmp_path / "fitted.json", tmp_path / "fitted.ssv"
@@ -223,7 +223,7 @@ def test_a_cli_fit_builds_an_fmu_that_carries_the_fitted_set(tmp_path, capsys):
 
 
 def test_no_ensemble_and_an_ensemble_file_are_refused_together_before_the_fit(tmp_path, capsys):
-    from identification.__main__ import main
+    from identification.cli import main
     assert main(["fit", "--sine", str(DATA / "synthetic_table5_sine_2mm_10Hz.csv"), "--no-ensemble",
                  "--ensemble", str(tmp_path / "e.json"), "--out", str(tmp_path / "p.json")]) == 2
     assert "--no-ensemble" in capsys.readouterr().err and not (tmp_path / "p.json").exists()
@@ -238,7 +238,7 @@ def test_reduced_budget_fit_reaches_the_floor_through_the_cli_and_a_built_fmu(tm
     import json
 
     import build_fmu
-    from identification.__main__ import main
+    from identification.cli import main
     from test_fmu_numerics import simulate_with_fmpy
 
     out, ssv = tmp_path / "fitted.json", tmp_path / "fitted.ssv"

@@ -7,7 +7,7 @@ import pytest
 
 from conftest import DATA
 from fmu_src.parameter_files import load_parameters
-from identification.__main__ import main
+from identification.cli import main
 from identification.measurements import MeasurementError
 from identification.rig_tests import ManifestError, load_manifest, training_tests
 

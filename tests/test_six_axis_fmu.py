@@ -206,7 +206,7 @@ def test_six_axis_parameter_file_errors_name_the_axis(tmp_path):
 
 
 def test_assemble_builds_the_six_axis_file_from_one_file_per_axis(tmp_path):
-    from identification.__main__ import main
+    from identification.cli import main
     files = {"x": DATA / "params_table5_combined.json", "y": DATA / "params_table2_sine.json",
              "z": DATA / "params_spencer_fit_synthetic_table5.json", "rx": DATA / "params_kelvin_voigt_fit_synthetic_table5.json",
              "ry": DATA / "params_single_bouc_wen_fit_synthetic_table5.json", "rz": DATA / "params_table4_step.ssv"}
@@ -222,7 +222,7 @@ def test_assemble_builds_the_six_axis_file_from_one_file_per_axis(tmp_path):
 
 
 def test_assemble_refuses_a_missing_axis_unless_told_how_to_fill_it(tmp_path, capsys):
-    from identification.__main__ import main
+    from identification.cli import main
     only_x = ["assemble", "--axis", f"x={DATA / 'params_table5_combined.json'}"]
     assert main([*only_x, "--out", str(tmp_path / "a.json")]) == 2
     assert "no parameter file for the axes y, z, rx, ry, rz" in capsys.readouterr().err

@@ -25,7 +25,6 @@ the explicit loop.
 from __future__ import annotations
 
 import shutil
-import sys
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
@@ -35,15 +34,11 @@ from xml.etree import ElementTree as ET
 import numpy as np
 
 def require_extras(script: str) -> None:
-    """Stop with one line naming the extras to install (exit 2) if libcosimpy or matplotlib
-    is missing: the examples run libcosim and plot (``pip install 'boucwen-bushing[cosim,plot]'``)."""
-    from identification.extras import MissingExtraError, require
-    try:
-        require("cosim", script)
-        require("plot", script)
-    except MissingExtraError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        sys.exit(2)
+    """Stop with one line naming the first missing extra (exit 2): the examples run libcosim
+    (``cosim``) and plot (``plot``)."""
+    from identification.extras import require_or_exit
+    require_or_exit("cosim", script)
+    require_or_exit("plot", script)
 
 
 SSD_NS = {"ssd": "http://ssp-standard.org/SSP1/SystemStructureDescription",
