@@ -166,10 +166,9 @@ def main(argv: list[str] | None = None) -> int:
         try:
             _require_extras(args)
             return COMMANDS[args.command](args)
-        except (IdentificationError, ParameterError, EngineError, commands.UsageError, MissingExtraError) as exc:
-            print(f"error: {exc}", file=sys.stderr)
-            return 2
-        except OSError as exc:   # a file that could not be read or written after all
+        # OSError: a file that could not be read or written after all
+        except (IdentificationError, ParameterError, EngineError, commands.UsageError, MissingExtraError,
+                OSError) as exc:
             print(f"error: {exc}", file=sys.stderr)
             return 2
 

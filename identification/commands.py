@@ -57,11 +57,17 @@ def check_output(path: Path | None, option: str, directory: bool = False, suffix
         raise UsageError(f"{option} {path}: not writable")
     if check.is_dir():
         # os.access says yes to root and on special file systems (/proc): try it
-        try:
-            with tempfile.TemporaryFile(dir=check):
-                pass
-        except OSError as exc:
-            raise UsageError(f"{option} {path}: cannot write in {check} ({exc.strerror or exc})") from None
+        try_writing_in(check, f"{option} {path}: cannot write in {check}")
+
+
+def try_writing_in(directory: Path, refusal: str) -> None:
+    """Write and remove a temporary file in ``directory``; if that fails, raise
+    :class:`UsageError` with ``refusal`` and the system's reason."""
+    try:
+        with tempfile.TemporaryFile(dir=directory):
+            pass
+    except OSError as exc:
+        raise UsageError(f"{refusal} ({exc.strerror or exc})") from None
 
 
 def prepare_directory(path: Path | None, option: str) -> None:
@@ -72,10 +78,9 @@ def prepare_directory(path: Path | None, option: str) -> None:
     check_output(path, option, directory=True)
     try:
         path.mkdir(parents=True, exist_ok=True)
-        with tempfile.TemporaryFile(dir=path):
-            pass
     except OSError as exc:
         raise UsageError(f"{option} {path}: cannot write there ({exc.strerror or exc})") from None
+    try_writing_in(path, f"{option} {path}: cannot write there")
 
 
 def print_warning(message: str) -> None:
