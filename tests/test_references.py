@@ -81,8 +81,7 @@ def run_fmu(fmu_path, times, signal, substeps, output_times):
     for k in range(times.size - 1):
         fine = times[k] + (times[k + 1] - times[k]) * np.arange(substeps + 1) / substeps
         fine[-1] = times[k + 1]
-        x_fine = signal(fine)[0] if signal is generator.sine_input else generator.STEP["amplitude_mm"] * np.minimum(
-            fine / generator.STEP["rise_time_s"], 1.0)   # the ramp itself up to its corner, then held
+        x_fine = signal(fine)[0]   # the input itself (the step's ramp up to its corner, then held)
         for i in range(substeps):
             h = fine[i + 1] - fine[i]
             assert fmu.step(x_fine[i] * MM, (x_fine[i + 1] - x_fine[i]) / h * MM, h) == "ok"
