@@ -38,10 +38,6 @@ from xml.dom.minidom import parseString
 from xml.etree import ElementTree as ET
 
 REPO = Path(__file__).resolve().parent
-LIBRARY_MODULES = ("bushing_params.py", "model_definition.py", "integration.py", "compiled_kernels.py", "axes.py",
-                   "proposed_model.py",
-                   "spencer_model.py", "single_bouc_wen_model.py", "kelvin_voigt_model.py", "bushing_models.py",
-                   "parameter_files.py", "variables.py", "jit.py")
 SLAVE_MODULE = "bushing_slave.py"
 
 sys.path.insert(0, str(REPO))
@@ -51,6 +47,7 @@ from fmu_src.axes import ONE_AXIS, SIX_AXIS_IDENTIFIER  # noqa: E402
 from fmu_src.bushing_models import MODEL_CHOICES, MODEL_NAMES, get_model  # noqa: E402
 from fmu_src.parameter_files import (parameter_document, read_parameter_set, read_six_axis,  # noqa: E402
                                      six_axis_document)
+
 
 PACKED_LIBRARY_INIT = '''"""Packed library of the bushing FMU (written by build_fmu.py)."""
 from pathlib import Path
@@ -68,6 +65,10 @@ SIX_AXIS_DEFAULT_FILE = "params_six_axis_illustrative.json"
 
 
 SOURCE_DIR = Path(fmu_src.__file__).resolve().parent
+LIBRARY_MODULES = tuple(sorted(path.name for path in SOURCE_DIR.glob("*.py")
+                               if path.name not in ("__init__.py", SLAVE_MODULE)))
+"""What the pythonfmu FMU packs beside its slave module: every module of fmu_src (the models and
+what they share; its __init__ is PACKED_LIBRARY_INIT), so a model module added there is packed too."""
 
 
 class BuildError(RuntimeError):

@@ -1,5 +1,7 @@
-"""The registry of bushing models: one line per model module (``model_definition`` says what a
-model module gives).
+"""The registry of bushing models: every module of this package whose name ends in ``_model``
+and that defines ``MODEL`` (``model_definition`` says what a model module gives). Adding a
+model is adding such a module; this registry, the FMUs, parameter files, the fit and
+``compare`` find it here. Listed in the order of ``BushingModel.rank``:
 
 - ``proposed``: the paper's model, eqs. 1-5, 16 parameters (``proposed_model``);
 - ``spencer``: Spencer et al. (1997), Fig. 7 of the paper (``spencer_model``);
@@ -9,14 +11,33 @@ model module gives).
 """
 from __future__ import annotations
 
-from . import kelvin_voigt_model, proposed_model, single_bouc_wen_model, spencer_model
+import importlib
+import pkgutil
+import sys
+
 from .bushing_params import ParameterError
 from .model_definition import BushingModel
 
-MODELS: dict[str, BushingModel] = {
-    module.MODEL.name: module.MODEL
-    for module in (proposed_model, spencer_model, single_bouc_wen_model, kelvin_voigt_model)
-}
+MODEL_MODULE_SUFFIX = "_model"
+
+
+def _discover() -> dict[str, BushingModel]:
+    """{name: model} of this package's model modules, in rank order (the packed copy inside a
+    pythonfmu FMU finds its own siblings the same way)."""
+    package = sys.modules[__package__]
+    found = []
+    for module in pkgutil.iter_modules(package.__path__):
+        if module.name.endswith(MODEL_MODULE_SUFFIX):
+            model = getattr(importlib.import_module(f"{__package__}.{module.name}"), "MODEL", None)
+            if isinstance(model, BushingModel):
+                found.append(model)
+    names = [model.name for model in found]
+    if len(set(names)) != len(names):
+        raise RuntimeError(f"two model modules define the same model name: {sorted(names)}")
+    return {model.name: model for model in sorted(found, key=lambda model: (model.rank, model.name))}
+
+
+MODELS: dict[str, BushingModel] = _discover()
 MODEL_NAMES = tuple(MODELS)
 ALIASES = {"bouc_wen": "single_bouc_wen"}
 """Older names still accepted: ``bouc_wen`` read as the proposed model's block, so it was renamed."""

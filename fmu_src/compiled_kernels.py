@@ -2,9 +2,12 @@
 
 One definition, two ways to run it. For a model, the source of its module (``proposed_model``
 ...) is written into a generated module in the cache folder (:func:`cache_directory`), where
-its kernels (``KERNELS``) are replaced by numba-compiled versions of themselves; its imports of
-the shared machinery (``integration``) are pointed at a generated module of that machinery,
-compiled the same way, so that every kernel calls the others compiled. Generated modules are
+every function the module defines (its kernels and their helpers) is replaced by a
+numba-compiled version of itself (numba compiles a function on its first call, so a helper
+that only plain Python calls costs nothing); its imports of the shared machinery
+(``integration``) are pointed at a generated module of that machinery, compiled the same way,
+so that every kernel calls the others compiled. Tuples and sums over a constant range are
+written out term by term first (``unrolling``), which numba needs. Generated modules are
 named after a hash of their content: a changed model or machinery compiles afresh (numba's cache
 checks only a file's own time stamp, not the sources of the functions a kernel calls), and
 numba's on-disk cache lets the next process load the machine code instead of compiling.
@@ -16,6 +19,7 @@ here: nothing imports it until a model is compiled.
 """
 from __future__ import annotations
 
+import ast
 import dataclasses
 import hashlib
 import importlib.util
@@ -28,16 +32,19 @@ import warnings
 from pathlib import Path
 
 from . import integration
+from .unrolling import unroll
 
 CACHE_ENVIRONMENT = "BUSHING_CACHE_DIR"
 _NUMBA_IMPORT = f"from {__package__}.jit import numba\n\n"
 """numba or its plain-Python stand-in (``jit``), from this package (``fmu_src`` or the FMU's packed copy)."""
 
 _JIT_KERNELS = (
-    # error_model="numpy": a division by zero gives inf/nan (caught as NOT_FINITE) instead of an
-    # exception that would abort a whole population.
-    "for _name in KERNELS:\n"
-    "    globals()[_name] = numba.njit(error_model='numpy', cache=True)(globals()[_name])\n")
+    # every function this module defines; error_model="numpy": a division by zero gives inf/nan
+    # (caught as NOT_FINITE) instead of an exception that would abort a whole population.
+    "import types as _types\n"
+    "for _name, _value in list(globals().items()):\n"
+    "    if isinstance(_value, _types.FunctionType) and _value.__module__ == __name__:\n"
+    "        globals()[_name] = numba.njit(error_model='numpy', cache=True)(_value)\n")
 
 
 def cache_directory() -> Path:
@@ -82,9 +89,15 @@ def load_generated(name: str, source: str) -> types.ModuleType:
     return module
 
 
+def kernel_source(module: types.ModuleType) -> str:
+    """The source of a kernel module as numba reads it: tuples and sums over a constant range
+    written out (``unrolling``)."""
+    return ast.unparse(unroll(ast.parse(inspect.getsource(module)), module.__dict__, module.__name__))
+
+
 def integration_module() -> str:
     """The name of the compiled copy of the shared machinery (generated and loaded)."""
-    source = (inspect.getsource(integration) + "\n\n# ---- appended by fmu_src/compiled_kernels.py ----\n"
+    source = (kernel_source(integration) + "\n\n# ---- appended by fmu_src/compiled_kernels.py ----\n"
               + _NUMBA_IMPORT + _JIT_KERNELS)
     name = module_name("bushing_integration", source)
     load_generated(name, source)
@@ -96,7 +109,7 @@ def model_source(model, machinery: str, appendix: str = "") -> str:
     protocol (``integration.step``, compiled as ``step``) and ``appendix``. Its relative imports point at its own package (plain Python: specs, checks)
     and at the compiled machinery ``machinery``."""
     module = sys.modules[model.kernel_module]
-    source = inspect.getsource(module)
+    source = kernel_source(module)
     source = source.replace("from .integration import", f"from {machinery} import")
     source = source.replace("from .", f"from {module.__package__}.")
     return (source + "\n\n# ---- appended by fmu_src/compiled_kernels.py ----\n" + _NUMBA_IMPORT + _JIT_KERNELS

@@ -30,7 +30,7 @@ writes its equations as five kernels and uses the pieces below to step them:
 
 Kernels are plain float arithmetic that raise nothing and report errors as status codes (OK,
 TOO_MANY_SUBSTEPS, NOT_FINITE), so that the identification compiles these same functions with
-numba (``identification/compiled_core.py``); ``KERNELS`` lists the ones compiled.
+numba (``identification/compiled_core.py``) and the native FMU translates them into C.
 
 Units (the paper's): displacements in mm, velocities in mm/s, hysteretic forces in N, time in s.
 """
@@ -56,10 +56,6 @@ DEFAULT_MAX_SUBSTEPS = 20000
 
 OK, TOO_MANY_SUBSTEPS, NOT_FINITE = 0, 1, 2
 """Status codes of the kernels."""
-
-KERNELS = ("decay_factors", "rk4_in_xi", "block_power", "block_segment", "block_step", "gain_variation",
-           "substeps_needed", "walk_along_xi", "block_gain")
-"""The functions of this module that the identification compiles with numba."""
 
 
 class StepError(ArithmeticError):

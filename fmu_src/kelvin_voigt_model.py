@@ -13,7 +13,6 @@ PARAMETER_SPECS = (
     ParameterSpec("c", "N.s/mm", "viscous damping", **DAMPING),
     ParameterSpec("preload", "N", "force at x = 0"),
 )
-KERNELS = ("prepare", "initial_state", "jump", "integrate", "force", "derivatives", "switches")
 
 
 def prepare(p):
@@ -52,4 +51,4 @@ def switches(m, state, x, v):
 MODEL = BushingModel(
     "kelvin_voigt", "KelvinVoigtBushing", "Kelvin-Voigt (linear)", PARAMETER_SPECS, (),
     "params_kelvin_voigt_fit_synthetic_table5.json", prepare, initial_state, jump, integrate, force,
-    derivatives, switches)
+    derivatives, switches, plot_style=("C3", "--"), rank=90)

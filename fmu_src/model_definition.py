@@ -22,8 +22,12 @@ positive x. ``derivatives`` and ``switches`` are for a host that integrates the 
 every path runs is ``integration.step`` (``BushingModel.step``).
 Kernels are plain float arithmetic that raise nothing and return status codes
 (``integration.OK`` ...), so that ``identification/compiled_core.py`` compiles the same
-source with numba; ``KERNELS`` of the module lists every function it must compile (the
-five and their helpers). The shared machinery they step with is ``integration``.
+source with numba (every function the module defines) and ``native/python_to_c.py`` translates
+it into C. The shared machinery they step with is ``integration``.
+
+Beside the equations a model module declares how the fit searches its parameters
+(``SearchBox``, read by ``identification.search_space``) and how plots draw it
+(``plot_style``); the registry (``bushing_models``) finds the module by its name, ``*_model``.
 """
 from __future__ import annotations
 
@@ -56,6 +60,41 @@ class StateSpec:
 
 
 @dataclass(frozen=True)
+class SearchCoordinate:
+    """One coordinate of the box the fit searches (``identification.search_space`` maps it to the
+    parameter): ``kind`` says how, scaled by the data's reference stiffness k_ref [N/mm],
+    damping c_ref [N.s/mm] and force F_ref [N] (tau_ref = c_ref/k_ref):
+
+    - ``stiffness``, ``gain``: log10(value/k_ref) (a gain also >= 1 N/mm, the paper's constraint);
+    - ``damping``: log10(value/c_ref);
+    - ``time_constant``: log10(tau/tau_ref) of a dashpot over the stiffnesses it works against
+      (``over``), tau = value/sum(over);
+    - ``shape``: value*F_ref^n/k_ref, n the block's exponent (``exponent``);
+    - ``shape_sum``: partner' + sign*value' of a block (value' = value*F_ref^n/k_ref);
+    - ``exponent``: the value itself.
+
+    ``low`` and ``high`` bound the coordinate."""
+    parameter: str
+    kind: str
+    low: float
+    high: float
+    exponent: str = ""                  # shape, shape_sum: the block's n
+    over: tuple[str, ...] = ()          # time_constant: the stiffnesses the dashpot works against
+    partner: str = ""                   # shape_sum: the block's beta-like parameter
+    sign: float = 1.0                   # shape_sum: coordinate = partner' + sign*parameter'
+
+
+@dataclass(frozen=True)
+class SearchBox:
+    """Where the fit searches a model: its ``coordinates`` (one per free parameter), the
+    Bouc-Wen weights held at 1 (``unit_weights``: each block's alpha, which the force does not
+    identify apart from its A, beta and gamma) and the parameters held at 0 (``zeros``)."""
+    coordinates: tuple[SearchCoordinate, ...]
+    unit_weights: tuple[str, ...] = ()
+    zeros: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
 class BushingModel:
     name: str                    # command-line name: proposed, spencer, single_bouc_wen, kelvin_voigt
     identifier: str              # FMI modelIdentifier and the "model" of parameter files
@@ -75,6 +114,12 @@ class BushingModel:
     switch_specs: tuple[StateSpec, ...] = ()
     """What ``switches`` returns, in order (index: the position in its tuple; unit "m/s" or "N"
     on a translational axis): the native FMU's event indicators."""
+    search: SearchBox | None = None
+    """Where the fit searches (None: fitted otherwise, Kelvin-Voigt by linear least squares)."""
+    plot_style: tuple[str, str] = ("k", "-")
+    """(matplotlib colour, line style) of the model in comparison plots."""
+    rank: int = 100
+    """Position in listings (the command line's choices, ``compare``'s columns): lower first."""
     step: Callable = field(init=False, repr=False, compare=False)
     """step(constants, state, state_x, x, v, h, max_substeps) -> (state, substeps, status): the
     step protocol of ``integration.step`` bound to this model's ``jump`` and ``integrate``."""

@@ -29,7 +29,7 @@ import math
 from .bushing_params import DAMPING, EXPONENT, GAIN, SPRING, WEIGHT, Constraint, ParameterSpec
 from .integration import (DEFAULT_MAX_SUBSTEPS, HEUN_JUMP_LIMIT, NOT_FINITE, OK, THETA_JUMP, TOO_MANY_SUBSTEPS,
                           block_gain, block_power, block_step, substeps_needed, walk_along_xi)
-from .model_definition import BushingModel, StateSpec
+from .model_definition import BushingModel, SearchBox, SearchCoordinate, StateSpec
 
 IDENTIFIER = "BoucWenBushing"
 
@@ -54,9 +54,6 @@ PARAMETER_SPECS: tuple[ParameterSpec, ...] = (
 )
 PARAMETER_NAMES: tuple[str, ...] = tuple(spec.name for spec in PARAMETER_SPECS)
 PARAMETER_UNITS: dict[str, str] = {spec.name: spec.unit for spec in PARAMETER_SPECS}
-
-KERNELS = ("prepare", "initial_state", "jump", "integrate", "force", "derivatives", "switches")
-
 
 CONSTRAINTS = (
     Constraint((("c0", 1.0), ("c2", 1.0)), 0.0, True, True, "N.s/mm", "it divides eq. 4"),
@@ -168,6 +165,22 @@ def switches(m, state, x, v):
     return (v - dy, state[1], v - dw, state[3])
 
 
+SEARCH = SearchBox(
+    (SearchCoordinate("k0", "stiffness", -3.0, 1.0), SearchCoordinate("k1", "stiffness", -3.0, 1.0),
+     SearchCoordinate("k2", "stiffness", -5.0, 0.0),
+     SearchCoordinate("c0", "time_constant", -math.inf, 6.0, over=("k2", "A2")),
+     SearchCoordinate("c1", "time_constant", -math.inf, 4.0, over=("k0", "k1", "A1")),
+     SearchCoordinate("c2", "damping", -4.0, 2.0),
+     SearchCoordinate("A1", "gain", -4.0, 1.0), SearchCoordinate("A2", "gain", -4.0, 1.0),
+     SearchCoordinate("beta1", "shape", 0.0, 20.0, "n1"), SearchCoordinate("beta2", "shape", 0.0, 20.0, "n2"),
+     SearchCoordinate("gamma1", "shape_sum", 0.0, 40.0, "n1", partner="beta1", sign=1.0),
+     SearchCoordinate("gamma2", "shape_sum", 0.0, 40.0, "n2", partner="beta2", sign=-1.0),
+     SearchCoordinate("n1", "exponent", 0.1, 1.5), SearchCoordinate("n2", "exponent", 0.1, 1.5)),
+    unit_weights=("alpha1", "alpha2"))
+"""The fit's box: the paper's constraints A >= 1 N/mm, beta >= 0, beta1 + gamma1 > 0 and
+beta2 - gamma2 > 0 are bounds of its coordinates; each block's alpha is held at 1."""
+
+
 MODEL = BushingModel(
     "proposed", IDENTIFIER, "proposed (paper eqs. 1-5)", PARAMETER_SPECS,
     (StateSpec("z1", 1, "N", "hysteretic force of the left block (eq. 1)"),
@@ -180,4 +193,4 @@ MODEL = BushingModel(
                   StateSpec("z1", 1, "N", "hysteretic force of block 1"),
                   StateSpec("u2", 2, "m/s", "relative velocity of block 2, v - dw/dt"),
                   StateSpec("z2", 3, "N", "hysteretic force of block 2")),
-    constraints=CONSTRAINTS)
+    constraints=CONSTRAINTS, search=SEARCH, plot_style=("C0", "-"), rank=0)

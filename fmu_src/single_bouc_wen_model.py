@@ -16,7 +16,7 @@ import math
 from .bushing_params import DAMPING, EXPONENT, GAIN, SPRING, WEIGHT, ParameterSpec
 from .integration import (DEFAULT_MAX_SUBSTEPS, HEUN_JUMP_LIMIT, NOT_FINITE, OK, THETA, THETA_JUMP, block_gain,
                           walk_along_xi)
-from .model_definition import BushingModel, StateSpec
+from .model_definition import BushingModel, SearchBox, SearchCoordinate, StateSpec
 from .spencer_model import SINGLE_BLOCK_CONSTRAINTS
 
 PARAMETER_SPECS = (
@@ -28,7 +28,6 @@ PARAMETER_SPECS = (
     ParameterSpec("gamma", "N^(1-n)/mm", "Bouc-Wen shape parameter on u*|z|^n (as in eq. 1)"),
     ParameterSpec("n", "1", "Bouc-Wen exponent", **EXPONENT),
 )
-KERNELS = ("prepare", "initial_state", "jump", "integrate", "force", "derivatives", "switches")
 
 
 # ---------------------------------------------------------------------------- kernels
@@ -77,10 +76,20 @@ def switches(m, state, x, v):
     return (v, state[0])
 
 
+SEARCH = SearchBox(
+    (SearchCoordinate("k0", "stiffness", -3.0, 1.0), SearchCoordinate("c0", "damping", -4.0, 2.0),
+     SearchCoordinate("A", "gain", -4.0, 1.0), SearchCoordinate("beta", "shape", 0.0, 20.0, "n"),
+     SearchCoordinate("gamma", "shape_sum", 0.0, 40.0, "n", partner="beta", sign=1.0),
+     SearchCoordinate("n", "exponent", 0.1, 1.5)),
+    unit_weights=("alpha",))
+"""The fit's box (alpha held at 1)."""
+
+
 MODEL = BushingModel(
     "single_bouc_wen", "SingleBoucWenBushing", "single Bouc-Wen", PARAMETER_SPECS,
     (StateSpec("z", 0, "N", "hysteretic force"),), "params_single_bouc_wen_fit_synthetic_table5.json",
     prepare, initial_state, jump, integrate, force,
     derivatives, switches, constraints=SINGLE_BLOCK_CONSTRAINTS,
     switch_specs=(StateSpec("v", 0, "m/s", "the velocity input, which drives the element"),
-                  StateSpec("z", 1, "N", "hysteretic force")))
+                  StateSpec("z", 1, "N", "hysteretic force")),
+    search=SEARCH, plot_style=("C1", ":"), rank=20)

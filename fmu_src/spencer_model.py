@@ -21,7 +21,7 @@ import math
 from .bushing_params import DAMPING, EXPONENT, GAIN, SPRING, WEIGHT, Constraint, ParameterSpec
 from .integration import (DEFAULT_MAX_SUBSTEPS, HEUN_JUMP_LIMIT, NOT_FINITE, OK, THETA_JUMP, TOO_MANY_SUBSTEPS,
                           block_gain, block_power, block_step, substeps_needed, walk_along_xi)
-from .model_definition import BushingModel, StateSpec
+from .model_definition import BushingModel, SearchBox, SearchCoordinate, StateSpec
 
 PARAMETER_SPECS = (
     ParameterSpec("c0", "N.s/mm", "viscous damping in parallel with the Bouc-Wen element (large velocities)",
@@ -37,8 +37,6 @@ PARAMETER_SPECS = (
     ParameterSpec("gamma", "N^(1-n)/mm", "Spencer's gamma: on |u|*z*|z|^(n-1) (the paper's beta)"),
     ParameterSpec("n", "1", "Bouc-Wen exponent", **EXPONENT),
 )
-KERNELS = ("prepare", "initial_state", "jump", "integrate", "force", "derivatives", "switches")
-
 
 SINGLE_BLOCK_CONSTRAINTS = (
     # beta and gamma as the single Bouc-Wen element names them too
@@ -119,6 +117,18 @@ def switches(m, state, x, v):
     return ((c1 * v - k0 * (x - y) - alpha * z) / C, z)
 
 
+SEARCH = SearchBox(
+    (SearchCoordinate("k0", "stiffness", -5.0, 1.0), SearchCoordinate("k1", "stiffness", -3.0, 1.0),
+     SearchCoordinate("c0", "damping", -4.0, 2.0),
+     SearchCoordinate("c1", "time_constant", -math.inf, 6.0, over=("k0", "A")),
+     SearchCoordinate("A", "gain", -4.0, 1.0), SearchCoordinate("gamma", "shape", 0.0, 20.0, "n"),
+     SearchCoordinate("beta", "shape_sum", 0.0, 40.0, "n", partner="gamma", sign=1.0),
+     SearchCoordinate("n", "exponent", 0.1, 1.5)),
+    unit_weights=("alpha",), zeros=("x0",))
+"""The fit's box. Spencer's gamma sits where eq. 1 has beta: gamma >= 0, gamma + beta > 0; its
+dashpot to ground c1 works against k0 and the Bouc-Wen element; x0 (a constant force) is held at 0."""
+
+
 MODEL = BushingModel(
     "spencer", "SpencerBushing", "Spencer (1997)", PARAMETER_SPECS,
     (StateSpec("z", 1, "N", "hysteretic force"),
@@ -127,4 +137,4 @@ MODEL = BushingModel(
     derivatives, switches,
     switch_specs=(StateSpec("u", 0, "m/s", "relative velocity of the Bouc-Wen element, v - dy/dt"),
                   StateSpec("z", 1, "N", "hysteretic force")),
-    constraints=SINGLE_BLOCK_CONSTRAINTS)
+    constraints=SINGLE_BLOCK_CONSTRAINTS, search=SEARCH, plot_style=("C2", "-."), rank=10)

@@ -11,10 +11,6 @@ from fmu_src.bushing_models import get_model
 from identification.measurements import Measurement
 from identification.objectives import nrmse
 
-MODEL_STYLES = {"proposed": ("C0", "-"), "spencer": ("C2", "-."), "single_bouc_wen": ("C1", ":"),
-                "kelvin_voigt": ("C3", "--")}
-
-
 def _pyplot():
     import matplotlib
     matplotlib.use("Agg")
@@ -46,8 +42,9 @@ def plot_comparison(measurement: Measurement, predictions: dict, path: Path, ban
         in_time.fill_between(m.time_s, lower / 1e3, upper / 1e3, color="C0", alpha=0.25, lw=0,
                              label="ensemble band")
     for model, predicted in predictions.items():
-        color, style = MODEL_STYLES.get(model, ("k", "-"))
-        label = get_model(model).title + (f" (NRMSE {nrmse(predicted, m.force_N):.1%})" if measured else "")
+        bushing = get_model(model)
+        color, style = bushing.plot_style
+        label = bushing.title + (f" (NRMSE {nrmse(predicted, m.force_N):.1%})" if measured else "")
         in_time.plot(m.time_s, predicted / 1e3, color=color, ls=style, lw=1.1, label=label)
         loop.plot(m.displacement_mm, predicted / 1e3, color=color, ls=style, lw=1.0)
     in_time.set(xlabel="time [s]", ylabel="force [kN]", title=Path(m.source).name)

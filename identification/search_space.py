@@ -12,7 +12,8 @@ hand-tuning): k_ref [N/mm] and c_ref [N*s/mm] of a Kelvin-Voigt least-squares fi
 F = k*x + c*v of the tests other than steps (of the steps if there are no others), F_ref [N]
 their peak force, tau_ref = c_ref/k_ref [s].
 
-Coordinates, each with bounds (the box):
+Coordinates, each with bounds (the box; each model declares its own in its module,
+``BushingModel.search``, a ``model_definition.SearchBox``):
 
 - stiffness: log10(k/k_ref); gain: log10(A/k_ref), with A >= 1 N/mm (the paper's constraint);
 - damping: log10(c/c_ref);
@@ -39,7 +40,8 @@ from typing import Mapping, Sequence
 import numpy as np
 from scipy.optimize import lsq_linear
 
-from fmu_src.bushing_models import get_model
+from fmu_src.bushing_models import MODELS, get_model
+from fmu_src.model_definition import SearchCoordinate
 from identification.errors import IdentificationError
 from identification.measurements import Measurement
 
@@ -71,49 +73,6 @@ class KelvinVoigtFit:
         return self.k * np.asarray(displacement_mm) + self.c * np.asarray(velocity_mm_s)
 
 
-@dataclass(frozen=True)
-class Coordinate:
-    parameter: str
-    kind: str        # stiffness, gain, damping, time_constant, shape, shape_sum, exponent
-    low: float
-    high: float
-    exponent: str = ""                  # shape, shape_sum: the block's n
-    over: tuple[str, ...] = ()          # time_constant: the stiffnesses the dashpot works against
-    partner: str = ""                   # shape_sum: the block's beta-like parameter
-    sign: float = 1.0                   # shape_sum: coordinate = partner' + sign*parameter'
-
-
-def _proposed_coordinates():
-    return (Coordinate("k0", "stiffness", -3.0, 1.0), Coordinate("k1", "stiffness", -3.0, 1.0),
-            Coordinate("k2", "stiffness", -5.0, 0.0),
-            Coordinate("c0", "time_constant", -math.inf, 6.0, over=("k2", "A2")),
-            Coordinate("c1", "time_constant", -math.inf, 4.0, over=("k0", "k1", "A1")),
-            Coordinate("c2", "damping", -4.0, 2.0),
-            Coordinate("A1", "gain", -4.0, 1.0), Coordinate("A2", "gain", -4.0, 1.0),
-            Coordinate("beta1", "shape", 0.0, 20.0, "n1"), Coordinate("beta2", "shape", 0.0, 20.0, "n2"),
-            Coordinate("gamma1", "shape_sum", 0.0, 40.0, "n1", partner="beta1", sign=1.0),
-            Coordinate("gamma2", "shape_sum", 0.0, 40.0, "n2", partner="beta2", sign=-1.0),
-            Coordinate("n1", "exponent", 0.1, 1.5), Coordinate("n2", "exponent", 0.1, 1.5))
-
-
-# Per model: the searched coordinates, the alphas fixed at 1 and the parameters fixed at 0.
-MODEL_SPACES = {
-    "proposed": (_proposed_coordinates(), ("alpha1", "alpha2"), ()),
-    # Spencer's gamma sits where eq. 1 has beta (bushing_models): gamma >= 0, gamma + beta > 0;
-    # its dashpot to ground c1 works against k0 and the Bouc-Wen element.
-    "spencer": ((Coordinate("k0", "stiffness", -5.0, 1.0), Coordinate("k1", "stiffness", -3.0, 1.0),
-                 Coordinate("c0", "damping", -4.0, 2.0),
-                 Coordinate("c1", "time_constant", -math.inf, 6.0, over=("k0", "A")),
-                 Coordinate("A", "gain", -4.0, 1.0), Coordinate("gamma", "shape", 0.0, 20.0, "n"),
-                 Coordinate("beta", "shape_sum", 0.0, 40.0, "n", partner="gamma", sign=1.0),
-                 Coordinate("n", "exponent", 0.1, 1.5)),
-                ("alpha",), ("x0",)),
-    "single_bouc_wen": ((Coordinate("k0", "stiffness", -3.0, 1.0), Coordinate("c0", "damping", -4.0, 2.0),
-                  Coordinate("A", "gain", -4.0, 1.0), Coordinate("beta", "shape", 0.0, 20.0, "n"),
-                  Coordinate("gamma", "shape_sum", 0.0, 40.0, "n", partner="beta", sign=1.0),
-                  Coordinate("n", "exponent", 0.1, 1.5)),
-                 ("alpha",), ()),
-}
 _ORDER = ("stiffness", "gain", "damping", "exponent", "time_constant", "shape", "shape_sum")
 """The order in which coordinates are mapped to parameters: each kind needs only earlier ones."""
 
@@ -132,8 +91,9 @@ class SearchSpace:
         """The space for these tests; ``steps`` marks which are step tests (left out of the
         scales unless all are). ``table``: a dynamic-stiffness table (``kdyn_table.KdynTable``),
         which sets the scales when no test other than steps is given (:meth:`from_table`)."""
-        if model not in MODEL_SPACES:
-            raise ValueError(f"no search space for the {model!r} model; choose one of {', '.join(MODEL_SPACES)} "
+        if get_model(model).search is None:
+            searched = [name for name, bushing in MODELS.items() if bushing.search is not None]
+            raise ValueError(f"no search space for the {model!r} model; choose one of {', '.join(searched)} "
                              "(kelvin_voigt is fitted by linear least squares)")
         steps = list(steps) or [False] * len(measurements)
         scaling = [m for m, is_step in zip(measurements, steps) if not is_step]
@@ -178,8 +138,8 @@ class SearchSpace:
         return cls(k_ref, c_ref, peak, interval, model)
 
     @property
-    def coordinates(self) -> tuple[Coordinate, ...]:
-        return MODEL_SPACES[self.model][0]
+    def coordinates(self) -> tuple[SearchCoordinate, ...]:
+        return self.bushing.search.coordinates
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -216,7 +176,7 @@ class SearchSpace:
         theta = np.atleast_2d(np.asarray(coordinates, dtype=float))
         names = self.bushing.parameter_names
         value = {name: np.zeros(theta.shape[0]) for name in names}   # fixed parameters (x0) stay 0
-        for name in MODEL_SPACES[self.model][1]:
+        for name in self.bushing.search.unit_weights:
             value[name] = np.ones(theta.shape[0])
         column = {c.parameter: i for i, c in enumerate(self.coordinates)}
         for c in sorted(self.coordinates, key=lambda c: _ORDER.index(c.kind)):
@@ -246,8 +206,8 @@ class SearchSpace:
     def to_coordinates(self, params: Mapping[str, float]) -> np.ndarray:
         """The inverse of :meth:`to_model_parameters` (after rescaling every alpha to 1)."""
         p = dict(params)
-        p = rescale_hysteresis(p, p["alpha1"], p["alpha2"]) if self.model == "proposed" else \
-            _rescale_block(p, "", p["alpha"])
+        for weight in self.bushing.search.unit_weights:   # each Bouc-Wen block's alpha, rescaled to 1
+            p = _rescale_block(p, weight[len("alpha"):], p[weight])
         theta = []
         for c in self.coordinates:
             value = p[c.parameter]

@@ -176,3 +176,12 @@ def test_the_docs_quote_these_figures():
             "equations") in models
     assert f"the FMU at 1 ms steps prints {QUOTED_RISE_KN}, {QUOTED_HOLD_KN} and {QUOTED_SINE_MAX_KN} kN" in models
     assert f"a largest |`F`| of {QUOTED_SINE_PEAK_N} N" in fmu_guide
+
+
+def test_every_registered_model_has_an_independent_reference():
+    # a model module added to fmu_src is found by the registry; its equations must also be typed
+    # into the generator (independently of the module) and its forward path bounded here
+    from fmu_src.bushing_models import MODELS
+    assert set(generator.MODELS) == set(MODELS), \
+        f"type the equations of {sorted(set(MODELS) - set(generator.MODELS))} into {REFERENCES / 'generate_references.py'}"
+    assert {model for model, _ in PROJECT_TOLERANCE} == set(MODELS)

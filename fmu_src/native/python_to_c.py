@@ -14,7 +14,8 @@ native FMU (``fmu_src/native``):
   ``return``; expressions with ``+ - * / **``, comparisons (chained too), ``and or not``,
   conditional expressions, constant tuple indices, calls of other kernels and of ``abs``,
   ``min``, ``max``, ``int``, ``float``, ``math.exp``/``log``/``sqrt``/``sin``/``cos``/``ceil``/
-  ``isfinite`` and the constants ``math.inf``, ``math.pi``.
+  ``isfinite`` and the constants ``math.inf``, ``math.pi``; ``tuple(...)`` and ``sum(...)`` of a
+  generator over a constant range, written out term by term first (``fmu_src/unrolling.py``).
 - Python's semantics where C's differ: ``/`` of two ints is a float division; ``int(x)`` of a
   NaN or of a value beyond C's int gives the largest int (Python would raise: the kernels'
   callers then refuse the step, as they do for too many substeps); ``min``/``max`` return the
@@ -36,6 +37,8 @@ import textwrap
 import types
 from dataclasses import dataclass, field
 from typing import Callable, Union
+
+from ..unrolling import UnrollError, unroll
 
 DOUBLE, INT = "double", "int"
 Type = Union[str, tuple]
@@ -141,8 +144,12 @@ class _Function:
         self.argument_types = argument_types
         self.name = name
         source = textwrap.dedent(inspect.getsource(python))
-        self.tree = ast.parse(source).body[0]
         self.line_offset = python.__code__.co_firstlineno - 1
+        try:
+            self.tree = unroll(ast.parse(source), python.__globals__, f"{python.__module__}.{python.__name__}",
+                               self.line_offset).body[0]
+        except UnrollError as exc:
+            raise TranslationError(str(exc)) from None
         self.arguments = [a.arg for a in self.tree.args.args]
         if len(self.arguments) != len(argument_types) or self.tree.args.vararg or self.tree.args.kwarg:
             raise self.error(self.tree, f"called with {len(argument_types)} arguments")

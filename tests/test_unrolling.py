@@ -1,0 +1,82 @@
+"""tuple(...) and sum(...) over a constant range in kernels: written out term by term for numba and
+the C translation (fmu_src/unrolling.py), with the plain-Python result bit for bit."""
+import ast
+import math
+import textwrap
+
+import pytest
+
+from fmu_src.native.python_to_c import DOUBLE, Translation, TranslationError
+from fmu_src.unrolling import UnrollError, unroll
+
+MODES = 4
+SOURCE = textwrap.dedent('''
+    def kernel(k, f, v):
+        rates = tuple(math.exp(0.5 * i) for i in range(MODES))
+        updated = tuple(f[i] * rates[i] + k[i] * v for i in range(1, MODES + 0 * 1 - 0))
+        return updated, sum(k[i] * f[i] for i in range(MODES))
+''')
+
+
+def unrolled_function(source, namespace):
+    tree = unroll(ast.parse(source), namespace, "test")
+    code = compile(tree, "<unrolled>", "exec")
+    exec(code, namespace)
+    return namespace["kernel"]
+
+
+def test_unrolled_tuples_and_sums_give_the_plain_python_floats_bit_for_bit():
+    namespace = {"math": math, "MODES": MODES}
+    exec(compile(SOURCE, "<plain>", "exec"), namespace)
+    plain = namespace["kernel"]
+    # the range with a non-literal bound is left as it is; the others are written out
+    text = ast.unparse(unroll(ast.parse(SOURCE), {"math": math, "MODES": MODES}, "test"))
+    assert "math.exp(0.5 * 3)" in text and "0 + k[0] * f[0] + k[1] * f[1]" in text
+    assert "for i in range(1, MODES + 0 * 1 - 0)" in text
+    unrolled = unrolled_function(SOURCE, {"math": math, "MODES": MODES})
+    for k, f, v in [((1.5, -2.0, 0.1, 3.0), (0.3, 0.7, -1.1, 1e-300), 2.5),
+                    ((-0.0, -0.0, -0.0, -0.0), (1.0, 1.0, 1.0, 1.0), 0.0)]:
+        assert repr(unrolled(k, f, v)) == repr(plain(k, f, v))   # repr: -0.0 and 0.0 differ
+
+
+def test_an_unrolled_sum_starts_from_zero_as_pythons_does():
+    source = "def kernel(a):\n    return sum(a[i] for i in range(2))\n"
+    unrolled = unrolled_function(source, {})
+    assert repr(unrolled((-0.0, -0.0))) == repr(sum((-0.0, -0.0))) == "0.0"
+
+
+@pytest.mark.parametrize("generator", ["x[i] for i in range(3) if i > 0", "x[i] + j for i in range(3) for j in range(2)"])
+def test_a_generator_it_cannot_write_out_names_the_line(generator):
+    source = f"\n\ndef kernel(x):\n    return tuple({generator})\n"
+    with pytest.raises(UnrollError, match=r"where, line 4: tuple\(\.\.\. for name in range"):
+        unroll(ast.parse(source), {}, "where")
+
+
+def test_the_c_translation_writes_the_terms_out(tmp_path):
+    namespace = {"math": math, "MODES": 3}
+    source = textwrap.dedent('''
+        def mean_rate(m):
+            return sum(m[i] for i in range(MODES)) / MODES
+    ''')
+    path = tmp_path / "unrolled_kernel.py"
+    path.write_text(source)
+    import importlib.util
+    spec = importlib.util.spec_from_file_location("unrolled_kernel", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    module.MODES = namespace["MODES"]
+    translation = Translation()
+    function = translation.function(module.mean_rate, ((DOUBLE, DOUBLE, DOUBLE),))
+    assert function.return_type == DOUBLE
+    assert "(((0 + m.f0) + m.f1) + m.f2)" in translation.source()
+
+
+def test_the_c_translation_refuses_a_generator_over_anything_else(tmp_path):
+    path = tmp_path / "refused_kernel.py"
+    path.write_text("def total(m):\n    return sum(value for value in m)\n")
+    import importlib.util
+    spec = importlib.util.spec_from_file_location("refused_kernel", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    with pytest.raises(TranslationError, match="refused_kernel.total, line 2"):
+        Translation().function(module.total, ((DOUBLE, DOUBLE),))
