@@ -37,6 +37,7 @@ PLAUSIBLE_ANGULAR_VELOCITY_RAD_S = 50.0
 ROTATIONAL_UNITS = {
     "N/mm": "N.mm/rad", "N.s/mm": "N.mm.s/rad", "mm": "rad", "N": "N.mm", "1": "1",
     "N^(1-n)/mm": "(N.mm)^(1-n)/rad", "N^(1-n1)/mm": "(N.mm)^(1-n1)/rad", "N^(1-n2)/mm": "(N.mm)^(1-n2)/rad",
+    "N/mm^3": "N.mm/rad^3", "N.s^alpha/mm": "N.mm.s^alpha/rad",
 }
 """A translational parameter's unit -> the same parameter's unit on a rotational axis."""
 
@@ -88,8 +89,10 @@ class Axis:
         return SMALL_ANGLE_RAD if self.rotational else PLAUSIBLE_TRAVEL_M
 
     def state_port(self, unit: str) -> tuple[str, float]:
-        """(FMU unit, kernel -> port factor) of a state declared in "N", "m" or "m/s"
+        """(FMU unit, kernel -> port factor) of a state declared in "N", "m", "m/s" or "1"
         (model_definition)."""
+        if unit == "1":
+            return ("1", 1.0)
         if unit == "N":
             return ("N.m", 1e-3) if self.rotational else ("N", 1.0)
         if unit == "m/s":

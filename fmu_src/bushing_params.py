@@ -21,26 +21,38 @@ UNIT_SYSTEM = "N-mm-s"
 
 @dataclass(frozen=True)
 class ParameterSpec:
-    """A parameter's name, unit, meaning and allowed range: ``minimum`` (inclusive unless
-    ``exclusive``; None: any finite value), with ``why`` the range is what it is. Values outside
-    are refused everywhere: by the FMU, by parameter files and by the identification."""
+    """A parameter's name, unit, meaning and allowed range: ``minimum`` and ``maximum`` (None: no
+    bound on that side), both exclusive if ``exclusive``, with ``why`` the range is what it is.
+    Values outside are refused everywhere: by the FMU, by parameter files and by the
+    identification. ``bound_powers`` = (p, q): how the parameter enters the force an FMU warns
+    above (``BushingModel.plausible_force_bound``): |value| * travel^p * velocity^q; None: by its
+    unit (a stiffness (1, 0), a damping (0, 1), anything else not at all)."""
     name: str
     unit: str
     description: str
     minimum: float | None = None
     exclusive: bool = False
     why: str = ""
+    maximum: float | None = None
+    bound_powers: tuple[int, int] | None = None
 
     @property
     def allowed(self) -> str:
-        """The allowed range in words: '> 0', '>= 0' or 'any finite value'."""
-        if self.minimum is None:
+        """The allowed range in words: '> 0', '>= 0', 'in (0, 1)', '<= 5' or 'any finite value'."""
+        if self.minimum is None and self.maximum is None:
             return "any finite value"
-        return f"{'>' if self.exclusive else '>='} {self.minimum:g}"
+        if self.maximum is None:
+            return f"{'>' if self.exclusive else '>='} {self.minimum:g}"
+        if self.minimum is None:
+            return f"{'<' if self.exclusive else '<='} {self.maximum:g}"
+        brackets = "()" if self.exclusive else "[]"
+        return f"in {brackets[0]}{self.minimum:g}, {self.maximum:g}{brackets[1]}"
 
     def range_error(self, value: float) -> str | None:
         """What is wrong with a finite ``value``, or None if it is in range."""
-        if self.minimum is None or (value > self.minimum if self.exclusive else value >= self.minimum):
+        above = self.minimum is None or (value > self.minimum if self.exclusive else value >= self.minimum)
+        below = self.maximum is None or (value < self.maximum if self.exclusive else value <= self.maximum)
+        if above and below:
             return None
         return f"{self.name} = {value} [{self.unit}] must be {self.allowed}" + (f" ({self.why})" if self.why else "")
 
@@ -111,6 +123,10 @@ UNIT_DEFINITIONS: dict[str, dict[str, str] | None] = {
     # the baseline models (bushing_models)
     "mm": {"m": "1", "factor": "0.001"},
     "N^(1-n)/mm": None,
+    # the filled-rubber models (berg_model, fractional_model): a cubic spring, and the
+    # fractional element's coefficient, whose unit has the non-integer power s^alpha
+    "N/mm^3": {"kg": "1", "m": "-2", "s": "-2", "factor": "1000000000"},
+    "N.s^alpha/mm": None,
     # ports and parameters of the rotational axes (fmu_src/axes.py)
     "rad": {"rad": "1"},
     "rad/s": {"rad": "1", "s": "-1"},
@@ -121,6 +137,8 @@ UNIT_DEFINITIONS: dict[str, dict[str, str] | None] = {
     # rates of the states (the native FMU's model exchange)
     "N/s": {"kg": "1", "m": "1", "s": "-3"},
     "N.m/s": {"kg": "1", "m": "2", "s": "-3"},
+    "N.mm/rad^3": {"kg": "1", "m": "2", "s": "-2", "rad": "-3", "factor": "0.001"},
+    "N.mm.s^alpha/rad": None,
     "(N.mm)^(1-n)/rad": None,
     "(N.mm)^(1-n1)/rad": None,
     "(N.mm)^(1-n2)/rad": None,

@@ -12,13 +12,15 @@ value's range, its default parameter file, and its equations as five kernels:
     force(constants, state, x, v) -> F [N]
     derivatives(constants, state, x, v) -> d(state)/dt
     switches(constants, state, x, v) -> the quantities whose sign selects the equations' branch
+    update(constants, state, x, v) -> state     (optional) the state after an event
 
 A state is a tuple of floats (the kernels' order; ``states`` names them for the FMU; empty
 for a model without state). Over a step the displacement is x + v*t [mm] for 0 <= t <= h [s]
 with v [mm/s] constant; ``jump`` is the model's exact response to an instantaneous
 displacement jump, and ``force`` is the force at displacement x with velocity v, positive for
-positive x. ``derivatives`` and ``switches`` are for a host that integrates the state itself
-(FMI model exchange: the states' derivatives and event indicators). The step protocol that
+positive x. ``derivatives``, ``switches`` and ``update`` are for a host that integrates the state itself
+(FMI model exchange: the states' derivatives, the event indicators, and the change of the state
+at an event, for a model whose state jumps there: a friction element's reversal). The step protocol that
 every path runs is ``integration.step`` (``BushingModel.step``).
 Kernels are plain float arithmetic that raise nothing and return status codes
 (``integration.OK`` ...), so that ``identification/compiled_core.py`` compiles the same
@@ -55,7 +57,7 @@ class StateSpec:
     the ``switches`` tuple, for a switch)."""
     name: str
     index: int
-    unit: str      # "N", "m" or "m/s" at the FMU (the kernels work in mm)
+    unit: str      # "N", "m", "m/s" or "1" at the FMU (the kernels work in mm)
     meaning: str
 
 
@@ -114,6 +116,11 @@ class BushingModel:
     switch_specs: tuple[StateSpec, ...] = ()
     """What ``switches`` returns, in order (index: the position in its tuple; unit "m/s" or "N"
     on a translational axis): the native FMU's event indicators."""
+    update: Callable | None = None
+    """update(constants, state, x, v) -> state: the state after an event at displacement x [mm]
+    and velocity v [mm/s] (model exchange's discrete-state update), for a model whose state
+    changes there, such as a friction element reversing where v has changed sign; None: an event
+    changes nothing. ``integrate`` and ``jump`` make the same change themselves, in co-simulation."""
     search: SearchBox | None = None
     """Where the fit searches (None: fitted otherwise, Kelvin-Voigt by linear least squares)."""
     plot_style: tuple[str, str] = ("k", "-")
@@ -183,14 +190,30 @@ class BushingModel:
     def plausible_force_bound(self, params: Mapping[str, float], travel: float = PLAUSIBLE_TRAVEL_MM,
                               velocity: float = PLAUSIBLE_VELOCITY_MM_S) -> float:
         """A force [N] no bushing with these parameters should reach in service: every spring
-        and Bouc-Wen gain of the model (A weighted by its alpha) and every dashpot in parallel,
-        at ``travel`` [mm] and ``velocity`` [mm/s], plus the constant force. Above it the inputs
-        are most likely in the wrong units (millimetres in the metre port). On a rotational
-        axis (``axes``): rad, rad/s and N.mm."""
-        stiffness = sum(abs(params[s.name]) * abs(params.get(self.gain_weight(s.name), 1.0))
-                        for s in self.specs if s.unit in STIFFNESS_UNITS)
-        damping = sum(abs(params[s.name]) for s in self.specs if s.unit in DAMPING_UNITS)
-        return stiffness * travel + damping * velocity + abs(self.force_offset(params))
+        and Bouc-Wen gain of the model (A weighted by its alpha), every dashpot and every other
+        force term (``ParameterSpec.bound_powers``) in parallel, at ``travel`` [mm] and
+        ``velocity`` [mm/s], plus the constant force. Above it the inputs are most likely in the
+        wrong units (millimetres in the metre port). On a rotational axis (``axes``): rad, rad/s
+        and N.mm."""
+        total = 0.0
+        for spec in self.specs:
+            powers = self.bound_powers(spec)
+            if powers is not None:
+                weight = abs(params.get(self.gain_weight(spec.name), 1.0))
+                total += abs(params[spec.name]) * weight * travel ** powers[0] * velocity ** powers[1]
+        return total + abs(self.force_offset(params))
+
+    @staticmethod
+    def bound_powers(spec: ParameterSpec) -> tuple[int, int] | None:
+        """(p, q): ``spec`` adds |value| * travel^p * velocity^q to the plausible force bound;
+        None: nothing (``ParameterSpec.bound_powers``, else by its unit)."""
+        if spec.bound_powers is not None:
+            return spec.bound_powers
+        if spec.unit in STIFFNESS_UNITS:
+            return (1, 0)
+        if spec.unit in DAMPING_UNITS:
+            return (0, 1)
+        return None
 
     @staticmethod
     def gain_weight(name: str) -> str:

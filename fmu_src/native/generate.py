@@ -3,7 +3,8 @@
 From the FMU's axes [(axes.Axis, model on that axis, parameters)] it writes
 
 - the models' kernels (``prepare``, ``initial_state``, ``step`` (``integration.step``), ``jump``,
-  ``force``, ``derivatives``, ``switches`` and the shared machinery they call), translated from
+  ``force``, ``derivatives``, ``switches``, ``update`` where a model has one, and the shared
+  machinery they call), translated from
   their Python source by ``python_to_c``;
 - per model, wrappers with the array interface of ``bw_model`` (``c/bushing_fmu.h``), and its
   parameter rules (``ParameterSpec``, ``Constraint``) as tables;
@@ -21,7 +22,7 @@ import uuid
 from dataclasses import dataclass
 
 from .. import integration
-from ..model_definition import DAMPING_UNITS, STIFFNESS_UNITS, BushingModel
+from ..model_definition import BushingModel
 from ..variables import FmuVariable, derivative_variables, fmu_variables, indicator_variables
 from .python_to_c import DOUBLE, INT, Translation, describe
 
@@ -69,6 +70,8 @@ class ModelCode:
             "derivatives": translation.function(model.derivatives, (m, s, DOUBLE, DOUBLE)),
             "switches": translation.function(model.switches, (m, s, DOUBLE, DOUBLE)),
         }
+        if model.update is not None:
+            self.kernels["update"] = translation.function(model.update, (m, s, DOUBLE, DOUBLE))
         self.switches = len(self.kernels["switches"].return_type)
         if [s.index for s in model.switch_specs] != list(range(self.switches)):
             raise ValueError(f"{model.name}: switch_specs must name the {self.switches} values switches() returns, "
@@ -106,6 +109,16 @@ class ModelCode:
             + ("    (void)s;\n" if not states else "")
             + f"    return {k['force'].name}({constants}, {self.state_literal('s')}, x, v);\n}}\n",
         ]
+        if "update" in k:
+            compare = " || ".join(f"r.f{i} != s[{i}]" for i in range(states))
+            lines.append(
+                f"static int bw_{name}_update(const void *c, double *s, double x, double v) {{\n"
+                f"    {self.translation.c_type(self.state_type)} r = {k['update'].name}({constants}, "
+                f"{self.state_literal('s')}, x, v);\n    int changed = {compare};\n"
+                + copy_state("r", "s") + "    return changed;\n}\n")
+        else:
+            lines.append(f"static int bw_{name}_update(const void *c, double *s, double x, double v) {{\n"
+                         "    (void)c;\n    (void)s;\n    (void)x;\n    (void)v;\n    return 0;\n}\n")
         for kernel, out in (("derivatives", "rates"), ("switches", "values")):
             count = len(k[kernel].return_type)
             lines.append(
@@ -123,9 +136,12 @@ class ModelCode:
         specs = []
         for spec in model.specs:
             weight = index.get(model.gain_weight(spec.name), -1)
+            powers = model.bound_powers(spec)
             specs.append(f"    {{{c_string(spec.name)}, {c_string(spec.unit)}, {int(spec.minimum is not None)}, "
-                         f"{c_double(spec.minimum or 0.0)}, {int(spec.exclusive)}, {c_string(spec.why)}, "
-                         f"{int(spec.unit in STIFFNESS_UNITS)}, {int(spec.unit in DAMPING_UNITS)}, {weight}}}")
+                         f"{c_double(spec.minimum or 0.0)}, {int(spec.maximum is not None)}, "
+                         f"{c_double(spec.maximum or 0.0)}, {int(spec.exclusive)}, {c_string(spec.allowed)}, "
+                         f"{c_string(spec.why)}, {int(powers is not None)}, {(powers or (0, 0))[0]}, "
+                         f"{(powers or (0, 0))[1]}, {weight}}}")
         constraints = []
         for c in model.constraints:
             terms = list(c.terms)
@@ -139,7 +155,8 @@ class ModelCode:
         if constraints:
             out += f"static const bw_constraint bw_constraints_{name}[] = {{\n" + ",\n".join(constraints) + "\n};\n"
         kernels = ", ".join(f"bw_{self.name}_{kernel}" for kernel in
-                            ("prepare", "initial_state", "step", "jump", "force", "derivatives", "switches"))
+                            ("prepare", "initial_state", "step", "jump", "force", "derivatives", "switches",
+                             "update"))
         out += (f"static const bw_model bw_model_{name} = {{{c_string(self.name)}, {len(model.specs)}, "
                 f"{len(self.state_type)}, {self.switches}, bw_specs_{name}, {len(constraints)}, "
                 f"{'bw_constraints_' + name if constraints else 'NULL'}, {kernels}}};\n")
@@ -157,8 +174,8 @@ def all_variables(axis_models) -> list[FmuVariable]:
 
 
 def nominal(variable: FmuVariable) -> float:
-    """A state's nominal value (1.0 for the other variables)."""
-    if variable.kind != "state":
+    """A state's nominal value (1.0 for the other variables and for dimensionless states)."""
+    if variable.kind != "state" or variable.unit == "1":
         return 1.0
     return NOMINAL_DISPLACEMENT.get(variable.unit) or NOMINAL_FORCE[variable.unit]
 

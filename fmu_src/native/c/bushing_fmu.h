@@ -33,18 +33,23 @@ typedef struct {
     double scale;      /* port value = scale * kernel value (states, derivatives, indicators) */
 } bw_variable;
 
-/* A parameter's allowed range (bushing_params.ParameterSpec): value >= minimum (> if
- * exclusive) where bounded, with why; role in the plausible-force bound. */
+/* A parameter's allowed range (bushing_params.ParameterSpec): value >= minimum and <= maximum
+ * (> and < if exclusive) where bounded, in words ("> 0", "in (0, 1)") with why; its part in
+ * the plausible-force bound: |value| * weight * travel^travel_power * velocity^velocity_power. */
 typedef struct {
     const char *name;
     const char *unit;
-    int bounded;
+    int has_minimum;
     double minimum;
+    int has_maximum;
+    double maximum;
     int exclusive;
+    const char *allowed;
     const char *why;
-    int stiffness;     /* counts as a spring in the plausible bound (N/mm, N.mm/rad) */
-    int damping;       /* counts as a dashpot (N.s/mm, N.mm.s/rad) */
-    int weight;        /* the parameter whose |value| weights this stiffness (a gain's alpha), or -1 */
+    int in_bound;      /* counts in the plausible bound (BushingModel.bound_powers) */
+    int travel_power;
+    int velocity_power;
+    int weight;        /* the parameter whose |value| weights it (a gain's alpha), or -1 */
 } bw_parameter_spec;
 
 /* A condition on several parameters (bushing_params.Constraint): sum of +-parameter > bound
@@ -79,6 +84,7 @@ typedef struct {
     double (*force)(const void *constants, const double *state, double x, double v);
     void (*derivatives)(const void *constants, const double *state, double x, double v, double *rates);
     void (*switch_values)(const void *constants, const double *state, double x, double v, double *values);
+    int (*update)(const void *constants, double *state, double x, double v);   /* 1 if the state changed */
 } bw_model;
 
 /* An axis of the FMU (fmu_src/axes.py): its ports, units and model. */

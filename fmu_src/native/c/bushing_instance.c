@@ -135,13 +135,12 @@ static int bw_check_axis(bw_instance *inst, int a) {
         for (i = 0; i < model->parameters; i++) {
             const bw_parameter_spec *p = &model->specs[i];
             double x = axis->parameters[i];
-            if (p->bounded && !(p->exclusive ? x > p->minimum : x >= p->minimum)) {
-                char minimum[40];
+            int above = !p->has_minimum || (p->exclusive ? x > p->minimum : x >= p->minimum);
+            int below = !p->has_maximum || (p->exclusive ? x < p->maximum : x <= p->maximum);
+            if (!(above && below)) {
                 bw_format_double(value, sizeof value, x);
-                snprintf(minimum, sizeof minimum, "%g", p->minimum);
-                bw_log(inst, BW_ERROR, "logStatusError", "%s%s = %s [%s] must be %s %s%s%s%s", spec->label, p->name,
-                       value, p->unit, p->exclusive ? ">" : ">=", minimum, p->why[0] ? " (" : "", p->why,
-                       p->why[0] ? ")" : "");
+                bw_log(inst, BW_ERROR, "logStatusError", "%s%s = %s [%s] must be %s%s%s%s", spec->label, p->name,
+                       value, p->unit, p->allowed, p->why[0] ? " (" : "", p->why, p->why[0] ? ")" : "");
                 errors++;
             }
         }
@@ -175,17 +174,18 @@ static int bw_check_axis(bw_instance *inst, int a) {
     }
     model->prepare(axis->parameters, &axis->constants);
     {   /* the plausible bound (BushingModel.plausible_force_bound), in port units */
-        double stiffness = 0.0, damping = 0.0, offset, rest[BW_MAX_STATES];
+        double total = 0.0, offset, rest[BW_MAX_STATES];
         for (i = 0; i < model->parameters; i++) {
             const bw_parameter_spec *p = &model->specs[i];
             double weight = p->weight >= 0 ? fabs(axis->parameters[p->weight]) : 1.0;
-            if (p->stiffness) stiffness += fabs(axis->parameters[i]) * weight;
-            if (p->damping) damping += fabs(axis->parameters[i]);
+            if (p->in_bound) {
+                total += fabs(axis->parameters[i]) * weight * pow(spec->plausible_travel, p->travel_power)
+                         * pow(spec->plausible_velocity, p->velocity_power);
+            }
         }
         model->initial_state(&axis->constants, 0.0, rest);
         offset = model->force(&axis->constants, rest, 0.0, 0.0);
-        axis->output_bound = (stiffness * spec->plausible_travel + damping * spec->plausible_velocity + fabs(offset))
-                             * spec->from_kernel;
+        axis->output_bound = (total + fabs(offset)) * spec->from_kernel;
     }
     return 1;
 }
@@ -552,6 +552,27 @@ static double bw_switch(bw_instance *inst, int a, int index) {
     if (!axis->usable) return 0.0;
     spec->model->switch_values(&axis->constants, axis->state, axis->x_now, axis->v * spec->to_kernel, values);
     return values[index];
+}
+
+/* The change of the axes' states at an event (the models' update kernel: a friction element's
+   reversal where the velocity has changed sign); 1 if any state changes. With apply = 0 it only
+   tells (fmi?CompletedIntegratorStep asks for event mode then). */
+static int bw_update_discrete_states(bw_instance *inst, int apply) {
+    int a, changed = 0;
+    if (!inst->model_exchange || !bw_check_parameters(inst)) return 0;
+    for (a = 0; a < BW_AXES; a++) {
+        const bw_axis_spec *spec = &bw_axis_specs[a];
+        bw_axis *axis = &inst->data.axes[a];
+        double state[BW_MAX_STATES];
+        memcpy(state, axis->state, sizeof state);
+        if (spec->model->update(&axis->constants, state, axis->x_now, axis->v * spec->to_kernel)) {
+            changed = 1;
+            if (!apply) return 1;
+            memcpy(axis->state, state, sizeof axis->state);
+            axis->output_is_current = 0;
+        }
+    }
+    return changed;
 }
 
 static bw_status bw_wrong_count(bw_instance *inst, const char *what, size_t count, int expected) {

@@ -355,11 +355,13 @@ fmi2Status fmi2EnterEventMode(fmi2Component c) {
 fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *eventInfo) {
     BW_NOT_NULL(c);
     if (!eventInfo) return fmi2Error;
-    /* no discrete states: an event only restarts the host's integrator at a switch */
+    /* the states change only where a model's update says so (a friction element's reversal); once
+       changed they are consistent, so no second iteration is needed */
     eventInfo->newDiscreteStatesNeeded = fmi2False;
     eventInfo->terminateSimulation = fmi2False;
     eventInfo->nominalsOfContinuousStatesChanged = fmi2False;
-    eventInfo->valuesOfContinuousStatesChanged = fmi2False;
+    eventInfo->valuesOfContinuousStatesChanged = bw_update_discrete_states(&BW_INSTANCE(c)->core, 1) ? fmi2True
+                                                                                                   : fmi2False;
     eventInfo->nextEventTimeDefined = fmi2False;
     eventInfo->nextEventTime = 0.0;
     return fmi2OK;
@@ -374,7 +376,8 @@ fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, fmi2Boolean noSetFMUStat
                                        fmi2Boolean *enterEventMode, fmi2Boolean *terminateSimulation) {
     (void)noSetFMUStatePriorToCurrentPoint;
     BW_NOT_NULL(c);
-    if (enterEventMode) *enterEventMode = fmi2False;
+    /* a reversal the event indicators did not locate (the velocity's root found on its old side) */
+    if (enterEventMode) *enterEventMode = bw_update_discrete_states(&BW_INSTANCE(c)->core, 0) ? fmi2True : fmi2False;
     if (terminateSimulation) *terminateSimulation = fmi2False;
     return fmi2OK;
 }

@@ -486,12 +486,15 @@ fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean *discrete
                                     fmi3Boolean *terminateSimulation, fmi3Boolean *nominalsOfContinuousStatesChanged,
                                     fmi3Boolean *valuesOfContinuousStatesChanged, fmi3Boolean *nextEventTimeDefined,
                                     fmi3Float64 *nextEventTime) {
+    int changed;
     BW3_NOT_NULL(instance);
-    /* no discrete states: an event only restarts the host's integrator at a switch */
+    /* the states change only where a model's update says so (a friction element's reversal); once
+       changed they are consistent, so no second iteration is needed */
+    changed = bw_update_discrete_states(&BW3(instance)->core, 1);
     if (discreteStatesNeedUpdate) *discreteStatesNeedUpdate = fmi3False;
     if (terminateSimulation) *terminateSimulation = fmi3False;
     if (nominalsOfContinuousStatesChanged) *nominalsOfContinuousStatesChanged = fmi3False;
-    if (valuesOfContinuousStatesChanged) *valuesOfContinuousStatesChanged = fmi3False;
+    if (valuesOfContinuousStatesChanged) *valuesOfContinuousStatesChanged = changed ? fmi3True : fmi3False;
     if (nextEventTimeDefined) *nextEventTimeDefined = fmi3False;
     if (nextEventTime) *nextEventTime = 0.0;
     return fmi3OK;
@@ -506,7 +509,8 @@ fmi3Status fmi3CompletedIntegratorStep(fmi3Instance instance, fmi3Boolean noSetF
                                        fmi3Boolean *enterEventMode, fmi3Boolean *terminateSimulation) {
     (void)noSetFMUStatePriorToCurrentPoint;
     BW3_NOT_NULL(instance);
-    if (enterEventMode) *enterEventMode = fmi3False;
+    /* a reversal the event indicators did not locate (the velocity's root found on its old side) */
+    if (enterEventMode) *enterEventMode = bw_update_discrete_states(&BW3(instance)->core, 0) ? fmi3True : fmi3False;
     if (terminateSimulation) *terminateSimulation = fmi3False;
     return fmi3OK;
 }
