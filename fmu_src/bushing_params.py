@@ -136,6 +136,7 @@ UNIT_DEFINITIONS: dict[str, dict[str, str] | None] = {
     "N.mm.s/rad": {"kg": "1", "m": "2", "s": "-1", "rad": "-1", "factor": "0.001"},
     # rates of the states (the native FMU's model exchange)
     "N/s": {"kg": "1", "m": "1", "s": "-3"},
+    "1/s": {"s": "-1"},
     "N.m/s": {"kg": "1", "m": "2", "s": "-3"},
     "N.mm/rad^3": {"kg": "1", "m": "2", "s": "-2", "rad": "-3", "factor": "0.001"},
     "N.mm.s^alpha/rad": None,

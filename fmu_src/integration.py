@@ -24,6 +24,11 @@ writes its equations as five kernels and uses the pieces below to step them:
 - a walk of z along a given relative displacement xi (``walk_along_xi``): a displacement jump
   (an impulse in dx/dt) moves z that way, and so does a step of a Bouc-Wen element driven
   directly by the displacement.
+- the rate-independent and viscoelastic elements of the filled-rubber models (``berg_model``,
+  ``fractional_model``): Berg's friction (``friction_force``, ``friction_turn``), an algebraic
+  law of the travel since the last reversal, so exact whatever the step; and the Maxwell
+  element (a spring and a dashpot in series, ``maxwell_step``), linear and propagated exactly
+  over a step with constant velocity.
 - the driver ``advance``: a model's jump and integration kernels for one communication step,
   their status codes turned into ``StepError`` with a message naming the inputs (the FMU's
   error policy lives in ``bushing_slave``; this is where the step's failures are worded).
@@ -228,6 +233,70 @@ def walk_along_xi(z, xi_total, A, beta, gamma, n, heun_limit, theta, max_pieces)
     else:
         return z, TOO_MANY_SUBSTEPS
     return z, OK
+
+
+# ---------------------------------------------------------------------------- friction and Maxwell elements
+def friction_force(limit, half_travel, travel, reversal_force, direction):
+    """Berg's smooth rate-independent friction force [N] (Berg, Vehicle System Dynamics 30, 1998).
+
+    ``limit`` F_max [N] is the force it tends to far from a reversal, ``half_travel`` x2 [mm] the
+    travel from rest at which it reaches F_max/2; the state is the ``travel`` x - x_s [mm] since
+    the last reversal, the force F_s [N] there (``reversal_force``) and the ``direction`` of the
+    motion since (+1 up, -1 down, 0 not yet moved). With beta = F_s/F_max, moving up
+
+        F = F_s + (x - x_s)*(F_max - F_s)/(x2*(1 - beta) + (x - x_s)),
+
+    moving down F = F_s + (x - x_s)*(F_max + F_s)/(x2*(1 + beta) - (x - x_s)); from rest (F_s = 0)
+    both are F_max*x/(x2 + |x|). Every branch leaves its reversal with the slope F_max/x2 and tends
+    to +-F_max. Written times F_max in numerator and denominator, so F_max = 0 gives 0."""
+    if direction > 0.0 or (direction == 0.0 and travel >= 0.0):
+        room = limit - reversal_force
+        denominator = half_travel * room + travel * limit
+    else:
+        room = limit + reversal_force
+        denominator = half_travel * room - travel * limit
+    if denominator > 0.0:
+        return reversal_force + travel * room * limit / denominator
+    return reversal_force
+
+
+ROUNDING_JUMP_MM = 1e-12
+"""A displacement jump smaller than this [mm, or rad] is rounding, not motion, for the friction: a
+master that passes v = (x_k+1 - x_k)/h gives x_k + v*h = x_k+1 only to rounding (1e-16 of x), and
+a reversal there would restart the friction's branch at every step."""
+
+
+def friction_jump_turn(limit, half_travel, travel, reversal_force, direction, jump_mm):
+    """:func:`friction_turn` for a displacement jump: one of rounding size (ROUNDING_JUMP_MM) never
+    reverses the friction (the travel still takes it)."""
+    motion = jump_mm if abs(jump_mm) > ROUNDING_JUMP_MM else 0.0
+    return friction_turn(limit, half_travel, travel, reversal_force, direction, motion)
+
+
+def friction_turn(limit, half_travel, travel, reversal_force, direction, motion):
+    """The friction state (travel, reversal force, direction) once the displacement moves the way
+    of ``motion``'s sign (a velocity or a jump): where that is against ``direction``, a reversal
+    here (travel 0, the reversal force the force here); the first motion from rest only sets the
+    direction (the curve from rest is both branches at once); no motion changes nothing."""
+    if motion > 0.0:
+        heading = 1.0
+    elif motion < 0.0:
+        heading = -1.0
+    else:
+        return travel, reversal_force, direction
+    if heading == direction:
+        return travel, reversal_force, direction
+    if direction == 0.0 and travel * heading >= 0.0:
+        return travel, reversal_force, heading
+    return 0.0, friction_force(limit, half_travel, travel, reversal_force, direction), heading
+
+
+def maxwell_step(force, stiffness, rate, v, h):
+    """The force [N] of a Maxwell element (spring ``stiffness`` [N/mm] in series with a dashpot,
+    ``rate`` = stiffness/damping [1/s]) after h [s] at velocity v [mm/s]: df/dt = k*v - rate*f,
+    solved exactly, f(h) = f*exp(-rate*h) + k*v*(1 - exp(-rate*h))/rate."""
+    E, phi1, _ = decay_factors(rate * h)
+    return force * E + stiffness * v * h * phi1
 
 
 # ---------------------------------------------------------------------------- the step

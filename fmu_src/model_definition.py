@@ -73,16 +73,21 @@ class SearchCoordinate:
       (``over``), tau = value/sum(over);
     - ``shape``: value*F_ref^n/k_ref, n the block's exponent (``exponent``);
     - ``shape_sum``: partner' + sign*value' of a block (value' = value*F_ref^n/k_ref);
-    - ``exponent``: the value itself.
+    - ``exponent``: the value itself;
+    - ``force``: log10(value/F_ref); ``travel``: log10(value/x_ref), x_ref [mm] the tests' largest
+      amplitude; ``cubic``: value*x_ref^2/k_ref;
+    - ``slower``: log10(tau/tau_partner), a dashpot's time constant (value over the stiffnesses
+      ``over``) over that of the dashpot ``partner`` (a ``time_constant`` coordinate);
+    - ``fractional``: log10(value/(k_ref*tau_ref^alpha)), alpha the parameter ``exponent``.
 
     ``low`` and ``high`` bound the coordinate."""
     parameter: str
     kind: str
     low: float
     high: float
-    exponent: str = ""                  # shape, shape_sum: the block's n
-    over: tuple[str, ...] = ()          # time_constant: the stiffnesses the dashpot works against
-    partner: str = ""                   # shape_sum: the block's beta-like parameter
+    exponent: str = ""                  # shape, shape_sum: the block's n; fractional: its alpha
+    over: tuple[str, ...] = ()          # time_constant, slower: the stiffnesses the dashpot works against
+    partner: str = ""                   # shape_sum: the block's beta-like parameter; slower: the faster dashpot
     sign: float = 1.0                   # shape_sum: coordinate = partner' + sign*parameter'
 
 

@@ -13,6 +13,10 @@ through :func:`unroll`, which writes each such call out term by term, i replaced
     tuple(k[i] * f[i] for i in range(3))   ->   (k[0] * f[0], k[1] * f[1], k[2] * f[2])
     sum(k[i] * f[i] for i in range(3))     ->   0 + k[0] * f[0] + k[1] * f[1] + k[2] * f[2]
 
+The terms' int arithmetic is folded (``state[3 + i]`` becomes ``state[3]``, ``state[4]`` ...: the
+C knows constant indices only), and a tuple written out inside a tuple display is spliced into it:
+``(v, 0.0, *tuple(... for i in range(N)))`` is one flat tuple of N + 2 values.
+
 The sum starts from the int 0 and adds left to right, as Python's ``sum`` does, so the unrolled
 source gives the same floats bit for bit (a sum of -0.0 terms included). Such a generator with
 a condition or two ``for`` clauses is an ``UnrollError`` naming the line; generators over
@@ -65,7 +69,8 @@ class _Unroller(ast.NodeTransformer):
         bounds = [self.constant(argument) for argument in clause.iter.args]
         if None in bounds:
             return node     # a range that is not constant: as above
-        terms = [ast.copy_location(_Substitute(clause.target.id, i).visit(_copy(generator.elt)), node)
+        terms = [ast.copy_location(_FoldInts().visit(_Substitute(clause.target.id, i).visit(_copy(generator.elt))),
+                                   node)
                  for i in range(*bounds)]
         if node.func.id == "tuple":
             return ast.copy_location(ast.Tuple(terms, ast.Load()), node)
@@ -73,6 +78,18 @@ class _Unroller(ast.NodeTransformer):
         for term in terms:
             total = ast.copy_location(ast.BinOp(total, ast.Add(), term), node)
         return total
+
+    def visit_Tuple(self, node: ast.Tuple):
+        self.generic_visit(node)
+        if not any(isinstance(e, ast.Starred) and isinstance(e.value, ast.Tuple) for e in node.elts):
+            return node
+        elements = []
+        for element in node.elts:
+            if isinstance(element, ast.Starred) and isinstance(element.value, ast.Tuple):
+                elements.extend(element.value.elts)
+            else:
+                elements.append(element)
+        return ast.copy_location(ast.Tuple(elements, node.ctx), node)
 
     def constant(self, node) -> int | None:
         """The int value of a range bound, None if it is not a literal or a constant of the module."""
@@ -98,6 +115,20 @@ class _Substitute(ast.NodeTransformer):
     def visit_Name(self, node: ast.Name):
         if node.id == self.name and isinstance(node.ctx, ast.Load):
             return ast.copy_location(ast.Constant(self.value), node)
+        return node
+
+
+class _FoldInts(ast.NodeTransformer):
+    """``a + b``, ``a - b`` and ``a * b`` of int literals as one literal (exact)."""
+
+    def visit_BinOp(self, node: ast.BinOp):
+        self.generic_visit(node)
+        if (isinstance(node.op, (ast.Add, ast.Sub, ast.Mult)) and isinstance(node.left, ast.Constant)
+                and isinstance(node.right, ast.Constant) and type(node.left.value) is int
+                and type(node.right.value) is int):
+            value = {ast.Add: int.__add__, ast.Sub: int.__sub__, ast.Mult: int.__mul__}[type(node.op)](
+                node.left.value, node.right.value)
+            return ast.copy_location(ast.Constant(value), node)
         return node
 
 

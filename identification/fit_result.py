@@ -227,9 +227,11 @@ class FitResult:
                         "search_space": {"k_ref_N_per_mm": round_for_file(self.space.k_ref),
                                          "c_ref_Ns_per_mm": round_for_file(self.space.c_ref),
                                          "F_ref_N": round_for_file(self.space.F_ref),
-                                         "shortest_time_constant_s": round_for_file(self.space.shortest_time_constant_s)},
-                        "note": "alpha = 1 in every Bouc-Wen block: the (alpha, A, beta, gamma) redundancy "
-                                "(search_space.rescale_hysteresis gives the equivalent sets)"})
+                                         "x_ref_mm": round_for_file(self.space.x_ref),
+                                         "shortest_time_constant_s": round_for_file(self.space.shortest_time_constant_s)}})
+            if self.space.bushing.search.unit_weights:
+                out["note"] = ("alpha = 1 in every Bouc-Wen block: the (alpha, A, beta, gamma) redundancy "
+                               "(search_space.rescale_hysteresis gives the equivalent sets)")
         if self.sampler is not None:
             out["posterior_sampling"] = {"acceptance": round_for_file(self.sampler.acceptance),
                                          "autocorrelation_steps": round_for_file(self.sampler.autocorrelation_steps),

@@ -25,7 +25,13 @@ Coordinates, each with bounds (the box; each model declares its own in its modul
 - shape: beta*F_ref^n/k_ref (beta >= 0, the paper's constraint);
 - shape sum: beta' + sign*gamma' of a block (gamma' = gamma*F_ref^n/k_ref), >= 0, which is the
   paper's constraint beta1 + gamma1 > 0 (sign +1) and beta2 - gamma2 > 0 (sign -1) as a bound;
-- exponent: n.
+- exponent: n (or a fractional derivative's order alpha);
+- force: log10(F/F_ref), a friction force limit; travel: log10(x/x_ref), x_ref [mm] the tests'
+  largest displacement amplitude (the friction's x2); cubic: k3*x_ref^2/k_ref, a cubic spring's
+  share of the force at x_ref, from 0;
+- slower: log10(tau/tau_partner) of a second dashpot's time constant over the first's (a Maxwell
+  element slower than its partner, so that two elements never swap places between fits);
+- fractional: log10(b/(k_ref*tau_ref^alpha)), a fractional element's coefficient.
 
 Every constraint is a bound, so bounded least squares and any box optimizer can search
 the space as it is. ``tests/test_search_space.py`` checks that the paper's Tables 2, 4, 5,
@@ -73,7 +79,8 @@ class KelvinVoigtFit:
         return self.k * np.asarray(displacement_mm) + self.c * np.asarray(velocity_mm_s)
 
 
-_ORDER = ("stiffness", "gain", "damping", "exponent", "time_constant", "shape", "shape_sum")
+_ORDER = ("stiffness", "gain", "damping", "exponent", "force", "travel", "cubic", "time_constant", "slower", "shape",
+          "shape_sum", "fractional")
 """The order in which coordinates are mapped to parameters: each kind needs only earlier ones."""
 
 
@@ -84,6 +91,7 @@ class SearchSpace:
     F_ref: float                  # N
     sample_interval_s: float      # the shortest median sample interval of the tests
     model: str = "proposed"
+    x_ref: float = 1.0            # mm: the tests' largest displacement amplitude
 
     @classmethod
     def from_measurements(cls, measurements: Sequence[Measurement], model: str = "proposed",
@@ -103,7 +111,7 @@ class SearchSpace:
                 peak = max([from_table.F_ref] + [float(np.max(np.abs(m.force_N))) for m in measurements])
                 interval = min([from_table.sample_interval_s] + [float(np.median(np.diff(m.time_s)))
                                                                  for m in measurements])
-                return cls(from_table.k_ref, from_table.c_ref, peak, interval, model)
+                return cls(from_table.k_ref, from_table.c_ref, peak, interval, model, from_table.x_ref)
         scaling = scaling or list(measurements)
         kelvin_voigt = KelvinVoigtFit.fit(scaling)
         peak = max(float(np.max(np.abs(m.force_N))) for m in scaling)
@@ -119,7 +127,7 @@ class SearchSpace:
         interval = min(float(np.median(np.diff(m.time_s))) for m in measurements)
         if table is not None:
             interval = min(interval, from_table.sample_interval_s)
-        return cls(k_ref, c_ref, peak, interval, model)
+        return cls(k_ref, c_ref, peak, interval, model, amplitude)
 
     @classmethod
     def from_table(cls, table, model: str = "proposed") -> "SearchSpace":
@@ -135,7 +143,8 @@ class SearchSpace:
         c_ref = float(np.median(damping)) if np.median(damping) > 0 else k_ref * 0.01
         peak = float(np.max(table.kdyn_N_per_mm[kept] * table.amplitude_mm[kept]))
         interval = 1.0 / (FIT_STEPS_PER_CYCLE * float(np.max(table.frequency_hz[kept])))
-        return cls(k_ref, c_ref, peak, interval, model)
+        amplitude = float(np.max(table.amplitude_mm[kept]))
+        return cls(k_ref, c_ref, peak, interval, model, amplitude)
 
     @property
     def coordinates(self) -> tuple[SearchCoordinate, ...]:
@@ -190,8 +199,18 @@ class SearchSpace:
                 value[c.parameter] = self.c_ref * 10.0 ** u
             elif c.kind == "exponent":
                 value[c.parameter] = u
+            elif c.kind == "force":
+                value[c.parameter] = self.F_ref * 10.0 ** u
+            elif c.kind == "travel":
+                value[c.parameter] = self.x_ref * 10.0 ** u
+            elif c.kind == "cubic":
+                value[c.parameter] = u * self.k_ref / self.x_ref ** 2
             elif c.kind == "time_constant":
                 value[c.parameter] = self.tau_ref * 10.0 ** u * sum(value[name] for name in c.over)
+            elif c.kind == "slower":
+                value[c.parameter] = self._time_constant(value, c.partner) * 10.0 ** u * sum(value[name] for name in c.over)
+            elif c.kind == "fractional":
+                value[c.parameter] = self.k_ref * self.tau_ref ** value[c.exponent] * 10.0 ** u
             elif c.kind == "shape":
                 value[c.parameter] = u * self._shape_scale(value[c.exponent])
             else:  # shape_sum: u = partner' + sign*parameter'
@@ -217,9 +236,21 @@ class SearchSpace:
                 theta.append(math.log10(value / self.c_ref) if value > 0 else -math.inf)
             elif c.kind == "exponent":
                 theta.append(value)
+            elif c.kind == "force":
+                theta.append(math.log10(value / self.F_ref) if value > 0 else -math.inf)
+            elif c.kind == "travel":
+                theta.append(math.log10(value / self.x_ref))
+            elif c.kind == "cubic":
+                theta.append(value * self.x_ref ** 2 / self.k_ref)
             elif c.kind == "time_constant":
                 stiffness = sum(p[name] for name in c.over)
                 theta.append(math.log10(value / stiffness / self.tau_ref) if value > 0 else -math.inf)
+            elif c.kind == "slower":
+                tau = value / sum(p[name] for name in c.over)
+                theta.append(math.log10(tau / self._time_constant(p, c.partner)))
+            elif c.kind == "fractional":
+                theta.append(math.log10(value / (self.k_ref * self.tau_ref ** p[c.exponent])) if value > 0
+                             else -math.inf)
             elif c.kind == "shape":
                 theta.append(value / self._shape_scale(p[c.exponent]))
             else:
@@ -231,6 +262,13 @@ class SearchSpace:
         theta = np.atleast_2d(coordinates)
         bounds = self.bounds()
         return np.all((theta >= bounds[:, 0]) & (theta <= bounds[:, 1]), axis=1)
+
+    def _time_constant(self, values, parameter: str):
+        """The time constant [s] of the dashpot ``parameter`` (a time_constant coordinate) in
+        ``values`` (a mapping of parameters or of their columns): its value over the
+        stiffnesses it works against."""
+        over = next(c.over for c in self.coordinates if c.parameter == parameter)
+        return values[parameter] / sum(values[name] for name in over)
 
     def _shape_scale(self, n):
         """beta = coordinate * k_ref / F_ref^n: the shape parameters' scale [N^(1-n)/mm]."""

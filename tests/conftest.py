@@ -140,6 +140,22 @@ def native_fmu_path(tmp_path_factory) -> Path:
     return build_fmu.build_native_fmu(out_dir=tmp_path_factory.mktemp("native_table5")).path
 
 
+@pytest.fixture(scope="session")
+def native_model_fmus(tmp_path_factory) -> dict:
+    """Each model's native FMU (FMI 2.0), and the six-axis one, with their default parameters."""
+    from fmu_src.bushing_models import MODELS
+    folder = tmp_path_factory.mktemp("native")
+    return {name: build_fmu.build_native_fmu(out_dir=folder, model=name).path for name in (*MODELS, "six_axis")}
+
+
+@pytest.fixture(scope="session")
+def pythonfmu_model_fmus(tmp_path_factory) -> dict:
+    """Each model's pythonfmu FMU, and the six-axis one, with their default parameters."""
+    from fmu_src.bushing_models import MODELS
+    folder = tmp_path_factory.mktemp("pythonfmu")
+    return {name: build_fmu.build_fmu(out_dir=folder, model=name) for name in (*MODELS, "six_axis")}
+
+
 def is_native(fmu_path) -> bool:
     """Whether ``fmu_path`` is a native FMU (build_fmu.py --native), not a pythonfmu one."""
     from fmpy import read_model_description

@@ -19,4 +19,10 @@ PARAMETER_UNITS = {
     "spencer": {"c0": "N.s/mm", "k0": "N/mm", "c1": "N.s/mm", "k1": "N/mm", "x0": "mm", **_block("")},
     "single_bouc_wen": {"c0": "N.s/mm", "k0": "N/mm", **_block("")},
     "kelvin_voigt": {"k": "N/mm", "c": "N.s/mm", "preload": "N"},
+    # F = k0*x + k3*x^3 + F_f(x; Ff_max, x2) + ...: k3*x^3 is a force with x in mm; the friction's
+    # limit is a force and x2 a travel; Maxwell elements k*(x - q), dq/dt = k*(x - q)/c;
+    # b*D^alpha x is a force with D^alpha x in mm/s^alpha
+    "berg": {"k0": "N/mm", "k3": "N/mm^3", "Ff_max": "N", "x2": "mm", "k1": "N/mm", "c1": "N.s/mm", "k2": "N/mm",
+             "c2": "N.s/mm"},
+    "fractional": {"k0": "N/mm", "k3": "N/mm^3", "Ff_max": "N", "x2": "mm", "b": "N.s^alpha/mm", "alpha": "1"},
 }

@@ -3,6 +3,7 @@ import numpy as np
 import pytest
 
 from conftest import paper_parameters
+from fmu_src.bushing_models import MODELS
 from fmu_src.proposed_model import PARAMETER_NAMES
 from identification.compiled_core import simulate_population_held
 from identification.protocols import Random, Sine, sample_times
@@ -59,7 +60,7 @@ def random_population(model: str, count: int, seed: int):
     return bushing.parameter_names, base * np.random.default_rng(seed).uniform(0.7, 1.3, (count, base.size))
 
 
-@pytest.mark.parametrize("model", ["proposed", "spencer", "single_bouc_wen", "kelvin_voigt"])
+@pytest.mark.parametrize("model", list(MODELS))
 def test_compiled_forces_equal_the_python_kernels_bitwise_for_every_model(model):
     # One definition, two paths: the FMU's plain-Python kernels (tests/python_core.py steps them
     # as the FMU does) and their numba-compiled copies must give the same floats.

@@ -7,12 +7,35 @@ from conftest import paper_equations, paper_parameters
 from fmu_src.bushing_models import MODELS
 from test_baseline_models import BOUC_WEN, SPENCER, bouc_wen_rhs, spencer_rhs
 
+def berg_rhs(p, s, x, v):
+    """Berg's model: d/dt of the travel is v, the reversal force and direction hold between
+    events, each Maxwell element df/dt = k*v - (k/c)*f."""
+    return [v, 0.0, 0.0, p["k1"] * v - p["k1"] / p["c1"] * s[3], p["k2"] * v - p["k2"] / p["c2"] * s[4]]
+
+
+def fractional_rhs(p, s, x, v):
+    """The fractional model's realisation as its docstring states it: Maxwell elements of rates
+    10^(-4 + j/2) 1/s, j = 0..18, stiffness b*sin(alpha*pi)/pi*r^alpha*ln(10)/2, and below them one
+    of stiffness b*sin(alpha*pi)/pi*r_a^alpha/alpha, rate r_a*(1 - alpha)/alpha, r_a = 10^-4.25."""
+    alpha, scale = p["alpha"], p["b"] * np.sin(p["alpha"] * np.pi) / np.pi
+    rates = [10.0 ** (-4.0 + j / 2.0) for j in range(19)]
+    stiffness = [scale * r ** alpha * np.log(10.0) / 2.0 for r in rates]
+    lowest = 10.0 ** -4.25
+    rates.append(lowest * (1.0 - alpha) / alpha)
+    stiffness.append(scale * lowest ** alpha / alpha)
+    return [v, 0.0, 0.0] + [k * v - r * f for k, r, f in zip(stiffness, rates, s[3:])]
+
+
+FILLED_RUBBER = {"k0": 500.0, "k3": 10.0, "Ff_max": 60.0, "x2": 0.08}
+
 CASES = {
     # model: (parameters, independent right-hand side(p, state, x, v), state scale)
     "proposed": (paper_parameters("table5"),
                  lambda p, s, x, v: paper_equations(0.0, s, p, lambda t: x, lambda t: v), (1.0, 500.0, 1.0, 50.0)),
     "spencer": (SPENCER, spencer_rhs, (1.0, 500.0)),
     "single_bouc_wen": (BOUC_WEN, bouc_wen_rhs, (500.0,)),
+    "berg": (dict(FILLED_RUBBER, k1=150.0, c1=15.0, k2=250.0, c2=0.5), berg_rhs, (1.0, 50.0, 1.0, 100.0, 100.0)),
+    "fractional": (dict(FILLED_RUBBER, b=70.0, alpha=0.22), fractional_rhs, (1.0, 50.0, 1.0) + (100.0,) * 20),
 }
 
 
@@ -39,6 +62,19 @@ def test_switches_are_the_blocks_relative_velocities_and_hysteretic_forces():
     np.testing.assert_allclose(bushing.switches(constants, state, x, v), (v - dy, state[1], v - dw, state[3]),
                                rtol=1e-14)
     assert MODELS["single_bouc_wen"].switches(MODELS["single_bouc_wen"].constants(BOUC_WEN), (7.0,), 0.1, -3.0) == (-3.0, 7.0)
+
+
+def test_the_friction_models_switch_where_the_velocity_changes_sign_and_reverse_there():
+    for name, params in (("berg", CASES["berg"][0]), ("fractional", CASES["fractional"][0])):
+        bushing = MODELS[name]
+        constants = bushing.constants(params)
+        state = (0.4,) + (0.0,) * (len(bushing.states) - 1)
+        state = (0.4, 0.0, 1.0) + state[3:]                        # moved up 0.4 mm from rest
+        assert bushing.switches(constants, state, 0.4, -3.0) == (-3.0,)
+        assert bushing.update(constants, state, 0.4, 2.0) == state     # still moving up: no change
+        turned = bushing.update(constants, state, 0.4, -2.0)
+        friction = params["Ff_max"] * 0.4 / (params["x2"] + 0.4)    # from rest, typed: Ff_max*x/(x2 + x)
+        assert turned[:3] == (0.0, pytest.approx(friction, rel=1e-14), -1.0) and turned[3:] == state[3:]
 
 
 def test_kelvin_voigt_has_no_state_to_integrate():

@@ -23,17 +23,15 @@ MM = 1e-3
 
 
 @pytest.fixture(scope="module")
-def native_fmus(tmp_path_factory):
-    """Each model's native FMU (FMI 2.0) with its default parameters."""
-    folder = tmp_path_factory.mktemp("native")
-    return {name: build_fmu.build_native_fmu(out_dir=folder, model=name).path for name in FMUS}
+def native_fmus(native_model_fmus):
+    """Each model's native FMU (FMI 2.0) with its default parameters (conftest)."""
+    return native_model_fmus
 
 
 @pytest.fixture(scope="module")
-def pythonfmu_fmus(tmp_path_factory):
-    """Each model's pythonfmu FMU with the same parameters."""
-    folder = tmp_path_factory.mktemp("pythonfmu")
-    return {name: build_fmu.build_fmu(out_dir=folder, model=name) for name in FMUS}
+def pythonfmu_fmus(pythonfmu_model_fmus):
+    """Each model's pythonfmu FMU with the same parameters (conftest)."""
+    return pythonfmu_model_fmus
 
 
 @pytest.mark.parametrize("name", FMUS)

@@ -80,3 +80,12 @@ def test_the_c_translation_refuses_a_generator_over_anything_else(tmp_path):
     spec.loader.exec_module(module)
     with pytest.raises(TranslationError, match="refused_kernel.total, line 2"):
         Translation().function(module.total, ((DOUBLE, DOUBLE),))
+
+
+def test_indices_are_folded_and_a_written_out_tuple_is_spliced_into_a_display():
+    source = "def kernel(state, v):\n    return (v, 0.0, *tuple(state[2 + i] * 2 for i in range(3)))\n"
+    text = ast.unparse(unroll(ast.parse(source), {}, "test"))
+    assert "return (v, 0.0, state[2] * 2, state[3] * 2, state[4] * 2)" in text
+    namespace = {}
+    exec(source, namespace)
+    assert unrolled_function(source, {})((1.0, 2.0, 3.0, 4.0, 5.0), 7.0) == namespace["kernel"]((1.0, 2.0, 3.0, 4.0, 5.0), 7.0)

@@ -1,17 +1,21 @@
-"""Reference results of the four one-axis bushing models on the paper's Table 5 tests.
+"""Reference results of the one-axis bushing models on the paper's Table 5 tests.
 
     python tests/references/generate_references.py [--check-convergence]
 
 Writes, next to this file, ``<model>_sine_2mm_10Hz.csv`` and ``<model>_step_2mm_rise0.4s.csv``
 (columns time_s, displacement_mm, force_N; 1 ms samples) and ``<model>.png`` (hysteresis loop
 and step response) for the proposed model (the paper's Table 5), Spencer's, the single Bouc-Wen
-and Kelvin-Voigt (the project's fitted sets). Running it again rewrites the same bytes on the same
+and Kelvin-Voigt (the project's fitted sets), and the filled-rubber models Berg and fractional
+(illustrative sets typed in data/). Running it again rewrites the same bytes on the same
 numpy/scipy/matplotlib.
 
 Independent of the code under test: the equations are typed here from the paper (eqs. 1-5) and
 Spencer et al. (1997) as the model modules' docstrings state them, the parameter files are read
 as plain JSON, and scipy's Radau integrates the continuous-time inputs (no sampling, no
-interpolation, no communication steps). Nothing of ``fmu_src`` or ``identification`` is imported.
+interpolation, no communication steps). The filled-rubber models are typed in
+``filled_rubber.py`` beside this file and solved exactly on a path of straight pieces, 10 us long
+for the sine (Berg's friction from its definition, Maxwell elements by scipy's lsim, the
+fractional derivative by the L1 sum). Nothing of ``fmu_src`` or ``identification`` is imported.
 
 The tests (paper §4.1-4.3, ``identification.protocols``): x = 2 mm * sin(2*pi*10 Hz*t) over 1 s,
 and a ramp from 0 to 2 mm over 0.4 s held to 10 s. The bushing starts in relaxed equilibrium at
@@ -20,8 +24,9 @@ the step's velocity jumps from 5 mm/s to 0; the sample there is the right limit 
 ``Step.signals`` gives it), which is lower than the left limit by the viscous feedthrough
 (8.4 N for the proposed model).
 
-``--check-convergence`` solves every ODE case again with 10x tighter tolerances and prints the
-largest difference relative to the peak |F| (the README quotes it); the files are not rewritten.
+``--check-convergence`` solves every ODE case again with 10x tighter tolerances (the filled-rubber
+sines on 10x shorter pieces) and prints the largest difference relative to the peak |F| (the
+README quotes it); the files are not rewritten.
 
 Units: time s, displacement mm, velocity mm/s, force N, parameters in the paper's N-mm-s.
 """
@@ -35,6 +40,9 @@ from pathlib import Path
 import numpy as np
 import scipy
 from scipy.integrate import solve_ivp
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import filled_rubber  # noqa: E402  (numpy and scipy only)
 
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parents[1]
@@ -61,7 +69,17 @@ MODELS = {
     "kelvin_voigt": ("params_kelvin_voigt_fit_synthetic_table5.json",
                      "Kelvin-Voigt F = k*x + c*dx/dt + preload, as the project fitted it to the synthetic "
                      "Table 5 tests"),
+    "berg": ("params_berg_filled_rubber.json",
+             "Berg 1998: spring k0*x + k3*x^3, Berg's friction, two Maxwell elements; an illustrative filled rubber"),
+    "fractional": ("params_fractional_filled_rubber.json",
+                   "spring k0*x + k3*x^3, Berg's friction, b*D^alpha x (the exact fractional derivative); an "
+                   "illustrative filled rubber"),
 }
+PATH_MODELS = ("berg", "fractional")
+"""Solved on a fine straight-piece path (filled_rubber.py), not by an ODE solver."""
+FINE_SINE_S = 1e-5
+"""The straight pieces that stand for the continuous sine of the path models: the friction's
+reversal and the fractional derivative of this path differ from the sine's by < 1e-7 of the peak."""
 
 
 # ------------------------------------------------------------------------------ inputs
@@ -171,6 +189,8 @@ def solve(model: str, p: dict, test: dict, tighter: float = 1.0) -> tuple[np.nda
     x, xd = signal(t)
     if model == "kelvin_voigt":
         return t, x, p["k"] * x + p["c"] * xd + p["preload"]
+    if model in PATH_MODELS:
+        return t, x, solve_path(model, p, test, tighter)
     rhs, force, start, atol = EQUATIONS[model]
     if test is SINE:
         pieces = [(0.0, test["duration_s"], sine_input)]
@@ -194,6 +214,18 @@ def solve(model: str, p: dict, test: dict, tighter: float = 1.0) -> tuple[np.nda
     return t, x, force(p, states, x, xd)
 
 
+def solve_path(model: str, p: dict, test: dict, tighter: float = 1.0) -> np.ndarray:
+    """The force [N] at the 1 ms samples of a filled-rubber model (filled_rubber.py): the step is
+    straight pieces between the samples already (its corners are samples); the sine runs on
+    pieces of FINE_SINE_S / ``tighter``, then is read at every 1 ms."""
+    if test is STEP:
+        t = sample_times(test["duration_s"])
+        return filled_rubber.FORCES[model](p, t, step_input(t)[0])
+    per_sample = round(SAMPLE_S / (FINE_SINE_S / tighter))
+    fine = np.arange(round(test["duration_s"] / SAMPLE_S) * per_sample + 1) * (SAMPLE_S / per_sample)
+    return filled_rubber.FORCES[model](p, fine, sine_input(fine)[0])[::per_sample]
+
+
 def header(model: str, test: dict) -> str:
     if test is SINE:
         signal = "x = 2 mm * sin(2*pi*10 Hz*t), t = 0..1 s"
@@ -201,6 +233,9 @@ def header(model: str, test: dict) -> str:
         signal = "x = ramp 0 -> 2 mm over 0.4 s, held to 10 s (dx/dt = 0 from t = 0.4 s: the right limit there)"
     if model == "kelvin_voigt":
         solver = "closed form F = k*x + c*dx/dt + preload (no state, nothing to integrate)"
+    elif model in PATH_MODELS:
+        solver = (f"exact on straight pieces (tests/references/filled_rubber.py: Berg's friction, lsim, the L1 sum), "
+                  f"pieces of {'1 ms' if test is STEP else f'{FINE_SINE_S:g} s'}, from rest at x(0)")
     else:
         solver = (f"scipy {scipy.__version__} solve_ivp Radau, rtol = {RTOL:g}, atol = {ATOL_MM:g} mm "
                   f"/ {ATOL_N:g} N, max_step = {MAX_STEP_S:g} s, from relaxed equilibrium at x(0)")
@@ -240,8 +275,8 @@ def plot(path: Path, model: str, sine, step) -> None:
     twin.plot(t_step, x_step, color="0.5", ls="--", lw=1)
     twin.set_ylabel("displacement x [mm] (dashed)")
     response.grid(alpha=0.3)
-    figure.suptitle(f"{model}: reference (data/{MODELS[model][0]}; "
-                    f"{'closed form' if model == 'kelvin_voigt' else 'scipy Radau'}, 1 ms samples)")
+    method = {"kelvin_voigt": "closed form", "berg": "straight pieces", "fractional": "straight pieces"}
+    figure.suptitle(f"{model}: reference (data/{MODELS[model][0]}; {method.get(model, 'scipy Radau')}, 1 ms samples)")
     figure.tight_layout()
     figure.savefig(path, dpi=80, metadata={"Software": None})   # no version stamp: same bytes on a rerun
     plt.close(figure)
