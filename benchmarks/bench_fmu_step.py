@@ -17,7 +17,8 @@ factor (simulated time / wall time) of one bushing.
 Then the native FMUs (``build_fmu.py --native``): through fmpy against a trivial native FMU of
 the same ports built from the same C layer (the stateless Kelvin-Voigt model, F = 2x) and
 against the pythonfmu bushing FMU, side by side; and in a plain C master
-(``c_master_timing.c``, 100 times the steps per run), where no Python is in the loop.
+(``c_master_timing.c``, 100 times the steps per run), where no Python is in the loop; and the
+native FMUs of the filled-rubber models (berg, fractional) with their default sets, the same way.
 """
 from __future__ import annotations
 
@@ -35,6 +36,9 @@ from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
+
+FILLED_RUBBER = ("berg", "fractional")
+"""The filled-rubber models, timed on the same sine with their default sets (data/params_*_filled_rubber.json)."""
 
 TRIVIAL_SLAVE = '''
 from pythonfmu import Fmi2Causality, Fmi2Slave, Real
@@ -205,19 +209,22 @@ def measure_native(steps: int, repeats: int) -> dict:
                 "pythonfmu": build_fmu.build_fmu(out_dir=work / "c"),
                 "native_trivial_six": build_fmu.build_native_fmu(all_gain, work / "d", "six_axis").path,
                 "native_six": build_fmu.build_native_fmu(all_proposed, work / "e", "six_axis").path,
-                "native_six_default": build_fmu.build_native_fmu(out_dir=work / "f", model="six_axis").path}
+                "native_six_default": build_fmu.build_native_fmu(out_dir=work / "f", model="six_axis").path,
+                **{f"native_{model}": build_fmu.build_native_fmu(out_dir=work / model, model=model).path
+                   for model in FILLED_RUBBER}}
         omega = 2 * math.pi * 10.0
         inputs_m = [[2e-3 * math.sin(omega * k * STEP_S), 2e-3 * omega * math.cos(omega * k * STEP_S)]
                     for k in range(steps)]
         inputs_six = [row * 3 + [10.0 * row[0], 10.0 * row[1]] * 3 for row in inputs_m]
         runs = {key: [] for key in fmus}
         for _ in range(repeats):
-            for key in ("native_trivial", "native", "pythonfmu"):
+            for key in ("native_trivial", "native", "pythonfmu", *(f"native_{model}" for model in FILLED_RUBBER)):
                 runs[key].append(time_fmu(fmus[key], inputs_m))
             for key in ("native_trivial_six", "native_six", "native_six_default"):
                 runs[key].append(time_fmu(fmus[key], inputs_six, SIX_AXIS_PORTS))
         result = {f"fmpy_{key}": statistics.median(values) for key, values in runs.items()}
-        result["fmpy_native_ratio"] = statistics.median(a / b for a, b in zip(runs["native"], runs["native_trivial"]))
+        for key in ("native", *(f"native_{model}" for model in FILLED_RUBBER)):
+            result[f"fmpy_{key}_ratio"] = statistics.median(a / b for a, b in zip(runs[key], runs["native_trivial"]))
         for key in ("native_six", "native_six_default"):
             result[f"fmpy_{key}_ratio"] = statistics.median(a / b for a, b in zip(runs[key], runs["native_trivial_six"]))
         result["fmpy_native_over_pythonfmu"] = statistics.median(a / b for a, b in zip(runs["native"],
@@ -225,7 +232,8 @@ def measure_native(steps: int, repeats: int) -> dict:
         master = work / "c_master_timing"
         subprocess.run(["cc", "-O2", "-std=c99", "-I", str(fmi_header_directory()), "-o", str(master),
                         str(Path(__file__).with_name("c_master_timing.c")), "-ldl", "-lm"], check=True)
-        for key in ("native_trivial", "native", "native_trivial_six", "native_six", "native_six_default"):
+        for key in ("native_trivial", "native", "native_trivial_six", "native_six", "native_six_default",
+                    *(f"native_{model}" for model in FILLED_RUBBER)):
             result[f"c_{key}"] = statistics.median(_c_master(master, fmus[key], work / key, 100 * steps, repeats))
     return result
 
@@ -286,6 +294,8 @@ def main() -> None:
     print(f"{'what':46s} {'fmpy':>9s} {'ratio':>6s} {'C master':>9s}")
     for key, label, ratio in (("native_trivial", "trivial native FMU, one axis", 1.0),
                               ("native", "native bushing FMU, one axis (<= 1.15x)", native["fmpy_native_ratio"]),
+                              *((f"native_{model}", f"native {model} FMU (C master: <= 1 us)",
+                                 native[f"fmpy_native_{model}_ratio"]) for model in FILLED_RUBBER),
                               ("native_trivial_six", "trivial native FMU, six axes", 1.0),
                               ("native_six", "native six-axis FMU, six proposed axes", native["fmpy_native_six_ratio"]),
                               ("native_six_default", "native six-axis FMU, its default set",

@@ -119,11 +119,13 @@ SEARCH = SearchBox(
      SearchCoordinate("k1", "stiffness", -4.0, 1.0), SearchCoordinate("c1", "time_constant", -math.inf, 4.0,
                                                                        over=("k1",)),
      SearchCoordinate("k2", "stiffness", -4.0, 1.0), SearchCoordinate("c2", "slower", 0.0, 6.0, over=("k2",),
-                                                                       partner="c1")))
+                                                                       partner="c1")),
+    loop_start=("k0", "k3", "Ff_max", "x2"))
 """The fit's box: the friction's limit scaled by the peak force and its x2 by the largest
 amplitude, the cubic term as k3*X^2/k_ref (0 to 2: up to twice k_ref's force added at the largest
 amplitude X); the second Maxwell element is the slower one (its time constant c2/k2 is
-10^(0..6) times c1/k1), so the two are never the same optimum twice."""
+10^(0..6) times c1/k1), so the two are never the same optimum twice. The spring and the friction
+have starts from the data's slowest loop (identification/loop_start.py)."""
 
 
 MODEL = BushingModel(

@@ -136,9 +136,11 @@ SEARCH = SearchBox(
     (SearchCoordinate("k0", "stiffness", -3.0, 1.0), SearchCoordinate("k3", "cubic", 0.0, 2.0),
      SearchCoordinate("Ff_max", "force", -3.0, 0.5), SearchCoordinate("x2", "travel", -4.0, 0.5),
      SearchCoordinate("alpha", "exponent", 0.02, 0.98), SearchCoordinate("b", "fractional", -4.0, 3.0,
-                                                                         exponent="alpha")))
+                                                                         exponent="alpha")),
+    loop_start=("k0", "k3", "Ff_max", "x2"))
 """The fit's box: as Berg's for the spring and the friction; alpha within (0.02, 0.98) and b as
-log10(b/(k_ref*tau_ref^alpha)), the element's |K*| at the data's own time scale in units of k_ref."""
+log10(b/(k_ref*tau_ref^alpha)), the element's |K*| at the data's own time scale in units of k_ref;
+the spring and the friction have starts from the data's slowest loop (identification/loop_start.py)."""
 
 
 def _mode_states():

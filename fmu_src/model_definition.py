@@ -95,10 +95,15 @@ class SearchCoordinate:
 class SearchBox:
     """Where the fit searches a model: its ``coordinates`` (one per free parameter), the
     Bouc-Wen weights held at 1 (``unit_weights``: each block's alpha, which the force does not
-    identify apart from its A, beta and gamma) and the parameters held at 0 (``zeros``)."""
+    identify apart from its A, beta and gamma), the parameters held at 0 (``zeros``) and those a
+    slow loop gives a start for (``loop_start``)."""
     coordinates: tuple[SearchCoordinate, ...]
     unit_weights: tuple[str, ...] = ()
     zeros: tuple[str, ...] = ()
+    loop_start: tuple[str, ...] = ()
+    """The parameters of a progressive spring k0*x + k3*x^3 and Berg's friction (Ff_max, x2) that
+    the fit estimates from the data's slowest sine loop for some of its starts
+    (``identification.loop_start``); empty: none."""
 
 
 @dataclass(frozen=True)

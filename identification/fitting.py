@@ -3,7 +3,9 @@
 ``fit(tests, model="proposed", preset="default", seed=0, workers=None, scheduler=None)``:
 
 1. the noise level of every test from its own data (``identification.noise``);
-2. the search (``identification.multistart``): screened Sobol starts, then successive
+2. the search (``identification.multistart``): screened Sobol starts (for a model with a
+   spring and friction, some with those from the data's slowest loop:
+   ``identification.loop_start``), then successive
    halving of bounded trust-region least squares on the misfit (``identification.objectives``),
    every start a task of the engine (``identification.engine``: this process, local worker
    processes, or a Dask cluster; the same seed gives the same bits on each);
@@ -41,6 +43,7 @@ from identification.extras import require
 from identification.fit_result import (FLOOR_FACTOR, MIN_AGREEING, FitNotConvergedWarning, FitResult,  # noqa: F401
                                        RigTestFit, TableFit, agreeing_starts)
 from identification.kdyn_table import KdynTable, load_kdyn_table
+from identification.loop_start import LOOP_STARTS, anchored_coordinates, slow_loop_start
 from identification.measurements import Measurement
 from identification.multistart import Problem, StartRecord, first_records, jacobian, run_stages, screen
 from identification.noise import NoiseEstimate, estimate_noise
@@ -195,12 +198,18 @@ def _search(tests, noise, model, preset, settings, seed, engine, progress, start
     # with a table, the screening and the early stages run its coarser loop (kdyn_table)
     problem = Problem(Objective(tests, noise, model=space.model, table=table, search=table is not None), space)
     ga_evaluations = PAPER_GA["population"] * PAPER_GA["generations"]
-    bars = SearchProgress(progress, settings, ga_evaluations if preset == "paper" else settings.screening)
+    notes = []
+    loop = slow_loop_start(tests, space) if preset != "paper" else None
+    if loop is not None:
+        notes.append(f"note: {LOOP_STARTS} of the screened starts take the {loop.describe()}")
+    bars = SearchProgress(progress, settings, ga_evaluations if preset == "paper" else
+                          settings.screening + (LOOP_STARTS if loop else 0))
     if preset == "paper":
         from identification.multistart import genetic_algorithm
         theta, misfits = genetic_algorithm(problem, engine, seed, bars.screening, **PAPER_GA)
     else:
-        theta, misfits = screen(problem, engine, settings.screening, seed, bars.screening)
+        theta, misfits = screen(problem, engine, settings.screening, seed, bars.screening,
+                                anchored=loop and anchored_coordinates(loop, space), anchored_count=LOOP_STARTS)
     evaluations = ga_evaluations if preset == "paper" else len(misfits)
     n, d = problem.objective.size, len(space.names)
     *early, last = settings.stages
@@ -209,7 +218,6 @@ def _search(tests, noise, model, preset, settings, seed, engine, progress, start
     # start before the last stage, and at the best fit; if that changes them, the last stage
     # runs once more, and a third check only reports (identification.refinement). A lone best
     # start gets company before the check at the best fit (_extend_if_alone).
-    notes = []
     refinement = _check_steps(problem, tests, records, n, d)
     problem = Problem(refinement.objective.with_fit_loop(tests), space)
     records = run_stages(problem, engine, records, [last], bars.stage, first_stage=len(early))

@@ -2,7 +2,8 @@
 trust-region least squares.
 
 1. Screening: ``screening`` points of a scrambled Sobol sequence over the box (seeded),
-   each simulated once; they rank the starts.
+   each simulated once, and for a model with a spring and friction some more whose spring and
+   friction come from the data (``identification.loop_start``); they rank the starts.
 2. Successive halving: the best ``starts`` of them each get scipy's bounded trust-region
    least squares (``least_squares(method="trf")``) for a few evaluations; the best fraction
    continue from where they stopped with a larger budget, and so on (``stages``). The last
@@ -70,11 +71,20 @@ class StartRecord:
     history: list[float] = field(default_factory=list)   # misfit at the end of each stage
 
 
-def screen(problem: Problem, engine, count: int, seed: int, progress=None) -> tuple[np.ndarray, np.ndarray]:
-    """``count`` scrambled Sobol points over the box and their misfits."""
+def screen(problem: Problem, engine, count: int, seed: int, progress=None,
+           anchored: dict[int, float] | None = None, anchored_count: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """``count`` scrambled Sobol points over the box and their misfits; with ``anchored``
+    ({coordinate index: value}, from the data: ``identification.loop_start``), ``anchored_count``
+    more: the first Sobol points with those coordinates set to those values."""
     bounds = problem.space.bounds()
     unit = qmc.Sobol(len(bounds), scramble=True, seed=np.random.default_rng(seed)).random(count)
     theta = bounds[:, 0] + unit * (bounds[:, 1] - bounds[:, 0])
+    if anchored and anchored_count:
+        extra = theta[np.arange(anchored_count) % count].copy()
+        for index, value in anchored.items():
+            extra[:, index] = value
+        theta = np.vstack([theta, extra])
+        count = len(theta)
     blocks = [theta[i:i + 256] for i in range(0, count, 256)]
     misfits = engine.map(_misfit_task, blocks, problem, progress=progress and (lambda n: progress(n * 256)))
     return theta, np.concatenate(misfits)

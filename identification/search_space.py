@@ -79,6 +79,8 @@ class KelvinVoigtFit:
         return self.k * np.asarray(displacement_mm) + self.c * np.asarray(velocity_mm_s)
 
 
+SCALED_KINDS = ("stiffness", "gain", "damping", "exponent", "force", "travel", "cubic")
+"""The kinds whose coordinate is the parameter's value on its own, scaled by the data."""
 _ORDER = ("stiffness", "gain", "damping", "exponent", "force", "travel", "cubic", "time_constant", "slower", "shape",
           "shape_sum", "fractional")
 """The order in which coordinates are mapped to parameters: each kind needs only earlier ones."""
@@ -230,18 +232,8 @@ class SearchSpace:
         theta = []
         for c in self.coordinates:
             value = p[c.parameter]
-            if c.kind in ("stiffness", "gain"):
-                theta.append(math.log10(value / self.k_ref) if value > 0 else -math.inf)
-            elif c.kind == "damping":
-                theta.append(math.log10(value / self.c_ref) if value > 0 else -math.inf)
-            elif c.kind == "exponent":
-                theta.append(value)
-            elif c.kind == "force":
-                theta.append(math.log10(value / self.F_ref) if value > 0 else -math.inf)
-            elif c.kind == "travel":
-                theta.append(math.log10(value / self.x_ref))
-            elif c.kind == "cubic":
-                theta.append(value * self.x_ref ** 2 / self.k_ref)
+            if c.kind in SCALED_KINDS:
+                theta.append(self.coordinate_of(c, value))
             elif c.kind == "time_constant":
                 stiffness = sum(p[name] for name in c.over)
                 theta.append(math.log10(value / stiffness / self.tau_ref) if value > 0 else -math.inf)
@@ -256,6 +248,19 @@ class SearchSpace:
             else:
                 theta.append((p[c.partner] + c.sign * value) / self._shape_scale(p[c.exponent]))
         return np.array(theta)
+
+    def coordinate_of(self, c: SearchCoordinate, value: float) -> float:
+        """The coordinate ``c`` of a parameter value, for the kinds that need no other parameter
+        (SCALED_KINDS); a scale of 0 is -inf."""
+        if c.kind not in SCALED_KINDS:
+            raise ValueError(f"the {c.kind} coordinate of {c.parameter} depends on other parameters")
+        if c.kind == "exponent":
+            return value
+        if c.kind == "cubic":
+            return value * self.x_ref ** 2 / self.k_ref
+        scale = {"stiffness": self.k_ref, "gain": self.k_ref, "damping": self.c_ref, "force": self.F_ref,
+                 "travel": self.x_ref}[c.kind]
+        return math.log10(value / scale) if value > 0 else -math.inf
 
     def inside(self, coordinates: np.ndarray) -> np.ndarray:
         """Whether each row of coordinates lies in the box."""
