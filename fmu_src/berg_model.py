@@ -27,8 +27,8 @@ from __future__ import annotations
 
 import math
 
-from .bushing_params import DAMPING, SPRING, ParameterSpec
-from .integration import NOT_FINITE, OK, friction_force, friction_jump_turn, friction_turn, maxwell_step
+from .bushing_params import SPRING, ParameterSpec
+from .integration import NOT_FINITE, OK, friction_force, friction_jump_turn, friction_turn, maxwell_decay, maxwell_step
 from .model_definition import BushingModel, SearchBox, SearchCoordinate, StateSpec
 
 FRICTION_LIMIT = dict(minimum=0.0, why="a friction force limit is a magnitude", bound_powers=(0, 0))
@@ -94,7 +94,8 @@ def integrate(m, state, x, v, h, max_substeps):
     travel grows by v*h and the Maxwell forces follow exactly; returns (state, 1, status)."""
     k0, k3, limit, half_travel, k1, rate1, k2, rate2 = m
     travel, reversal, direction, f1, f2 = update(m, state, x, v)
-    new = (travel + v * h, reversal, direction, maxwell_step(f1, k1, rate1, v, h), maxwell_step(f2, k2, rate2, v, h))
+    new = (travel + v * h, reversal, direction, maxwell_step(f1, k1, maxwell_decay(rate1, h), v, h),
+           maxwell_step(f2, k2, maxwell_decay(rate2, h), v, h))
     if not (math.isfinite(new[0]) and math.isfinite(new[3]) and math.isfinite(new[4])):
         return new, 1, NOT_FINITE
     return new, 1, OK

@@ -106,15 +106,18 @@ def integration_module() -> str:
 
 def model_source(model, machinery: str, appendix: str = "") -> str:
     """``model``'s module (a ``BushingModel``'s kernel module), its kernels compiled, the step
-    protocol (``integration.step``, compiled as ``step``) and ``appendix``. Its relative imports point at its own package (plain Python: specs, checks)
+    protocol (``integration.step`` and ``step_prepared``, compiled; ``prepare_step`` the
+    machinery's ``unprepared_step`` where the module has none) and ``appendix``. Its relative imports point at its own package (plain Python: specs, checks)
     and at the compiled machinery ``machinery``."""
     module = sys.modules[model.kernel_module]
     source = kernel_source(module)
     source = source.replace("from .integration import", f"from {machinery} import")
     source = source.replace("from .", f"from {module.__package__}.")
     return (source + "\n\n# ---- appended by fmu_src/compiled_kernels.py ----\n" + _NUMBA_IMPORT + _JIT_KERNELS
-            + "\n\n" + inspect.getsource(integration.step)
-            + "\n\nstep = numba.njit(error_model='numpy', cache=True)(step)\n" + appendix)
+            + f"\nif 'prepare_step' not in globals():\n    from {machinery} import unprepared_step as prepare_step\n"
+            + "\n\n" + inspect.getsource(integration.step_prepared) + "\n\n" + inspect.getsource(integration.step)
+            + "\n\nstep_prepared = numba.njit(error_model='numpy', cache=True)(step_prepared)"
+            + "\nstep = numba.njit(error_model='numpy', cache=True)(step)\n" + appendix)
 
 
 def compiled_module(model, appendix: str = "", prefix: str = "bushing") -> types.ModuleType:

@@ -35,7 +35,7 @@ import math
 
 from .berg_model import CUBIC, FRICTION_LIMIT, HALF_TRAVEL
 from .bushing_params import SPRING, ParameterSpec
-from .integration import NOT_FINITE, OK, friction_force, friction_jump_turn, friction_turn, maxwell_step
+from .integration import NOT_FINITE, OK, friction_force, friction_jump_turn, friction_turn, maxwell_decay, maxwell_step
 from .model_definition import BushingModel, SearchBox, SearchCoordinate, StateSpec
 
 MODES = 19
@@ -109,13 +109,24 @@ def jump(m, state, jump_mm):
             *tuple(state[3 + i] + stiffness[i] * jump_mm for i in range(ELEMENTS))), OK
 
 
-def integrate(m, state, x, v, h, max_substeps):
-    """Over the step x + v*t: a reversal at its start if v runs against the motion, the travel
-    grows by v*h and every Maxwell force follows exactly; returns (state, 1, status)."""
+def prepare_step(m, h):
+    """The step's constants: the model's constants and every Maxwell element's decay over h
+    (``integration.maxwell_decay``), which depend on h alone: a caller that steps many times with
+    the same h computes them once (the fit's population loop), instead of ELEMENTS exponentials
+    a step."""
+    rates = m[5]
+    return (m, tuple(maxwell_decay(rates[i], h) for i in range(ELEMENTS)))
+
+
+def integrate(ms, state, x, v, h, max_substeps):
+    """Over the step x + v*t (``ms`` = ``prepare_step(m, h)``): a reversal at its start if v runs
+    against the motion, the travel grows by v*h and every Maxwell force follows exactly; returns
+    (state, 1, status)."""
+    m, decays = ms
     k0, k3, limit, half_travel, stiffness, rates, dashpot = m
     travel, reversal, direction = friction_turn(limit, half_travel, state[0], state[1], state[2], v)
     new = (travel + v * h, reversal, direction,
-           *tuple(maxwell_step(state[3 + i], stiffness[i], rates[i], v, h) for i in range(ELEMENTS)))
+           *tuple(maxwell_step(state[3 + i], stiffness[i], decays[i], v, h) for i in range(ELEMENTS)))
     if not math.isfinite(new[0] + sum(new[3 + i] for i in range(ELEMENTS))):
         return new, 1, NOT_FINITE
     return new, 1, OK

@@ -291,31 +291,51 @@ def friction_turn(limit, half_travel, travel, reversal_force, direction, motion)
     return 0.0, friction_force(limit, half_travel, travel, reversal_force, direction), heading
 
 
-def maxwell_step(force, stiffness, rate, v, h):
-    """The force [N] of a Maxwell element (spring ``stiffness`` [N/mm] in series with a dashpot,
-    ``rate`` = stiffness/damping [1/s]) after h [s] at velocity v [mm/s]: df/dt = k*v - rate*f,
-    solved exactly, f(h) = f*exp(-rate*h) + k*v*(1 - exp(-rate*h))/rate."""
+def maxwell_decay(rate, h):
+    """(E, phi1) of a Maxwell element of ``rate`` = stiffness/damping [1/s] over h [s]:
+    exp(-rate*h) and (1 - E)/(rate*h) (``decay_factors``), what :func:`maxwell_step` takes; a
+    model may compute them once per step size (``prepare_step``)."""
     E, phi1, _ = decay_factors(rate * h)
-    return force * E + stiffness * v * h * phi1
+    return E, phi1
+
+
+def maxwell_step(force, stiffness, decay, v, h):
+    """The force [N] of a Maxwell element (spring ``stiffness`` [N/mm] in series with a dashpot)
+    after h [s] at velocity v [mm/s]: df/dt = k*v - rate*f, solved exactly,
+    f(h) = f*E + k*v*h*phi1 with ``decay`` = (E, phi1) = :func:`maxwell_decay` (rate, h)."""
+    return force * decay[0] + stiffness * v * h * decay[1]
 
 
 # ---------------------------------------------------------------------------- the step
+def unprepared_step(m, h):
+    """``prepare_step`` of a model without constants of its own per step size: its constants."""
+    return m
+
+
 def step(m, state, state_x, x, v, h, max_substeps):
     """One communication step of a model, the protocol every path runs: the displacement is
     x + v*t [mm] for 0 <= t <= h [s]; ``state`` is valid at displacement ``state_x``, so where
     x differs from it the difference is first a displacement jump (``jump``), then the model
-    integrates over the step (``integrate``). Returns (state at x + v*h, substeps, status).
+    integrates over the step (``integrate``, given the step's constants ``prepare_step(m, h)``:
+    what depends on h alone, such as a relaxation mode's decay; ``m`` itself for most models).
+    Returns (state at x + v*h, substeps, status).
 
-    Written once here and bound to each model's own ``jump`` and ``integrate``: in plain Python
-    as ``BushingModel.step`` (a copy of this function whose globals are the model module's),
+    Written once here and bound to each model's own kernels: in plain Python as
+    ``BushingModel.step`` (a copy of this function whose globals are the model module's),
     compiled into each model's generated module (``compiled_kernels.model_source``), and in the
     generated C of the native FMU. It is never called in this module."""
+    return step_prepared(m, prepare_step(m, h), state, state_x, x, v, h, max_substeps)  # noqa: F821
+
+
+def step_prepared(m, ms, state, state_x, x, v, h, max_substeps):
+    """:func:`step` with the step's constants ``ms`` = ``prepare_step(m, h)`` at hand: a caller that
+    steps many times with the same h (the fit's population loop) prepares them once per h."""
     status = OK
     used = 0
     if x != state_x:
         state, status = jump(m, state, x - state_x)  # noqa: F821 (the model's, where bound)
     if status == OK:
-        state, used, status = integrate(m, state, x, v, h, max_substeps)  # noqa: F821
+        state, used, status = integrate(ms, state, x, v, h, max_substeps)  # noqa: F821
     return state, used, status
 
 

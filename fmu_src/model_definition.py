@@ -8,7 +8,8 @@ value's range, its default parameter file, and its equations as five kernels:
     prepare(p) -> constants               p: the parameter values, a tuple in ``specs`` order
     initial_state(constants, x0) -> state     relaxed equilibrium at displacement x0 [mm]
     jump(constants, state, jump_mm) -> (state, status)
-    integrate(constants, state, x, v, h, max_substeps) -> (state, substeps, status)
+    prepare_step(constants, h) -> step constants    (optional) what depends on the step size alone
+    integrate(step constants, state, x, v, h, max_substeps) -> (state, substeps, status)
     force(constants, state, x, v) -> F [N]
     derivatives(constants, state, x, v) -> d(state)/dt
     switches(constants, state, x, v) -> the quantities whose sign selects the equations' branch
@@ -18,7 +19,9 @@ A state is a tuple of floats (the kernels' order; ``states`` names them for the 
 for a model without state). Over a step the displacement is x + v*t [mm] for 0 <= t <= h [s]
 with v [mm/s] constant; ``jump`` is the model's exact response to an instantaneous
 displacement jump, and ``force`` is the force at displacement x with velocity v, positive for
-positive x. ``derivatives``, ``switches`` and ``update`` are for a host that integrates the state itself
+positive x. ``integrate`` takes the step's constants ``prepare_step(constants, h)`` where the module defines
+that kernel (the fractional model's relaxation modes' decay over h), else the constants
+themselves. ``derivatives``, ``switches`` and ``update`` are for a host that integrates the state itself
 (FMI model exchange: the states' derivatives, the event indicators, and the change of the state
 at an event, for a model whose state jumps there: a friction element's reversal). The step protocol that
 every path runs is ``integration.step`` (``BushingModel.step``).
@@ -108,7 +111,7 @@ class SearchBox:
 
 @dataclass(frozen=True)
 class BushingModel:
-    name: str                    # command-line name: proposed, spencer, single_bouc_wen, kelvin_voigt
+    name: str                    # command-line name: proposed, spencer, berg, ... (bushing_models)
     identifier: str              # FMI modelIdentifier and the "model" of parameter files
     title: str
     specs: tuple[ParameterSpec, ...]
@@ -143,9 +146,19 @@ class BushingModel:
 
     def __post_init__(self):
         # integration.step's code with the globals of the module that defines the kernels in use
-        # (a model module, or a compiled copy of it): one definition of the protocol for all
-        namespace = sys.modules[self.kernel_module].__dict__
+        # (a model module, or a compiled copy of it): one definition of the protocol for all.
+        # A module without a prepare_step of its own steps with its constants as they are.
+        namespace = dict(sys.modules[self.kernel_module].__dict__)
+        namespace.setdefault("prepare_step", integration.unprepared_step)
+        namespace["step_prepared"] = types.FunctionType(integration.step_prepared.__code__, namespace, "step_prepared")
         object.__setattr__(self, "step", types.FunctionType(integration.step.__code__, namespace, "step"))
+
+    @property
+    def prepare_step(self) -> Callable:
+        """prepare_step(constants, h) -> the step's constants, which ``integrate`` takes: the model
+        module's own (what depends on the step size alone, computed once per h by a caller that
+        steps many times), else the constants as they are."""
+        return self.step.__globals__["prepare_step"]
 
     @property
     def parameter_names(self) -> tuple[str, ...]:

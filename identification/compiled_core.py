@@ -28,21 +28,26 @@ from identification import steady_state
 _MAX_SUBSTEPS = integration.DEFAULT_MAX_SUBSTEPS
 
 
-def _population_forces(matrix, t, x, v, out_index, out_velocity, max_substeps):
+def _population_forces(matrix, t, x, v, out_index, out_velocity, max_substeps, step_sizes, step_size_index):
     """Forces of every parameter set (rows of ``matrix``) at the communication points
     ``t[out_index]``; the input over [t_k, t_k+1] is x_k + v_k*(t - t_k), as in the FMU, and the
     force at an output point is the model's force with the velocity ``out_velocity`` (the FMU's
-    direct feedthrough of the velocity set at that instant).
+    direct feedthrough of the velocity set at that instant). ``step_sizes``: the distinct
+    t_k+1 - t_k, and ``step_size_index[k]`` which one step k has: the step's constants
+    (``prepare_step``) are made once per candidate and step size (empty: at every step).
 
     Written here, never called here: its source is compiled in each model's generated module
-    (see :func:`_population_appendix`), where ``prepare``, ``step`` (``integration.step``) and
-    ``force`` are that model's compiled kernels and ``_VALUES(row)`` the row's values as the
-    tuple ``prepare`` takes."""
+    (see :func:`_population_appendix`), where ``prepare``, ``prepare_step``, ``step``,
+    ``step_prepared`` (``integration``) and ``force`` are that model's compiled kernels and
+    ``_VALUES(row)`` the row's values as the tuple ``prepare`` takes."""
     count, samples, outputs = matrix.shape[0], t.size, out_index.size
     forces = np.full((count, outputs), np.nan)
+    cached = step_sizes.size > 0
     for i in numba.prange(count):
         row = matrix[i]
         m = prepare(_VALUES(row))
+        prepared = [prepare_step(m, step_sizes[u] if cached else t[1] - t[0])
+                    for u in range(max(step_sizes.size, 1))]
         state_x = x[0]
         state = initial_state(m, state_x)
         j = 0
@@ -53,7 +58,11 @@ def _population_forces(matrix, t, x, v, out_index, out_velocity, max_substeps):
             if j == outputs:
                 break
             h = t[k + 1] - t[k]
-            state, used, status = step(m, state, state_x, x[k], v[k], h, max_substeps)
+            if cached:
+                state, used, status = step_prepared(m, prepared[step_size_index[k]], state, state_x, x[k], v[k], h,
+                                                    max_substeps)
+            else:
+                state, used, status = step(m, state, state_x, x[k], v[k], h, max_substeps)
             if status != _OK:
                 break  # this candidate failed: NaN from here on
             state_x = x[k] + v[k] * h
@@ -107,7 +116,8 @@ def simulate_population_held(parameter_sets, time_s, displacement_mm, velocity_m
     t, x, v = _input_arrays(time_s, displacement_mm, velocity_mm_s)
     out_velocity = np.concatenate([v[:1], v[:-1]])
     return compiled_model(model)._simulate_population(parameter_matrix(parameter_sets, model), t, x, v,
-                                                      np.arange(t.size), out_velocity, max_substeps)
+                                                      np.arange(t.size), out_velocity, max_substeps,
+                                                      *_step_sizes(t))
 
 
 def simulate_population_at(parameter_sets, time_s, displacement_mm, velocity_mm_s, output_index,
@@ -123,7 +133,21 @@ def simulate_population_at(parameter_sets, time_s, displacement_mm, velocity_mm_
             and np.all(np.diff(out_index) > 0) and 0 <= out_index[0] and out_index[-1] < t.size):
         raise ValueError("output_index must be increasing indices into time_s, one output velocity each")
     return compiled_model(model)._simulate_population(parameter_matrix(parameter_sets, model), t, x, v, out_index,
-                                                      out_velocity, max_substeps)
+                                                      out_velocity, max_substeps, *_step_sizes(t))
+
+
+MAX_STEP_SIZES = 256
+"""Distinct step sizes up to which the population loop prepares the step's constants once per size
+(a sampled test has a few dozen, from rounding); beyond, at every step."""
+
+
+def _step_sizes(t):
+    """(distinct step sizes, index of each step's among them) of the communication points t, or
+    two empty arrays where there are more than MAX_STEP_SIZES distinct sizes."""
+    sizes, index = np.unique(np.diff(t), return_inverse=True)
+    if sizes.size > MAX_STEP_SIZES:
+        return np.empty(0), np.empty(0, dtype=np.int64)
+    return np.ascontiguousarray(sizes), np.ascontiguousarray(index, dtype=np.int64)
 
 
 def _input_arrays(time_s, displacement_mm, velocity_mm_s):

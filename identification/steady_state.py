@@ -2,8 +2,9 @@
 
 :func:`_sine_steady_state` is written here and never called here: like the population loop of
 ``compiled_core``, its source is appended to each model's generated module, where ``prepare``,
-``step`` (``fmu_src.integration.step``) and ``force`` are that model's compiled kernels and
-``_VALUES(row)`` a parameter row's values.
+``prepare_step``, ``step_prepared`` (``fmu_src.integration``) and ``force`` are that model's
+compiled kernels and ``_VALUES(row)`` a parameter row's values; the step's constants are made once
+per case, whose steps all have the same size.
 
 Per item (a parameter set and one sine x = P + X*sin(2*pi*f*t)): the bushing starts in relaxed
 equilibrium at the preload P and is driven cycle after cycle, ``steps`` communication steps per
@@ -42,6 +43,7 @@ def _sine_steady_state(matrix, rows, amplitude, frequency, preload, steps, min_c
         X, P = amplitude[i], preload[i]
         omega = 2.0 * math.pi * frequency[i]
         h = 1.0 / (frequency[i] * steps)
+        ms = prepare_step(m, h)
         state_x = P
         state = initial_state(m, P)
         previous_re, previous_im, previous_change = 0.0, 0.0, -1.0
@@ -57,7 +59,7 @@ def _sine_steady_state(matrix, rows, amplitude, frequency, preload, steps, min_c
                 a += f_k * math.cos(phase)
                 b += f_k * math.sin(phase)
                 x_next = P + X * math.sin(2.0 * math.pi * ((k + 1) % steps) / steps)
-                state, used, code = step(m, state, state_x, x_k, (x_next - x_k) / h, h, max_substeps)
+                state, used, code = step_prepared(m, ms, state, state_x, x_k, (x_next - x_k) / h, h, max_substeps)
                 if code != _OK:
                     failed = True
                     break

@@ -130,10 +130,10 @@ def test_the_fractional_elements_realisation_is_b_times_i_omega_to_the_alpha(alp
 def test_a_displacement_jump_is_the_limit_of_a_steep_ramp(model, jump_mm):
     bushing = MODELS[model]
     constants = bushing.constants(defaults(model))
-    state, _, _ = bushing.integrate(constants, bushing.initial_state(constants, 0.0), 0.0, 5.0, 0.1, 100)
+    state, _, _ = bushing.step(constants, bushing.initial_state(constants, 0.0), 0.0, 0.0, 5.0, 0.1, 100)
     jumped, status = bushing.jump(constants, state, jump_mm)
     ramp = 1e-11     # the fastest relaxation mode (1e5 1/s) moves by 1e-6 of itself meanwhile
-    ramped, _, _ = bushing.integrate(constants, state, 0.5, jump_mm / ramp, ramp, 100)
+    ramped, _, _ = bushing.step(constants, state, 0.5, 0.5, jump_mm / ramp, ramp, 100)
     assert status == integration.OK
     x = 0.5 + jump_mm
     assert bushing.force(constants, jumped, x, 0.0) == pytest.approx(bushing.force(constants, ramped, x, 0.0),
@@ -177,3 +177,37 @@ def test_parameters_outside_their_range_are_refused_with_name_value_unit_and_ran
     params = dict(defaults(model), **{name: value})
     with pytest.raises(ParameterError, match=re.escape(fragment)):
         MODELS[model].check(params)
+
+
+ROTATIONAL = {"berg": {"k0": 3e5, "k3": 1e6, "Ff_max": 2e3, "x2": 0.004, "k1": 1e5, "c1": 1e4, "k2": 5e4, "c2": 100.0},
+              "fractional": {"k0": 3e5, "k3": 1e6, "Ff_max": 2e3, "x2": 0.004, "b": 4e4, "alpha": 0.3}}
+"""Illustrative torsion sets (N.mm/rad, N.mm/rad^3, N.mm, rad, N.mm.s^alpha/rad ...)."""
+
+
+def test_the_filled_rubber_models_are_axes_of_the_six_axis_fmu_in_both_kinds(tmp_path):
+    from fmpy import simulate_fmu
+    from fmu_src.axes import SIX_AXES
+    from fmu_src.parameter_files import save_six_axis
+    axes = {"x": ("berg", defaults("berg")), "y": ("fractional", defaults("fractional")),
+            "z": ("kelvin_voigt", {"k": 900.0, "c": 2.0, "preload": 0.0}), "rx": ("berg", ROTATIONAL["berg"]),
+            "ry": ("fractional", ROTATIONAL["fractional"]), "rz": ("fractional", ROTATIONAL["fractional"])}
+    params = save_six_axis(tmp_path / "six.json", axes)
+    fmus = {"pythonfmu": build_fmu.build_fmu(params, tmp_path / "py", model="six_axis"),
+            "native": build_fmu.build_native_fmu(params, tmp_path / "native", model="six_axis").path}
+    t = sample_times(0.3, 1000.0)
+    columns, expected = {}, {}
+    for i, axis in enumerate(SIX_AXES):
+        amplitude = 0.02 if axis.rotational else 1.5e-3       # rad or m
+        x = amplitude * np.sin(2 * math.pi * (4.0 + 3.0 * i) * t + 0.3 * i)
+        v = np.append(np.diff(x) / np.diff(t), 0.0)           # the secant path: no turning point is a jump
+        columns[axis.displacement], columns[axis.velocity] = x, v
+        model, p = axes[axis.name]
+        scale = 1.0 if axis.rotational else 1000.0            # the kernels' rad, or mm
+        expected[axis.output] = simulate_model_held(model, p, t, x * scale, v * scale) * (1e-3 if axis.rotational else 1.0)
+    table = np.array(list(zip(t, *columns.values())), dtype=[("time", float)] + [(k, float) for k in columns])
+    for kind, fmu in fmus.items():
+        result = simulate_fmu(str(fmu), stop_time=t[-1], step_size=1e-3, output_interval=1e-3, input=table,
+                              output=list(expected))
+        for output, values in expected.items():
+            np.testing.assert_allclose(result[output][:t.size], values, rtol=1e-12,
+                                       atol=1e-12 * np.max(np.abs(values)), err_msg=f"{kind} {output}")
