@@ -4,11 +4,13 @@
 Writes ``DIR/<identifier>.fmu`` (FMI 2.0 co-simulation, pythonfmu; with ``--native``: compiled C,
 FMI 2.0 or 3.0, co-simulation and model exchange, see ``fmu_src/native``) of the model NAME
 (``proposed``, the default: ``BoucWenBushing.fmu``; ``spencer``: ``SpencerBushing``;
-``single_bouc_wen``: ``SingleBoucWenBushing``; ``kelvin_voigt``: ``KelvinVoigtBushing``; ``six_axis``:
-``SixAxisBushing``, six uncoupled axes each one of the four, see ``fmu_src/axes.py``) whose
-parameter start values are the set in FILE, project JSON or SSP 1.0 ``.ssv`` (default: the
-paper's Table 5 for the proposed model, the baselines' fits to the synthetic Table 5 tests
-in ``data/`` for the others, ``data/params_six_axis_illustrative.json`` for six axes).
+``single_bouc_wen``: ``SingleBoucWenBushing``; ``berg``: ``BergBushing``; ``fractional``:
+``FractionalBushing``; ``kelvin_voigt``: ``KelvinVoigtBushing``; every model of
+``fmu_src/bushing_models``; ``six_axis``: ``SixAxisBushing``, six uncoupled axes each one of the
+models, see ``fmu_src/axes.py``) whose parameter start values are the set in FILE, project JSON
+or SSP 1.0 ``.ssv`` (default: the model's file in ``data/``: the paper's Table 5 for the proposed
+model, the baselines' fits to the synthetic Table 5 tests, an illustrative filled rubber for Berg's
+and the fractional model, ``data/params_six_axis_illustrative.json`` for six axes).
 
 What the build adds to pythonfmu's output, and why:
 - Unique module names. The slave module is packed as ``boucwen_bushing_<hash>.py`` with its

@@ -3,7 +3,7 @@
 A one-axis FMU has one axis: ports ``x`` [m], ``v`` [m/s], ``F`` [N], parameters named as the
 model names them. The six-axis FMU (``SixAxisBushing``) joins two markers I and J of a
 multibody model: three translational axes x, y, z and three rotational axes rx, ry, rz, all in
-the axes of marker J, each one of the four models and uncoupled from the others (the diagonal
+the axes of marker J, each one of the models and uncoupled from the others (the diagonal
 bushing of MSC Adams' BUSHING, Project Chrono's ``ChLoadBodyBodyBushing*``, Simbody's
 ``LinearBushing``). Its parameters and locals are named ``<axis>.<name>`` (``x.k0``, ``rz.c``).
 

@@ -32,10 +32,11 @@ The modules, in the order of the workflow:
   ``steady_state`` (the models' kernels, compiled per model), ``refinement`` (finer steps where
   needed);
 - fitting: ``fitting`` (``fit``), ``fit_result`` (what it returns), ``presets``, ``search_space``
-  (the box), ``objectives`` (the misfit), ``multistart`` (screening and least-squares stages),
+  (the box), ``loop_start`` (starts from a slow loop), ``objectives`` (the misfit), ``multistart``
+  (screening and least-squares stages),
   ``ensemble`` (how sure), ``engine`` (where tasks run), ``progress``, ``fleet`` (many bushings);
 - analysis: ``predict`` (force and band), ``dynamic_stiffness`` (data sheet), ``design`` (the next
-  test), ``sensitivity``, ``report`` and ``compare`` (the paper's §5 tables and study),
+  test), ``sensitivity``, ``report`` (the paper's §5 tables), ``compare`` (fit every model, recommend one),
   ``six_axis`` (one file from six fits), ``plots``;
 - the command line: ``cli`` (arguments), ``commands`` (what each does), ``extras``, ``errors``.
 """

@@ -69,8 +69,8 @@ def main(argv: list[str] | None = None) -> int:
 
     fit_parser = subcommands.add_parser("fit", help="fit a model's parameters to rig tests, with convergence evidence")
     fit_parser.add_argument("--model", choices=MODEL_CHOICES, metavar="MODEL",
-                            help="proposed (the paper's 16 parameters, default), spencer, single_bouc_wen or "
-                                 "kelvin_voigt (linear least squares); default: the manifest's, else proposed")
+                            help=f"one of {', '.join(MODEL_NAMES)} (kelvin_voigt by linear least squares; "
+                                 "`compare` recommends one); default: the manifest's, else proposed, the paper's")
     _add_training_arguments(fit_parser)
     _add_search_arguments(fit_parser)
     fit_parser.add_argument("--out", type=Path, required=True, help="parameter file to write (JSON)")
@@ -98,11 +98,16 @@ def main(argv: list[str] | None = None) -> int:
     report_parser.add_argument("--plots", type=Path, help="directory for force-time/force-displacement PNGs")
 
     compare_parser = subcommands.add_parser(
-        "compare", help="fit several models on training tests and compare them on validation files")
+        "compare", help="fit several models on training tests, weigh them on held-out files and a table, and "
+                        "recommend one")
     _add_training_arguments(compare_parser)
     _add_search_arguments(compare_parser)
     compare_parser.add_argument("--validate", action="append", type=Path, default=[], metavar="FILE",
-                                help="validation test CSV; repeatable (default: the training files)")
+                                help="validation test CSV, held out of the fits; repeatable (default: the training "
+                                     "files, shown but not held out)")
+    compare_parser.add_argument("--validate-kdyn", type=Path, metavar="TABLE",
+                                help="dynamic-stiffness table held out of the fits (CSV amplitude_mm,frequency_hz,"
+                                     "kdyn_N_per_mm,loss_angle_deg[,preload_mm][,weight]): each model predicts it")
     compare_parser.add_argument("--models", default=",".join(MODEL_NAMES),
                                 help=f"comma-separated models (default: {','.join(MODEL_NAMES)})")
     compare_parser.add_argument("--out", type=Path, required=True,

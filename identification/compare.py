@@ -1,38 +1,131 @@
-"""The comparison study (paper §3.1, §4.3, Figs. 15-17): fit several models on the same
-training tests, compare them on validation files.
+"""Choosing the model: fit several models on the same training tests, weigh them on what the user
+has, and recommend one (the paper's comparison study, §3.1, §4.3, Figs. 15-17, made a decision).
+
+Each model is fitted (``fitting.fit``) and assessed on:
+
+- training: its NRMSE against each test's noise level (at the floor: every test within
+  ``fit_result.FLOOR_FACTOR`` of it), chi^2/n, and Schwarz's information criterion
+  BIC = chi^2 + d*ln(n) over its d free parameters;
+- held out: the validation files that are not training files (NRMSE and the paper's eq. 10), and
+  a dynamic-stiffness table (|K*| and loss-angle errors per amplitude and frequency, and their
+  rms in units of the table's uncertainty, ``kdyn_table``).
+
+The recommendation (:func:`recommend`) is the simplest model that reaches the noise floor and
+predicts best: among the models at the floor (all models, if none is), those whose held-out
+errors are within ``PREDICTION_TOLERANCE`` of the best on each kind of held-out data (all of
+them, if none is held out); of those the one with the fewest free parameters, then the lowest
+BIC.
 
 Writes into the output directory: ``params_<model>.json`` per model (with provenance),
-``comparison.csv`` (NRMSE and the paper's eq. 10 error per validation file and model) and
-one PNG per validation file overlaying the measured and predicted force over time and the
-force-displacement loops. Prints the table.
+``comparison.csv`` (one row per model: everything above and whether it is the recommendation),
+``validation.csv`` (NRMSE and eq. 10 per file and model), ``kdyn_errors.csv`` (per row of the
+table and model), one PNG per validation file (force over time and force-displacement loops) and
+one for the table. Prints the tables; the last line is ``recommended: <model>``.
 """
 from __future__ import annotations
 
 import csv
+import math
 import sys
 import warnings
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Sequence
 
+import numpy as np
+
 from fmu_src.bushing_models import get_model
 from identification.engine import make_engine
-from identification.fitting import FitNotConvergedWarning, fit
+from identification.fit_result import FLOOR_FACTOR, FitResult, TableFit
+from identification.fitting import FitNotConvergedWarning, fit, table_fit
+from identification.kdyn_table import KDYN_UNCERTAINTY, LOSS_ANGLE_UNCERTAINTY_DEG, KdynTable
 from identification.measurements import load_measurement
 from identification.objectives import nrmse, rms_level_error
+from identification.plots import plot_comparison, plot_table_comparison
 from identification.rig_tests import RigTest
-from identification.plots import plot_comparison
 from identification.simulate import simulate
+
+PREDICTION_TOLERANCE = 0.1
+"""A model predicts as well as the best if its held-out error is at most this much larger (10 %)."""
+
+
+@dataclass
+class Assessment:
+    """One model on the comparison's data."""
+    model: str
+    free_parameters: int
+    residuals: int
+    misfit: float                          # chi^2/n over the training tests
+    training_ratio: float                  # the largest NRMSE over the noise level of a training test
+    at_floor: bool
+    converged: bool
+    seconds: float
+    validation: dict[str, tuple[float, float]] = field(default_factory=dict)   # held-out file: (NRMSE, eq. 10)
+    table: TableFit | None = None          # the held-out table at the fitted parameters
+
+    @property
+    def information_criterion(self) -> float:
+        """BIC = chi^2 + d*ln(n) (``FitResult.information_criterion``)."""
+        return self.residuals * self.misfit + self.free_parameters * math.log(max(self.residuals, 1))
+
+    @property
+    def validation_error(self) -> float | None:
+        """The mean NRMSE over the held-out files (None without any)."""
+        return float(np.mean([error for error, _ in self.validation.values()])) if self.validation else None
+
+    @property
+    def table_error(self) -> float | None:
+        """The held-out table's rms error in units of its uncertainty (None without a table)."""
+        return self.table.ratio if self.table is not None else None
+
+    @classmethod
+    def of(cls, result: FitResult) -> "Assessment":
+        return cls(result.model, result.free_parameters, result.residuals, result.misfit,
+                   max((t.ratio for t in result.tests), default=math.nan), result.at_floor, result.converged,
+                   result.seconds)
+
+
+@dataclass(frozen=True)
+class Recommendation:
+    model: str
+    reason: str
+
+
+def recommend(assessments: Sequence[Assessment], tolerance: float = PREDICTION_TOLERANCE) -> Recommendation:
+    """The simplest model that reaches the floor and predicts best (module docstring), and why."""
+    pool = [a for a in assessments if a.at_floor]
+    why = [f"{len(pool)} of {len(assessments)} at the noise floor"]
+    if not pool:
+        pool = list(assessments)
+        why = ["no model reaches the noise floor"]
+    for name, error in (("held-out files", lambda a: a.validation_error), ("table", lambda a: a.table_error)):
+        known = [a for a in pool if error(a) is not None and math.isfinite(error(a))]
+        if not known:
+            continue
+        best = min(error(a) for a in known)
+        close = [a for a in known if error(a) <= (1.0 + tolerance) * best]
+        why.append(f"{len(close)} predict the {name} within {tolerance:.0%} of the best")
+        pool = close
+    chosen = min(pool, key=lambda a: (a.free_parameters, a.information_criterion))
+    simplest = [a.model for a in pool if a.free_parameters == chosen.free_parameters]
+    why.append(f"{chosen.model} has the fewest free parameters of those ({chosen.free_parameters})"
+               + (f" and the lowest BIC among {', '.join(simplest)}" if len(simplest) > 1 else ""))
+    return Recommendation(chosen.model, "; ".join(why))
 
 
 def compare_models(models: Sequence[str], tests: Sequence[RigTest], validation_files: Sequence[Path], out_dir: Path,
                    preset: str = "default", seed: int = 0, workers: int | None = None, scheduler=None,
-                   screening: int | None = None, starts: int | None = None, ensemble: bool = True) -> dict:
-    """Fit every model on ``tests``, evaluate it on every validation file; returns
-    ``{"parameters": {model: params}, "errors": {(file, model): (nrmse, eq10)}}``."""
+                   screening: int | None = None, starts: int | None = None, ensemble: bool = True,
+                   table: KdynTable | None = None) -> dict:
+    """Fit every model on ``tests``, assess it on the training tests, on the ``validation_files``
+    and on the held-out dynamic-stiffness ``table``, write the files (module docstring) and
+    recommend one. Returns ``{"parameters": {model: params}, "errors": {(file, model): (nrmse,
+    eq10)}, "assessments": [Assessment], "recommendation": Recommendation}``."""
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     validation = [load_measurement(path) for path in validation_files]
-    parameters = {}
+    training_names = {Path(t.measurement.source).name for t in tests}
+    parameters, assessments = {}, []
     with make_engine(workers, scheduler) as engine, warnings.catch_warnings():
         warnings.simplefilter("ignore", FitNotConvergedWarning)   # reported below, per model
         for model in models:
@@ -41,6 +134,10 @@ def compare_models(models: Sequence[str], tests: Sequence[RigTest], validation_f
                          starts=starts, ensemble=ensemble)
             result.save(out_dir / f"params_{model}.json", data=[t.measurement.source for t in tests])
             parameters[model] = result.parameters.parameters
+            assessment = Assessment.of(result)
+            if table is not None:
+                assessment.table = table_fit(table, result.parameters)
+            assessments.append(assessment)
             state = "converged" if result.converged else f"WARNING: {result.warning}"
             print(f"  misfit {result.misfit:.4f} in {result.seconds:.0f} s; {state}", file=sys.stderr)
 
@@ -50,26 +147,103 @@ def compare_models(models: Sequence[str], tests: Sequence[RigTest], validation_f
         predictions = {model: simulate(parameters[model], m.time_s, m.displacement_mm, m.measured_velocity_mm_s,
                                        model=model)
                        for model in models}
-        for model, predicted in predictions.items():
-            errors[name, model] = (nrmse(predicted, m.force_N), rms_level_error(predicted, m.force_N))
+        for assessment in assessments:
+            predicted = predictions[assessment.model]
+            errors[name, assessment.model] = (nrmse(predicted, m.force_N), rms_level_error(predicted, m.force_N))
+            if name not in training_names:
+                assessment.validation[name] = errors[name, assessment.model]
         plot_comparison(m, predictions, out_dir / f"compare_{Path(m.source).stem}.png")
+    if table is not None:
+        plot_table_comparison(table, {a.model: a.table for a in assessments}, out_dir / f"compare_{table.name}.png")
+    recommendation = recommend(assessments)
 
-    print(format_comparison(errors, models, [Path(m.source).name for m in validation]))
+    print(format_assessments(assessments, recommendation))
+    if validation:
+        print(format_comparison(errors, models, [Path(m.source).name for m in validation], training_names))
+    if table is not None:
+        print(format_table_errors(table, assessments))
+    _write_csvs(out_dir, assessments, recommendation, errors, table)
+    print(f"wrote {out_dir}/comparison.csv, validation.csv{', kdyn_errors.csv' if table is not None else ''}, "
+          "params_<model>.json and compare_*.png", file=sys.stderr)
+    print(f"why: {recommendation.reason}")
+    print(f"recommended: {recommendation.model}")
+    return {"parameters": parameters, "errors": errors, "assessments": assessments, "recommendation": recommendation}
+
+
+def format_assessments(assessments: Sequence[Assessment], recommendation: Recommendation) -> str:
+    """One row per model: parameters, training against the noise, BIC, held-out errors."""
+    best_bic = min(a.information_criterion for a in assessments)
+    lines = [f"{'model':17s} {'params':>6s} {'worst NRMSE/noise':>17s} {'floor':>5s} {'chi2/n':>9s} {'dBIC':>9s} "
+             f"{'held-out NRMSE':>14s} {'table err/unc':>13s}"]
+    for a in assessments:
+        held = f"{a.validation_error:.2%}" if a.validation_error is not None else "-"
+        table = f"{a.table_error:.2f}" if a.table_error is not None else "-"
+        mark = "  <- recommended" if a.model == recommendation.model else ""
+        lines.append(f"{a.model:17s} {a.free_parameters:6d} {a.training_ratio:17.2f} {'yes' if a.at_floor else 'NO':>5s} "
+                     f"{a.misfit:9.3f} {a.information_criterion - best_bic:9.1f} {held:>14s} {table:>13s}{mark}")
+    lines.append(f"floor: every training test's NRMSE within {FLOOR_FACTOR}x its noise level; dBIC: BIC = chi^2 + "
+                 "d*ln(n) over the best; held-out NRMSE: the mean over the validation files that are not training "
+                 f"files; table err/unc: rms error in units of {KDYN_UNCERTAINTY:.0%} on |K*| and "
+                 f"{LOSS_ANGLE_UNCERTAINTY_DEG:g} deg")
+    return "\n".join(lines)
+
+
+def format_comparison(errors: dict, models: Sequence[str], files: Sequence[str], training: set[str] = frozenset()) -> str:
+    """NRMSE per file (rows) and model (columns), the eq. 10 error in brackets."""
+    width = max(len(name) for name in files) + 13
+    lines = [f"{'file':{width}s}" + "".join(f"{model:>22s}" for model in models)]
+    for name in files:
+        cells = "".join(f"{errors[name, model][0]:>12.2%} ({errors[name, model][1]:+6.1%})" for model in models)
+        lines.append(f"{name + (' (training)' if name in training else ''):{width}s}{cells}")
+    lines.append("NRMSE = rms(F_pre - F_exp)/rms(F_exp); (eq. 10) = (rms F_exp - rms F_pre)/rms F_exp")
+    return "\n".join(lines)
+
+
+def format_table_errors(table: KdynTable, assessments: Sequence[Assessment]) -> str:
+    """The largest and rms |K*| and loss-angle errors of each model on the held-out table."""
+    lines = [f"held-out table {table.name} ({int(np.count_nonzero(table.weight > 0))} rows): "
+             "|K*| error largest / rms, loss angle error largest / rms"]
+    for a in assessments:
+        kdyn, angle = np.abs(a.table.kdyn_errors), np.abs(a.table.angle_errors_deg)
+        lines.append(f"  {a.model:17s} {np.max(kdyn):7.2%} / {np.sqrt(np.mean(kdyn ** 2)):6.2%}   "
+                     f"{np.max(angle):6.2f} / {np.sqrt(np.mean(angle ** 2)):5.2f} deg")
+    return "\n".join(lines)
+
+
+def _write_csvs(out_dir: Path, assessments, recommendation: Recommendation, errors: dict, table) -> None:
+    best_bic = min(a.information_criterion for a in assessments)
     with open(out_dir / "comparison.csv", "w", newline="") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(["model", "free_parameters", "worst_nrmse_over_noise", "at_floor", "converged",
+                         "misfit_chi2_per_residual", "residuals", "bic", "delta_bic", "held_out_mean_nrmse",
+                         "table_error_over_uncertainty", "table_largest_kdyn_error", "table_largest_loss_angle_error_deg",
+                         "seconds", "recommended"])
+        for a in assessments:
+            kdyn = np.max(np.abs(a.table.kdyn_errors)) if a.table is not None else None
+            angle = np.max(np.abs(a.table.angle_errors_deg)) if a.table is not None else None
+            writer.writerow([a.model, a.free_parameters, _cell(a.training_ratio), a.at_floor, a.converged,
+                             _cell(a.misfit), a.residuals, _cell(a.information_criterion),
+                             _cell(a.information_criterion - best_bic), _cell(a.validation_error),
+                             _cell(a.table_error), _cell(kdyn), _cell(angle), f"{a.seconds:.1f}",
+                             a.model == recommendation.model])
+    with open(out_dir / "validation.csv", "w", newline="") as handle:
         writer = csv.writer(handle)
         writer.writerow(["file", "model", "nrmse", "eq10_rms_level_error"])
         for (name, model), (error, eq10) in errors.items():
             writer.writerow([name, model, f"{error:.6g}", f"{eq10:.6g}"])
-    print(f"wrote {out_dir}/comparison.csv, params_<model>.json and compare_*.png", file=sys.stderr)
-    return {"parameters": parameters, "errors": errors}
+    if table is not None:
+        kept = table.weight > 0
+        with open(out_dir / "kdyn_errors.csv", "w", newline="") as handle:
+            writer = csv.writer(handle)
+            writer.writerow(["model", "amplitude_mm", "frequency_hz", "preload_mm", "kdyn_N_per_mm", "loss_angle_deg",
+                             "kdyn_relative_error", "loss_angle_error_deg"])
+            for a in assessments:
+                for row, (X, f, P, kdyn, angle) in enumerate(zip(table.amplitude_mm[kept], table.frequency_hz[kept],
+                                                                 table.preload_mm[kept], table.kdyn_N_per_mm[kept],
+                                                                 table.loss_angle_deg[kept])):
+                    writer.writerow([a.model, f"{X:g}", f"{f:g}", f"{P:g}", f"{kdyn:.6g}", f"{angle:.6g}",
+                                     f"{a.table.kdyn_errors[row]:.6g}", f"{a.table.angle_errors_deg[row]:.6g}"])
 
 
-def format_comparison(errors: dict, models: Sequence[str], files: Sequence[str]) -> str:
-    """NRMSE per file (rows) and model (columns), the eq. 10 error in brackets."""
-    width = max(len(name) for name in files) + 2
-    lines = [f"{'file':{width}s}" + "".join(f"{model:>22s}" for model in models)]
-    for name in files:
-        cells = "".join(f"{errors[name, model][0]:>12.2%} ({errors[name, model][1]:+6.1%})" for model in models)
-        lines.append(f"{name:{width}s}{cells}")
-    lines.append("NRMSE = rms(F_pre - F_exp)/rms(F_exp); (eq. 10) = (rms F_exp - rms F_pre)/rms F_exp")
-    return "\n".join(lines)
+def _cell(value) -> str:
+    return "" if value is None else f"{value:.6g}"

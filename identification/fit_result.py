@@ -11,6 +11,8 @@ Units: forces in N, NRMSE and noise levels as fractions of the rms force, misfit
 """
 from __future__ import annotations
 
+import math
+
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Sequence
@@ -150,6 +152,18 @@ class FitResult:
     added_starts: int = 0                  # starts that ran the last stage because one alone reached the best
     agreed_before_added: int | None = None  # the agreement count when the last stage ended, before any added start
     ensemble_sampled: bool = True          # False: fit(ensemble=False), the ensemble is the best fit alone
+    residuals: int = 0                     # n, the residuals chi^2/n is over (0: not recorded)
+
+    @property
+    def free_parameters(self) -> int:
+        """The parameters the fit chose: its search box's coordinates (Kelvin-Voigt: k and c)."""
+        return len(self.space.names) if self.space is not None else 2
+
+    @property
+    def information_criterion(self) -> float:
+        """Schwarz's BIC with the noise levels known: chi^2 + d*ln(n), chi^2 = n*misfit, d the free
+        parameters; lower is better, and a model must lower chi^2 by ln(n) per parameter it adds."""
+        return self.residuals * self.misfit + self.free_parameters * math.log(max(self.residuals, 1))
 
     @property
     def model(self) -> str:

@@ -269,8 +269,8 @@ def _search(tests, noise, model, preset, settings, seed, engine, progress, start
     result = FitResult(parameters, float(best.misfit), _test_fits(tests, noise, parameters, steps), records, threshold,
                        ensemble, ident, preset, seed, evaluations, time.perf_counter() - started, engine.description,
                        space, final_starts=len(final), sampler=sampler, notes=notes, steps_per_sample=steps,
-                       table=_table_fit(table, parameters), added_starts=added, agreed_before_added=agreeing,
-                       ensemble_sampled=sample_ensemble)
+                       table=table_fit(table, parameters), added_starts=added, agreed_before_added=agreeing,
+                       ensemble_sampled=sample_ensemble, residuals=n)
     result.parameters.provenance = result.provenance()
     return result
 
@@ -300,7 +300,8 @@ def _fit_kelvin_voigt(tests, noise, started, table=None) -> FitResult:
     parameters = ParameterSet(bushing, values)
     misfit = float(objective(parameter_matrix([values], bushing.name))[0])
     result = FitResult(parameters, misfit, _test_fits(tests, noise, parameters), [], 0.0, [values], None,
-                       "linear", 0, 1, time.perf_counter() - started, table=_table_fit(table, parameters))
+                       "linear", 0, 1, time.perf_counter() - started, table=table_fit(table, parameters),
+                       residuals=objective.size)
     result.parameters.provenance = result.provenance()
     return result
 
@@ -344,9 +345,10 @@ def _test_fits(tests, noise, parameters: ParameterSet, steps=None) -> list[RigTe
     return fits
 
 
-def _table_fit(table: KdynTable | None, parameters: ParameterSet) -> TableFit | None:
+def table_fit(table: KdynTable | None, parameters: ParameterSet) -> TableFit | None:
     """The table's rows (weight > 0) against the converged characterisation of ``parameters``,
-    and how far the fit's fixed-cycle loop is from it (its largest relative |K*| difference)."""
+    and how far the fit's fixed-cycle loop is from it (its largest relative |K*| difference):
+    a fitted table, or one held out (``compare``)."""
     if table is None:
         return None
     from identification.dynamic_stiffness import (MAX_CYCLES, STEPS_PER_CYCLE, TOLERANCE, CharacterisationWarning,

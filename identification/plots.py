@@ -139,3 +139,39 @@ def plot_dynamic_stiffness(table, folder: Path, measured=None) -> list[Path]:
     figure.tight_layout()
     written.append(_save(figure, folder / "steady_state_loops.png"))
     return written
+
+
+def plot_table_comparison(table, fits: dict, path: Path) -> Path:
+    """A held-out dynamic-stiffness table (``kdyn_table.KdynTable``, crosses) and each model's
+    prediction of its rows (lines in the model's style; ``fits``: {model: ``fit_result.TableFit``}):
+    |K*| (top) and the loss angle (bottom) against frequency, one column per amplitude."""
+    plt = _pyplot()
+    kept = table.weight > 0
+    amplitudes = np.unique(table.amplitude_mm[kept])
+    figure, axes = plt.subplots(2, amplitudes.size, figsize=(3.2 * amplitudes.size + 1.5, 6.2), squeeze=False,
+                                sharex=True)
+    amplitude, frequency = table.amplitude_mm[kept], table.frequency_hz[kept]
+    measured = {"kdyn": table.kdyn_N_per_mm[kept], "angle": table.loss_angle_deg[kept]}
+    for column, X in enumerate(amplitudes):
+        rows = np.flatnonzero(amplitude == X)
+        rows = rows[np.argsort(frequency[rows])]
+        top, bottom = axes[0, column], axes[1, column]
+        top.plot(frequency[rows], measured["kdyn"][rows], "kx", ms=7, mew=1.5, label="table")
+        bottom.plot(frequency[rows], measured["angle"][rows], "kx", ms=7, mew=1.5)
+        for model, fitted in fits.items():
+            color, style = get_model(model).plot_style
+            kdyn = measured["kdyn"][rows] * (1.0 + fitted.kdyn_errors[rows])
+            angle = measured["angle"][rows] + fitted.angle_errors_deg[rows]
+            top.plot(frequency[rows], kdyn, color=color, ls=style, lw=1.3, label=model)
+            bottom.plot(frequency[rows], angle, color=color, ls=style, lw=1.3)
+        top.set_title(f"{X:g} mm")
+        bottom.set_xlabel("frequency [Hz]")
+        for a in (top, bottom):
+            a.set_xscale("log")
+            a.grid(alpha=0.3, which="both")
+    axes[0, 0].set_ylabel("dynamic stiffness |K*| [N/mm]")
+    axes[1, 0].set_ylabel("loss angle [deg]")
+    axes[0, 0].legend(fontsize=7)
+    figure.suptitle(f"{table.name}: the table (held out) and each model's prediction", fontsize=10)
+    figure.tight_layout()
+    return _save(figure, path)

@@ -78,3 +78,18 @@ def test_the_default_preset_reaches_the_noise_floor_on_the_models_own_equations(
     ratios = [t.ratio for t in result.tests]
     assert max(ratios) <= 1.25, (result.summary(), ratios)
     assert any("slow loop" in note for note in result.notes)
+
+
+@pytest.mark.slow
+@pytest.mark.optimizer
+def test_a_data_sheet_alone_gives_the_fractional_models_parameters():
+    # the truth's own data sheet (no noise; data/kdyn_synthetic_filled_rubber.csv): the fit matches
+    # it to the table's uncertainty and lands near the truth that made it
+    from identification.kdyn_table import load_kdyn_table
+    table = load_kdyn_table(Path(__file__).resolve().parents[1] / "data" / "kdyn_synthetic_filled_rubber.csv")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        result = fit([], model="fractional", kdyn=table, seed=0, progress=False, ensemble=False)
+    assert result.table.at_floor, result.summary()
+    fitted = result.parameters.parameters
+    assert fitted["alpha"] == pytest.approx(0.22, abs=0.02) and fitted["k0"] == pytest.approx(500.0, rel=0.05)

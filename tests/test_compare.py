@@ -1,0 +1,78 @@
+"""Choosing the model (identification.compare): the recommendation rule on hand-made assessments,
+and `compare` through the command line on the synthetic filled-rubber bushing."""
+import csv
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from identification.__main__ import main
+from identification.compare import Assessment, recommend
+from identification.fit_result import TableFit
+
+DATA = Path(__file__).resolve().parents[1] / "data"
+FILLED = DATA / "synthetic_filled_rubber"
+
+
+def assessment(model, parameters, ratio, held_out=None, table=None, misfit=1.0, residuals=1000):
+    a = Assessment(model, parameters, residuals, misfit, ratio, ratio <= 1.25, ratio <= 1.25, 1.0)
+    if held_out is not None:
+        a.validation = {"held_out.csv": (held_out, 0.0)}
+    if table is not None:    # a table error of `table` uncertainties: |K*| off by table %
+        a.table = TableFit("table.csv", np.array([table * 0.01]), np.array([0.0]), np.array([1.0]), 0.0)
+    return a
+
+
+def test_the_simplest_model_at_the_floor_that_predicts_within_ten_percent_of_the_best_is_recommended():
+    choice = recommend([assessment("many", 14, 1.0, held_out=0.0100), assessment("few", 6, 1.1, held_out=0.0108),
+                        assessment("linear", 2, 40.0, held_out=0.2)])
+    assert choice.model == "few"
+    assert "2 of 3 at the noise floor" in choice.reason and "fewest free parameters" in choice.reason
+
+
+def test_a_simpler_model_that_predicts_worse_by_more_than_ten_percent_is_not_recommended():
+    choice = recommend([assessment("many", 14, 1.0, held_out=0.0100), assessment("few", 6, 1.1, held_out=0.0120)])
+    assert choice.model == "many"
+
+
+def test_every_kind_of_held_out_data_must_be_predicted_well():
+    choice = recommend([assessment("a", 6, 1.0, held_out=0.010, table=5.0),
+                        assessment("b", 8, 1.0, held_out=0.0105, table=0.5)])
+    assert choice.model == "b"
+
+
+def test_without_a_model_at_the_floor_the_best_predictor_is_recommended_and_the_reason_says_so():
+    choice = recommend([assessment("a", 6, 3.0, held_out=0.05), assessment("b", 14, 2.0, held_out=0.03),
+                        assessment("c", 2, 50.0, held_out=0.30)])
+    assert choice.model == "b" and choice.reason.startswith("no model reaches the noise floor")
+
+
+def test_without_held_out_data_equal_counts_are_decided_by_the_information_criterion():
+    # BIC = n*misfit + d*ln(n): the same d, the lower chi^2 wins
+    a, b = assessment("a", 8, 1.1, misfit=1.02), assessment("b", 8, 1.0, misfit=1.01)
+    assert b.information_criterion < a.information_criterion
+    assert recommend([a, b]).model == "b"
+    assert recommend([a, b, assessment("c", 6, 1.2, misfit=1.1)]).model == "c"
+    assert b.information_criterion == pytest.approx(1000 * 1.01 + 8 * math.log(1000))
+
+
+@pytest.mark.slow
+def test_compare_on_the_filled_rubber_bushing_writes_its_files_and_recommends_a_filled_rubber_model(tmp_path, capsys):
+    out = tmp_path / "cmp"
+    code = main(["compare", "--models", "berg,kelvin_voigt", "--sine", f"{FILLED}_sine_2mm_10Hz.csv",
+                 "--sine", f"{FILLED}_sine_0.5mm_3Hz.csv", "--validate", f"{FILLED}_random_2mm.csv",
+                 "--validate-kdyn", str(DATA / "kdyn_synthetic_filled_rubber.csv"), "--screening", "256",
+                 "--starts", "8", "--no-ensemble", "--quiet", "--out", str(out)])
+    printed = capsys.readouterr().out
+    assert code == 0
+    assert printed.strip().splitlines()[-1] == "recommended: berg"     # Kelvin-Voigt misses by 20x the noise
+    for name in ("comparison.csv", "validation.csv", "kdyn_errors.csv", "params_berg.json", "params_kelvin_voigt.json",
+                 "compare_synthetic_filled_rubber_random_2mm.png", "compare_kdyn_synthetic_filled_rubber.csv.png"):
+        assert (out / name).is_file(), name
+    with open(out / "comparison.csv") as handle:
+        rows = {row["model"]: row for row in csv.DictReader(handle)}
+    assert rows["berg"]["recommended"] == "True" and rows["kelvin_voigt"]["recommended"] == "False"
+    assert int(rows["berg"]["free_parameters"]) == 8 and int(rows["kelvin_voigt"]["free_parameters"]) == 2
+    with open(out / "kdyn_errors.csv") as handle:
+        assert sum(1 for _ in csv.DictReader(handle)) == 2 * 25      # every row of the table, per model
