@@ -36,7 +36,7 @@ import numpy as np
 
 from fmu_src.bushing_models import get_model
 from identification.engine import make_engine
-from identification.fit_result import FLOOR_FACTOR, FitResult, TableFit
+from identification.fit_result import FLOOR_FACTOR, FitResult, TableFit, information_criterion
 from identification.fitting import FitNotConvergedWarning, fit, table_fit
 from identification.kdyn_table import KDYN_UNCERTAINTY, LOSS_ANGLE_UNCERTAINTY_DEG, KdynTable
 from identification.measurements import load_measurement
@@ -65,8 +65,8 @@ class Assessment:
 
     @property
     def information_criterion(self) -> float:
-        """BIC = chi^2 + d*ln(n) (``FitResult.information_criterion``)."""
-        return self.residuals * self.misfit + self.free_parameters * math.log(max(self.residuals, 1))
+        """BIC = chi^2 + d*ln(n) (``fit_result.information_criterion``)."""
+        return information_criterion(self.misfit, self.free_parameters, self.residuals)
 
     @property
     def validation_error(self) -> float | None:

@@ -108,6 +108,13 @@ class TableFit:
                 f"{'yes' if self.at_floor else 'NO'}")
 
 
+def information_criterion(misfit: float, free_parameters: int, residuals: int) -> float:
+    """Schwarz's BIC with the noise levels known: chi^2 + d*ln(n), chi^2 = n*misfit over n
+    residuals, d the free parameters; lower is better, and a model must lower chi^2 by ln(n) per
+    parameter it adds."""
+    return residuals * misfit + free_parameters * math.log(max(residuals, 1))
+
+
 @dataclass
 class FitResult:
     """What ``fit`` returns: the best parameter set, the evidence that it is the optimum, and
@@ -161,9 +168,8 @@ class FitResult:
 
     @property
     def information_criterion(self) -> float:
-        """Schwarz's BIC with the noise levels known: chi^2 + d*ln(n), chi^2 = n*misfit, d the free
-        parameters; lower is better, and a model must lower chi^2 by ln(n) per parameter it adds."""
-        return self.residuals * self.misfit + self.free_parameters * math.log(max(self.residuals, 1))
+        """Schwarz's BIC of the fit (:func:`information_criterion`)."""
+        return information_criterion(self.misfit, self.free_parameters, self.residuals)
 
     @property
     def model(self) -> str:
