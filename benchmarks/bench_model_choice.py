@@ -9,10 +9,10 @@ an independently typed truth, 3 N noise), trained on the sines 2 mm/10 Hz and 0.
 Prints each model's largest |K*| and loss-angle error on the data sheet (target for the
 recommended model: 3 % and 1 degree).
 
-``friction-damper``: the real friction damper (../shared/data/brfd/, CC BY-SA 4.0), trained on the
-0.5 Hz, 1 in sine; held out: every other sine. Prints, per file, the recommended model's NRMSE over
-that of a least-squares Kelvin-Voigt fitted to the file itself (the best linear bushing there;
-target <= 0.5) and over the Kelvin-Voigt trained with the others.
+``friction-damper``: the real friction damper (data/brfd/, CC BY-SA 4.0: data/brfd/README.md),
+trained on the 0.5 Hz, 1 in sine; held out: every other sine. Prints, per file, the recommended
+model's NRMSE over that of a least-squares Kelvin-Voigt fitted to the file itself (the best linear
+bushing there; target <= 0.5) and over the Kelvin-Voigt trained with the others.
 
 Both run ``compare`` (identification.compare) with the default preset, seed 0, on every core, and
 print each model's fit time (target for the filled-rubber models: <= 3 min on 2 cores).
@@ -41,7 +41,7 @@ from identification.rig_tests import training_tests  # noqa: E402
 from identification.search_space import KelvinVoigtFit  # noqa: E402
 
 DATA = REPO / "data"
-BRFD = REPO.parent / "shared" / "data" / "brfd"
+BRFD = DATA / "brfd"
 FILLED = DATA / "synthetic_filled_rubber"
 
 
@@ -61,10 +61,10 @@ def filled_rubber(out: Path, models, ensemble: bool) -> None:
 
 
 def friction_damper(out: Path, models, ensemble: bool) -> None:
-    if not BRFD.is_dir():
-        sys.exit(f"the friction-damper data are not at {BRFD} (a shared/ folder beside the checkout)")
-    training = BRFD / "sine_0.5Hz30lbtension1amplitude.csv"
-    others = sorted(path for path in BRFD.glob("sine_*.csv") if path != training)
+    training = BRFD / "sine_0.5Hz30lbtension1amplitude.csv.gz"
+    if not training.is_file():
+        sys.exit(f"the friction-damper data are not in {BRFD} (make them with {BRFD / 'convert.py'})")
+    others = sorted(path for path in BRFD.glob("sine_*.csv.gz") if path != training)
     tests = training_tests(sine=[training])
     result = compare_models(models, tests, others, out, ensemble=ensemble)
     chosen = result["recommendation"].model

@@ -5,6 +5,8 @@ there), then a header naming columns with their units, then comma-separated numb
 
     time_s,displacement_mm,force_N[,velocity_mm_s]
 
+A file whose name ends in ``.gz`` (``test.csv.gz``) is read through gzip, as numpy and pandas do.
+
 Other declared units are converted: displacement in m, mm, in; force in N, kN, lbf, kip;
 velocity in m_s, mm_s, in_s (per second). Internal units: s, mm, N, mm/s.
 
@@ -23,6 +25,7 @@ content, or a wrong time unit).
 """
 from __future__ import annotations
 
+import gzip
 import math
 import warnings
 from dataclasses import dataclass, field
@@ -85,6 +88,36 @@ def _column_factor(path: Path, header: str, quantity: str, table: dict[str, floa
     return table[unit]
 
 
+def _read_text(path: Path) -> str:
+    """The text of a CSV, or of a gzip-compressed one if its name ends in ``.gz``."""
+    compressed = path.suffix.lower() == ".gz"
+    try:
+        if compressed:
+            with gzip.open(path, "rt", encoding="utf-8") as stream:
+                return stream.read()
+        return path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise MeasurementError(f"measurement file {path} does not exist") from None
+    except IsADirectoryError:
+        raise MeasurementError(f"measurement file {path} is a directory") from None
+    except (gzip.BadGzipFile, EOFError) as exc:
+        raise MeasurementError(f"{path}: not a readable gzip file ({exc}); "
+                               "only a compressed CSV may end in .gz") from None
+    except UnicodeDecodeError as exc:
+        hint = "" if compressed else "; a compressed file must end in .gz"
+        raise MeasurementError(f"{path}: not UTF-8 text (byte {exc.start}){hint}") from None
+
+
+def measurement_name(source: str | Path) -> str:
+    """A measurement file's name without its directory and its ``.csv`` / ``.csv.gz`` suffixes,
+    for the names of the plots and tables made from it."""
+    name = Path(source).name
+    for suffix in (".gz", ".csv"):
+        if name.lower().endswith(suffix):
+            name = name[: -len(suffix)]
+    return name
+
+
 def load_measurement(path: str | Path, force_optional: bool = False) -> Measurement:
     """Load a measured (or synthetic) rig test from a CSV file.
 
@@ -93,7 +126,7 @@ def load_measurement(path: str | Path, force_optional: bool = False) -> Measurem
     path : str or Path
         CSV with a header line naming ``time_s``, ``displacement_<unit>`` (mm, m, in),
         ``force_<unit>`` (N, kN, lbf, kip) and optionally ``velocity_<unit>`` columns; ``#``
-        lines are comments.
+        lines are comments. A name ending in ``.gz`` is read as a gzip-compressed CSV.
     force_optional : bool
         Accept a file without a force column (an input to ``predict``).
 
@@ -109,10 +142,7 @@ def load_measurement(path: str | Path, force_optional: bool = False) -> Measurem
         Naming what is wrong and where (file, line, column).
     """
     path = Path(path)
-    try:
-        lines = path.read_text(encoding="utf-8").splitlines()
-    except FileNotFoundError:
-        raise MeasurementError(f"measurement file {path} does not exist") from None
+    lines = _read_text(path).splitlines()
     comments = [line[1:].strip() for line in lines if line.startswith("#")]
     body = [(number, line) for number, line in enumerate(lines, start=1)
             if line.strip() and not line.startswith("#")]

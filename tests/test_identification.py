@@ -97,18 +97,6 @@ def test_a_plausible_test_loads_without_a_warning(tmp_path):
         load_measurement(write(tmp_path, table5_sine_text()))
 
 
-BRFD = DATA.parent.parent / "shared" / "data" / "brfd"
-
-
-@pytest.mark.skipif(not BRFD.is_dir(), reason=f"the real friction-damper data are not beside the checkout ({BRFD})")
-def test_real_friction_damper_file_loads():
-    with warnings.catch_warnings():
-        warnings.simplefilter("error", MeasurementWarning)   # real data look plausible
-        m = load_measurement(BRFD / "sine_0.5Hz30lbtension1amplitude.csv")
-    assert len(m) == 14337 and not m.velocity_derived
-    assert 20 < np.max(np.abs(m.displacement_mm)) < 30  # 1 in = 25.4 mm amplitude
-
-
 # -------------------------------------------------------------------- objectives
 def synthetic(params, protocol, duration_s, scale=1.0):
     """A measurement whose force is ``scale`` times the model's with ``params``."""
