@@ -12,6 +12,22 @@ named after a hash of their content: a changed model or machinery compiles afres
 checks only a file's own time stamp, not the sources of the functions a kernel calls), and
 numba's on-disk cache lets the next process load the machine code instead of compiling.
 
+The contract a model module keeps for this (checked on its syntax tree by
+:func:`checked_imports`, which raises :class:`ModelContractError` naming the module and line of
+anything else):
+
+- its imports are at the module's top and of these forms only: ``from __future__ import ...``,
+  ``import math``, ``from .integration import names`` (the shared machinery: in the generated
+  module they come from the compiled machinery), ``from .<sibling> import names`` (another module
+  of the package: its plain-Python values, such as specs, constants and ``BushingModel``; a
+  function imported from there stays uncompiled, and numba refuses a kernel that calls it). Nothing
+  else: ``from math import exp``, ``import numpy``, ``from . import integration`` and imports
+  inside functions are refused, not copied.
+- the step protocol (``integration.step`` and ``step_prepared``, appended to the generated module)
+  calls the module's globals ``jump`` and ``integrate`` (and ``prepare_step``, where the module
+  defines one): they must be the kernels its ``MODEL`` holds (``model_definition.check_step_kernels``, which
+  ``BushingModel`` runs when a model is defined).
+
 Users: the FMU (:func:`compiled_model`, when numba is importable in the host's Python; the slave
 falls back to the plain-Python kernels otherwise) and the identification
 (``identification/compiled_core.py``, which appends its population loop). Numba is optional
@@ -20,10 +36,12 @@ here: nothing imports it until a model is compiled.
 from __future__ import annotations
 
 import ast
+import ctypes
 import dataclasses
 import hashlib
 import importlib.util
 import inspect
+import ntpath
 import os
 import sys
 import time
@@ -32,6 +50,7 @@ import warnings
 from pathlib import Path
 
 from . import integration
+from .model_definition import ModelContractError, check_step_kernels
 from .unrolling import unroll
 
 CACHE_ENVIRONMENT = "BUSHING_CACHE_DIR"
@@ -89,15 +108,52 @@ def load_generated(name: str, source: str) -> types.ModuleType:
     return module
 
 
-def kernel_source(module: types.ModuleType) -> str:
+ALLOWED_IMPORTS = ("from __future__ import ..., import math, from .integration import <names>, "
+                   "from .<module of this package> import <names>")
+
+
+def checked_imports(tree: ast.Module, module: str, machinery: str | None, package: str) -> ast.Module:
+    """``tree``, the source of the kernel module ``module``, with its relative imports made
+    absolute: ``from .integration import`` from ``machinery`` (the compiled machinery's module;
+    None: from ``package``'s own), ``from .<sibling> import`` from ``package``. Raises
+    ModelContractError for an import of any other form (:data:`ALLOWED_IMPORTS`) or anywhere but
+    at the module's top. Changes ``tree`` in place."""
+    def refuse(node, why: str):
+        return ModelContractError(f"{module}, line {node.lineno}: {ast.unparse(node)!r} {why}; a model module "
+                                  f"may import only: {ALLOWED_IMPORTS}")
+    top_level = {id(node) for node in tree.body}
+    for node in ast.walk(tree):
+        if not isinstance(node, (ast.Import, ast.ImportFrom)):
+            continue
+        if id(node) not in top_level:
+            raise refuse(node, "is inside a function or block")
+        if isinstance(node, ast.Import):
+            if [(alias.name, alias.asname) for alias in node.names] != [("math", None)]:
+                raise refuse(node, "is not allowed")
+        elif node.level == 0:
+            if node.module != "__future__":
+                raise refuse(node, "is not allowed (an absolute import would not be compiled)")
+        elif node.level != 1 or node.module is None or "." in node.module \
+                or any(alias.name == "*" for alias in node.names):
+            raise refuse(node, "is not allowed (relative imports name one module of this package and its names)")
+        elif node.module == "integration" and machinery is not None:
+            node.module, node.level = machinery, 0
+        else:
+            node.module, node.level = f"{package}.{node.module}", 0
+    return tree
+
+
+def kernel_source(module: types.ModuleType, machinery: str | None = None) -> str:
     """The source of a kernel module as numba reads it: tuples and sums over a constant range
-    written out (``unrolling``)."""
-    return ast.unparse(unroll(ast.parse(inspect.getsource(module)), module.__dict__, module.__name__))
+    written out (``unrolling``), its imports checked and made absolute (:func:`checked_imports`;
+    ``machinery``: the compiled machinery's module, or None for the machinery itself)."""
+    tree = unroll(ast.parse(inspect.getsource(module)), module.__dict__, module.__name__)
+    return ast.unparse(checked_imports(tree, module.__name__, machinery, module.__package__))
 
 
 def integration_module() -> str:
     """The name of the compiled copy of the shared machinery (generated and loaded)."""
-    source = (kernel_source(integration) + "\n\n# ---- appended by fmu_src/compiled_kernels.py ----\n"
+    source = (kernel_source(integration, None) + "\n\n# ---- appended by fmu_src/compiled_kernels.py ----\n"
               + _NUMBA_IMPORT + _JIT_KERNELS)
     name = module_name("bushing_integration", source)
     load_generated(name, source)
@@ -107,12 +163,12 @@ def integration_module() -> str:
 def model_source(model, machinery: str, appendix: str = "") -> str:
     """``model``'s module (a ``BushingModel``'s kernel module), its kernels compiled, the step
     protocol (``integration.step`` and ``step_prepared``, compiled; ``prepare_step`` the
-    machinery's ``unprepared_step`` where the module has none) and ``appendix``. Its relative imports point at its own package (plain Python: specs, checks)
-    and at the compiled machinery ``machinery``."""
+    machinery's ``unprepared_step`` where the module has none) and ``appendix``. Its relative
+    imports point at its own package (plain Python: specs, checks) and at the compiled machinery
+    ``machinery``; a module outside the contract (module docstring) is a ModelContractError."""
     module = sys.modules[model.kernel_module]
-    source = kernel_source(module)
-    source = source.replace("from .integration import", f"from {machinery} import")
-    source = source.replace("from .", f"from {module.__package__}.")
+    check_step_kernels(model, module)
+    source = kernel_source(module, machinery)
     return (source + "\n\n# ---- appended by fmu_src/compiled_kernels.py ----\n" + _NUMBA_IMPORT + _JIT_KERNELS
             + f"\nif 'prepare_step' not in globals():\n    from {machinery} import unprepared_step as prepare_step\n"
             + "\n\n" + inspect.getsource(integration.step_prepared) + "\n\n" + inspect.getsource(integration.step)
@@ -219,31 +275,97 @@ STEP_ENVIRONMENT = "BUSHING_FMU_STEP"
 compiles them in any host (default: only where the host process is a Python interpreter)."""
 
 
-def _python_host() -> bool:
-    """Whether this process's executable is a Python interpreter (fmpy, libcosimpy, ...), not a
-    C/C++ tool that embeds Python (measured 2026-11-23: numba-compiled kernels in a C host that
-    embeds libpython, tests/c_host, end in heap corruption; in Python hosts they run clean)."""
+PROCESS_LINKS = ("/proc/self/exe", "/proc/curproc/file")
+"""Where procfs names the running executable (Linux; FreeBSD with procfs mounted)."""
+
+
+def _kernel32():
+    """Windows' kernel32 (a function of its own so that tests can give a stand-in)."""
+    return ctypes.WinDLL("kernel32")
+
+
+def _libc():
+    """The C library of the process, on macOS libSystem with ``_NSGetExecutablePath``."""
+    return ctypes.CDLL(None)
+
+
+def _windows_executable(kernel32) -> str:
+    """GetModuleFileNameW(NULL): the path of the process's .exe."""
+    size = 32768                       # the longest path Windows has
+    buffer = ctypes.create_unicode_buffer(size)
+    length = kernel32.GetModuleFileNameW(None, buffer, size)
+    if not 0 < length < size:
+        raise OSError(f"GetModuleFileNameW returned {length}")
+    return buffer.value[:length]
+
+
+def _macos_executable(libc) -> str:
+    """_NSGetExecutablePath: the path of the process's executable (asked for its size first)."""
+    size = ctypes.c_uint32(0)
+    libc._NSGetExecutablePath(None, ctypes.pointer(size))
+    buffer = ctypes.create_string_buffer(max(size.value, 1))
+    if libc._NSGetExecutablePath(buffer, ctypes.pointer(size)) != 0:
+        raise OSError(f"_NSGetExecutablePath needs {size.value} bytes")
+    return os.path.realpath(os.fsdecode(buffer.value))
+
+
+def host_executable() -> tuple[str | None, str]:
+    """(the path of this process's executable as the operating system tells it, or None; how it
+    was told or why not). Not ``sys.executable``: in a host that embeds Python it is not the
+    process's executable (on Windows it is the host's own .exe, on Linux and macOS the first
+    ``python3`` on PATH when the host names no program), so only the operating system can say
+    whether the process is a Python interpreter."""
     try:
-        executable = os.path.basename(os.path.realpath("/proc/self/exe"))
-    except OSError:
-        return False
-    return executable.startswith("python")
+        if sys.platform == "win32":
+            return _windows_executable(_kernel32()), "GetModuleFileNameW"
+        if sys.platform == "darwin":
+            return _macos_executable(_libc()), "_NSGetExecutablePath"
+        for link in PROCESS_LINKS:
+            try:
+                return os.readlink(link), link
+            except FileNotFoundError:
+                continue
+        return None, f"none of {', '.join(PROCESS_LINKS)} exists on {sys.platform}"
+    except (OSError, AttributeError, ValueError) as exc:   # no such call, or the call failed
+        return None, f"asking {sys.platform} for it failed ({type(exc).__name__}: {exc})"
+
+
+def _python_host(executable: str) -> bool:
+    """Whether ``executable`` (:func:`host_executable`) is a Python interpreter (fmpy,
+    libcosimpy, ... run in one), not a C/C++ tool that embeds Python (measured 2026-11-23:
+    numba-compiled kernels in a C host that embeds libpython, tests/c_host, end in heap
+    corruption; in Python hosts they run clean). By its file name: python, python3.12,
+    python.exe, pythonw.exe, and macOS's framework interpreter .../Python.app/Contents/MacOS/Python."""
+    name = (ntpath.basename(executable) if sys.platform == "win32" else os.path.basename(executable)).lower()
+    return name.startswith("python")
 
 
 def compile_axes(axes) -> tuple[list, dict, str]:
     """An FMU's axes [(axis, model, parameters)] with each model's COMPILED_IN_FMU kernels
     compiled, {model name: its compiled steps (:func:`_step_axes` for several axes,
     :func:`_step_one` for one)}, and a sentence saying which
-    step runs; the axes unchanged and no batched steps (the plain-Python step) if numba is not
-    importable or fails, if the host is not a Python interpreter, or if $BUSHING_FMU_STEP is
-    "python". The compiled and the plain-Python steps give the same forces
+    step runs and why (the host's executable among it); the axes unchanged and no batched steps
+    (the plain-Python step) if numba is not importable or fails, if the host is not a Python
+    interpreter or its executable cannot be told (:func:`host_executable`), or if
+    $BUSHING_FMU_STEP is "python". The compiled and the plain-Python steps give the same forces
     (tests/test_fmu_compiled_step.py)."""
     choice = os.environ.get(STEP_ENVIRONMENT, "").lower()
     if choice == "python":
         return list(axes), {}, f"pure-Python step ({STEP_ENVIRONMENT}=python)"
-    if choice != "compiled" and not _python_host():
-        return list(axes), {}, ("pure-Python step: the host is not a Python interpreter, where numba-compiled "
-                                f"kernels have corrupted the heap ({STEP_ENVIRONMENT}=compiled forces them)")
+    executable, how = host_executable()
+    if executable is None:
+        host = f"the host's executable is unknown ({how})"
+    else:
+        host = f"the host is {executable} ({how})"
+    if choice != "compiled":
+        if executable is None:
+            return list(axes), {}, (f"pure-Python step: {host}, and in a host that is not a Python interpreter "
+                                    "numba-compiled kernels have corrupted the heap "
+                                    f"({STEP_ENVIRONMENT}=compiled forces them)")
+        if not _python_host(executable):
+            return list(axes), {}, (f"pure-Python step: the host is not a Python interpreter ({executable}, by "
+                                    f"{how}), where numba-compiled kernels have corrupted the heap "
+                                    f"({STEP_ENVIRONMENT}=compiled forces them)")
     compiled, seconds = {}, 0.0
     try:
         for _, model, _ in axes:
@@ -257,5 +379,6 @@ def compile_axes(axes) -> tuple[list, dict, str]:
     out = [(axis, dataclasses.replace(model, **{name: compiled[model.name][name] for name in COMPILED_IN_FMU}),
             parameters) for axis, model, parameters in axes]
     batched = {name: (kernels["step_axes"], kernels["step_one"]) for name, kernels in compiled.items()}
-    return out, batched, (f"compiled step (numba): one call per model for all its axes; {seconds:.2f} s to "
-                          f"compile the kernels or load them from {cache_directory()}")
+    why = f"{STEP_ENVIRONMENT}=compiled" if choice == "compiled" else "a Python interpreter"
+    return out, batched, (f"compiled step (numba): {host}, {why}; one call per model for all its axes; "
+                          f"{seconds:.2f} s to compile the kernels or load them from {cache_directory()}")

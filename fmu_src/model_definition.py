@@ -54,6 +54,30 @@ STIFFNESS_UNITS = ("N/mm", "N.mm/rad")
 DAMPING_UNITS = ("N.s/mm", "N.mm.s/rad")
 
 
+class ModelContractError(ValueError):
+    """A model module outside the contract of the compiled path (the message names the module,
+    the line and what is allowed)."""
+
+
+STEP_KERNELS = ("jump", "integrate")
+"""The model kernels ``integration.step`` and ``step_prepared`` call by their global names (their
+``prepare_step`` is the module's own or the machinery's ``unprepared_step``, by construction)."""
+
+
+def check_step_kernels(model, module: types.ModuleType) -> None:
+    """Raise ModelContractError unless the globals of ``module`` that the step protocol calls
+    (:data:`STEP_KERNELS`) are ``model``'s kernels of those names: the protocol is bound to the
+    module's globals by name, so a model whose ``jump`` is another function would step with the
+    wrong one."""
+    for name in STEP_KERNELS:
+        if vars(module).get(name) is not getattr(model, name):
+            raise ModelContractError(
+                f"{module.__name__}: the step protocol calls its global {name!r}, which is "
+                f"{vars(module).get(name)!r}, not the model {model.name!r}'s {name} kernel "
+                f"{getattr(model, name)!r}; name the kernels jump and integrate in the module "
+                "that defines them")
+
+
 @dataclass(frozen=True)
 class StateSpec:
     """An internal state exposed by the FMU: entry ``index`` of the model's state tuple (or of
@@ -148,6 +172,7 @@ class BushingModel:
         # integration.step's code with the globals of the module that defines the kernels in use
         # (a model module, or a compiled copy of it): one definition of the protocol for all.
         # A module without a prepare_step of its own steps with its constants as they are.
+        check_step_kernels(self, sys.modules[self.kernel_module])
         namespace = dict(sys.modules[self.kernel_module].__dict__)
         namespace.setdefault("prepare_step", integration.unprepared_step)
         namespace["step_prepared"] = types.FunctionType(integration.step_prepared.__code__, namespace, "step_prepared")

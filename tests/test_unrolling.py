@@ -1,11 +1,19 @@
-"""tuple(...) and sum(...) over a constant range in kernels: written out term by term for numba and
-the C translation (fmu_src/unrolling.py), with the plain-Python result bit for bit."""
+"""The kernels' source as numba and the C translation read it: tuple(...) and sum(...) over a
+constant range written out term by term (fmu_src/unrolling.py), with the plain-Python result bit
+for bit; the compiled path's contract on a model module's imports and step kernels
+(fmu_src/compiled_kernels.py), checked on its syntax tree."""
 import ast
+import dataclasses
 import math
+import re
+import sys
 import textwrap
 
 import pytest
 
+from fmu_src import compiled_kernels
+from fmu_src.bushing_models import MODELS
+from fmu_src.model_definition import ModelContractError
 from fmu_src.native.python_to_c import DOUBLE, Translation, TranslationError
 from fmu_src.unrolling import UnrollError, unroll
 
@@ -89,3 +97,55 @@ def test_indices_are_folded_and_a_written_out_tuple_is_spliced_into_a_display():
     namespace = {}
     exec(source, namespace)
     assert unrolled_function(source, {})((1.0, 2.0, 3.0, 4.0, 5.0), 7.0) == namespace["kernel"]((1.0, 2.0, 3.0, 4.0, 5.0), 7.0)
+
+
+ALLOWED_IMPORTS = textwrap.dedent('''
+    from __future__ import annotations
+
+    import math
+
+    from .bushing_params import SPRING, ParameterSpec
+    from .integration import OK, maxwell_step as step_of_a_maxwell_element
+''')
+
+
+def test_a_model_modules_allowed_imports_are_pointed_at_the_compiled_machinery_and_the_package():
+    tree = compiled_kernels.checked_imports(ast.parse(ALLOWED_IMPORTS), "pkg.some_model", "machinery_0123", "pkg")
+    assert ast.unparse(tree).splitlines() == [
+        "from __future__ import annotations", "import math", "from pkg.bushing_params import SPRING, ParameterSpec",
+        "from machinery_0123 import OK, maxwell_step as step_of_a_maxwell_element"]
+
+
+@pytest.mark.parametrize("statement", [
+    "from math import exp", "import numpy as np", "import math as m", "import math, os", "from . import integration",
+    "from ..integration import OK", "from .integration import *", "from .native.build import FLAGS",
+    "from numpy import exp"])
+def test_any_other_import_form_is_refused_naming_module_and_line(statement):
+    source = f"import math\n\n{statement}\n"
+    expected = rf"^pkg\.some_model, line 3: {re.escape(repr(statement))} is not allowed.*may import only: from __future__"
+    with pytest.raises(ModelContractError, match=expected):
+        compiled_kernels.checked_imports(ast.parse(source), "pkg.some_model", "machinery_0123", "pkg")
+
+
+def test_an_import_inside_a_kernel_is_refused():
+    source = "import math\n\n\ndef force(m, state, x, v):\n    from .integration import OK\n    return OK\n"
+    with pytest.raises(ModelContractError, match=r"pkg.some_model, line 5: 'from \.integration import OK' is inside a "
+                                                 "function or block"):
+        compiled_kernels.checked_imports(ast.parse(source), "pkg.some_model", "machinery_0123", "pkg")
+
+
+@pytest.mark.parametrize("name", list(MODELS))
+def test_every_registered_model_keeps_the_compiled_paths_contract(name):
+    module = sys.modules[MODELS[name].kernel_module]
+    source = compiled_kernels.kernel_source(module, "machinery_0123")
+    assert "from machinery_0123 import" in source and "from ." not in source
+
+
+def test_a_model_whose_step_kernels_are_not_the_modules_jump_and_integrate_is_refused_when_defined():
+    model = MODELS["kelvin_voigt"]
+
+    def other_jump(m, state, jump_mm):
+        return state, 0
+    with pytest.raises(ModelContractError, match=r"kelvin_voigt_model: the step protocol calls its global 'jump', "
+                                                 r"which is <function jump .*not the model 'kelvin_voigt''s jump"):
+        dataclasses.replace(model, jump=other_jump)

@@ -10,19 +10,33 @@ native FMU (``fmu_src/native``):
   (``typedef struct {...} bw_tuple_<k>``) returned and passed by value. A function called with
   other argument types is translated once more under another name.
 - the statements the kernels use: assignment (also unpacking a tuple), augmented assignment,
-  ``if``/``elif``/``else``, ``while``, ``for _ in range(...)`` with ``else``, ``break``,
-  ``return``; expressions with ``+ - * / **``, comparisons (chained too), ``and or not``,
-  conditional expressions, constant tuple indices, calls of other kernels and of ``abs``,
-  ``min``, ``max``, ``int``, ``float``, ``math.exp``/``log``/``sqrt``/``sin``/``cos``/``ceil``/
-  ``isfinite`` and the constants ``math.inf``, ``math.pi``; ``tuple(...)`` and ``sum(...)`` of a
-  generator over a constant range, written out term by term first (``fmu_src/unrolling.py``).
+  ``if``/``elif``/``else``, ``while``, ``for name in range(stop)`` or ``range(start, stop)``
+  with ``else``, ``break``, ``continue``, ``return``; expressions with ``+ - * / **`` (``**``
+  with a float operand), comparisons ``< <= > >= == !=`` (chained too), ``not``, ``and``/``or``
+  (see below), conditional expressions, constant tuple indices, int constants within C's int,
+  calls of other kernels (Python functions, not recursive) and of ``abs``, ``min``, ``max`` (two
+  arguments), ``int``, ``float``, ``math.exp``/``log``/``sqrt``/``sin``/``cos``/``ceil``/
+  ``isfinite`` (written ``math.<name>``, the module imported as ``import math``) and the
+  constants ``math.inf``, ``math.pi``; ``tuple(...)`` and ``sum(...)`` of a generator over a
+  constant range, written out term by term first (``fmu_src/unrolling.py``).
 - Python's semantics where C's differ: ``/`` of two ints is a float division; ``int(x)`` of a
   NaN or of a value beyond C's int gives the largest int (Python would raise: the kernels'
   callers then refuse the step, as they do for too many substeps); ``min``/``max`` return the
-  first of equal arguments.
+  first of equal arguments. Where Python raises on floats (a division by zero, ``0.0 ** -1``, an
+  overflow in ``**`` or ``math.exp``), the C gives inf or NaN as numba's ``error_model="numpy"``
+  does, and the kernels' callers refuse a step whose state is not finite.
 
-Anything else is a ``TranslationError`` naming the function and the line: a kernel that the C
-cannot follow must fail the build, not run differently. The C is compiled without contraction
+Refused, with a ``TranslationError`` naming the function and the line, because C would compute
+something else: ``and``/``or`` whose value is used as a number (Python gives an operand, C 0 or
+1; allowed as the test of an ``if``, ``while`` or conditional expression, where only the truth
+counts, or where every operand is a comparison, ``not ...``, ``True``/``False`` or
+``math.isfinite(...)``); a ``for`` variable read outside its loop's body (C leaves ``stop``
+after the loop, Python ``stop - 1``), assigned in it, or reused by an inner loop; ``//`` and
+``%`` (they round differently on negative operands), ``int ** int`` (an int in Python, possibly
+a float in C), ``is``/``in``, bit operations; calls of any other function (``round``, a
+``math`` function imported by name with ``from math import ...``, a method); ints beyond C's
+int; a tuple as a truth value. Anything else the translator does not know is refused the same
+way: a kernel that the C cannot follow must fail the build, not run differently. The C is compiled without contraction
 of multiplications and additions (``-ffp-contract=off``), so on the same processor it gives the
 same floats as the Python and numba kernels (``tests/test_native_fmu.py`` checks 1e-12, and
 bitwise where it can).
@@ -45,6 +59,13 @@ Type = Union[str, tuple]
 """A kernel value's type: DOUBLE, INT, or a tuple of types."""
 
 MATH_FUNCTIONS = {"exp": "exp", "log": "log", "sqrt": "sqrt", "sin": "sin", "cos": "cos"}
+MATH_INT_FUNCTIONS = ("ceil", "isfinite")
+"""math functions whose Python result is an int (ceil) or a bool (isfinite)."""
+BUILTINS = {"abs": abs, "min": min, "max": max, "int": int, "float": float}
+C_INT_MIN, C_INT_MAX = -2 ** 31, 2 ** 31 - 1
+"""The range of C's int (32 bits on every platform the native FMU is built for)."""
+SUPPORTED_CALLS = ("other kernels (Python functions), abs, min, max, int, float and "
+                   + ", ".join(f"math.{name}" for name in (*MATH_FUNCTIONS, *MATH_INT_FUNCTIONS)))
 MATH_CONSTANTS = {"inf": "HUGE_VAL", "pi": "3.141592653589793"}
 C_RESERVED = frozenset("""auto break case char const continue default do double else enum extern float for goto if
 inline int long register restrict return short signed sizeof static struct switch typedef union unsigned void volatile
@@ -107,6 +128,8 @@ class Translation:
     def function(self, function: Callable, argument_types: tuple) -> "_Function":
         """The translation of ``function`` for ``argument_types`` (made on first request)."""
         function = getattr(function, "py_func", function)   # a numba dispatcher: its Python source
+        if not isinstance(function, types.FunctionType):
+            raise TranslationError(f"{function!r} is not a Python function: only {SUPPORTED_CALLS} are translated")
         key = (function, argument_types)
         if key not in self.functions:
             same_name = sum(f.python is function for f in self.functions.values())
@@ -156,7 +179,10 @@ class _Function:
         self.locals: dict[str, Type] = dict(zip(self.arguments, argument_types))
         # C warns of variables set but never read: names never read are neither declared nor set
         self.read = {n.id for n in ast.walk(self.tree) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)}
-        self.loop_names = {n.target.id for n in ast.walk(self.tree) if isinstance(n, ast.For)}
+        self.loop_names = {n.target.id for n in ast.walk(self.tree)
+                           if isinstance(n, ast.For) and isinstance(n.target, ast.Name)}
+        self.check_loop_variables(self.tree, frozenset())
+        self.truth_tests = self.truth_test_nodes()
         self.return_type: Type | None = None
         self.temporaries = 0
         self.loops: list = []
@@ -165,6 +191,76 @@ class _Function:
     def error(self, node, message: str) -> TranslationError:
         line = getattr(node, "lineno", 1) + self.line_offset
         return TranslationError(f"{self.python.__module__}.{self.python.__name__}, line {line}: {message}")
+
+    def check_loop_variables(self, node, open_loops: frozenset):
+        """Refuse a ``for`` variable read outside its loop's body (after the loop C leaves it at
+        ``stop``, Python at ``stop - 1``), assigned other than by its ``for`` (C would change the
+        count), or reused by a loop inside its loop. ``open_loops``: the variables of the loops
+        around ``node``."""
+        if isinstance(node, ast.For) and isinstance(node.target, ast.Name):
+            name = node.target.id
+            if name in open_loops:
+                raise self.error(node, f"the loop variable {name!r} is reused by a loop inside its loop; use "
+                                       "another name")
+            self.check_loop_variables(node.iter, open_loops)
+            for statement in node.body:
+                self.check_loop_variables(statement, open_loops | {name})
+            for statement in node.orelse:
+                self.check_loop_variables(statement, open_loops)
+            return
+        if isinstance(node, ast.Name) and node.id in self.loop_names:
+            if isinstance(node.ctx, ast.Store):
+                raise self.error(node, f"the loop variable {node.id!r} is assigned other than by its for; only "
+                                       "its loop may set it")
+            if node.id not in open_loops:
+                raise self.error(node, f"the loop variable {node.id!r} is read outside its loop's body (after "
+                                       "the loop Python leaves it at stop - 1, C at stop); copy it into "
+                                       "another variable inside the loop")
+        for child in ast.iter_child_nodes(node):
+            self.check_loop_variables(child, open_loops)
+
+    def truth_test_nodes(self) -> set:
+        """The ids of the expressions whose truth alone counts: the tests of ``if``, ``while`` and
+        conditional expressions, the operands of ``not`` and the operands of an ``and``/``or``
+        that is itself such a test (there C's 0/1 and Python's operand agree)."""
+        tests = []
+        for node in ast.walk(self.tree):
+            if isinstance(node, (ast.If, ast.While, ast.IfExp)):
+                tests.append(node.test)
+            elif isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.Not):
+                tests.append(node.operand)
+        found = set()
+        while tests:
+            node = tests.pop()
+            found.add(id(node))
+            if isinstance(node, ast.BoolOp):
+                tests.extend(node.values)
+        return found
+
+    def is_boolean(self, e) -> bool:
+        """Whether ``e``'s Python value is a bool (so that C's 0 or 1 is the same number)."""
+        if isinstance(e, ast.Compare) or (isinstance(e, ast.UnaryOp) and isinstance(e.op, ast.Not)):
+            return True
+        if isinstance(e, ast.Constant):
+            return isinstance(e.value, bool)
+        if isinstance(e, ast.BoolOp):
+            return all(self.is_boolean(value) for value in e.values)
+        if isinstance(e, ast.Call) and isinstance(e.func, ast.Attribute) and e.func.attr == "isfinite":
+            return self.callee(e) == ("math", "isfinite")
+        return False
+
+    def check_truth_value(self, e):
+        """Refuse a tuple as a truth value (Python: whether it is empty; C cannot test a struct)."""
+        if isinstance(self.type_of(e), tuple):
+            raise self.error(e, f"a tuple as a truth value: {ast.unparse(e)}")
+
+    def math_module(self, node) -> bool:
+        """Whether ``node`` is the name ``math`` and means the math module."""
+        if not (isinstance(node, ast.Name) and node.id == "math" and node.id not in self.locals):
+            return False
+        if self.global_value("math", node) is not math:
+            raise self.error(node, "the name math is not the math module here")
+        return True
 
     # ------------------------------------------------------------------ types
     def translate(self):
@@ -228,11 +324,11 @@ class _Function:
             except TypeError as exc:
                 raise self.error(s, f"returns {exc}") from None
         elif isinstance(s, ast.If):
-            self.type_of(s.test)
+            self.check_truth_value(s.test)
             self.infer_block(s.body)
             self.infer_block(s.orelse)
         elif isinstance(s, ast.While):
-            self.type_of(s.test)
+            self.check_truth_value(s.test)
             self.infer_block(s.body)
             self.infer_block(s.orelse)
         elif isinstance(s, ast.For):
@@ -244,6 +340,9 @@ class _Function:
             pass
         elif isinstance(s, ast.Expr) and isinstance(s.value, ast.Constant):
             pass    # a string as a comment
+        elif isinstance(s, (ast.Import, ast.ImportFrom)):
+            raise self.error(s, f"an import in a kernel ({ast.unparse(s)}); import at the module's top: "
+                                "import math, from .integration import ...")
         else:
             raise self.error(s, f"statement {type(s).__name__} is not supported")
 
@@ -270,19 +369,20 @@ class _Function:
             if isinstance(e.value, bool):
                 return INT
             if isinstance(e.value, int):
+                self.check_int_range(e.value, e)
                 return INT
             if isinstance(e.value, float):
                 return DOUBLE
-            raise self.error(e, f"constant {e.value!r}")
+            raise self.error(e, f"constant {e.value!r}: only int and float constants")
         if isinstance(e, ast.Name):
             if e.id in self.locals:
                 return self.locals[e.id]
             value = self.global_value(e.id, e)
             return self.constant_type(value, e)
         if isinstance(e, ast.Attribute):
-            if isinstance(e.value, ast.Name) and e.value.id == "math" and e.attr in MATH_CONSTANTS:
+            if self.math_module(e.value) and e.attr in MATH_CONSTANTS:
                 return DOUBLE
-            raise self.error(e, f"attribute {ast.unparse(e)}")
+            raise self.error(e, f"attribute {ast.unparse(e)}: only math.inf and math.pi")
         if isinstance(e, ast.Tuple):
             return tuple(self.type_of(element) for element in e.elts)
         if isinstance(e, ast.Subscript):
@@ -292,6 +392,7 @@ class _Function:
         if isinstance(e, ast.UnaryOp):
             t = self.type_of(e.operand)
             if isinstance(e.op, ast.Not):
+                self.check_truth_value(e.operand)
                 return INT
             if isinstance(e.op, (ast.USub, ast.UAdd)) and not isinstance(t, tuple):
                 return t
@@ -306,11 +407,18 @@ class _Function:
                 return DOUBLE
             if isinstance(e.op, (ast.Add, ast.Sub, ast.Mult)):
                 return INT if left == right == INT else DOUBLE
-            raise self.error(e, f"operator {type(e.op).__name__}")
+            if isinstance(e.op, (ast.FloorDiv, ast.Mod)):
+                raise self.error(e, f"operator {'//' if isinstance(e.op, ast.FloorDiv) else '%'}: Python rounds "
+                                    "towards minus infinity, C towards zero; only + - * / **")
+            raise self.error(e, f"operator {type(e.op).__name__}: only + - * / **")
         if isinstance(e, ast.BoolOp):
             for value in e.values:
-                if isinstance(self.type_of(value), tuple):
-                    raise self.error(e, "and/or of tuples")
+                self.check_truth_value(value)
+            if id(e) not in self.truth_tests and not self.is_boolean(e):
+                word = "and" if isinstance(e.op, ast.And) else "or"
+                raise self.error(e, f"{word} used as a number ({ast.unparse(e)}): Python gives one of the "
+                                    "operands, C gives 0 or 1; allowed as an if/while/conditional test or where "
+                                    "every operand is a comparison, not ..., True/False or math.isfinite(...)")
             return INT
         if isinstance(e, ast.Compare):
             for operand in (e.left, *e.comparators):
@@ -318,10 +426,10 @@ class _Function:
                     raise self.error(e, "comparison of tuples")
             for op in e.ops:
                 if not isinstance(op, (ast.Lt, ast.LtE, ast.Gt, ast.GtE, ast.Eq, ast.NotEq)):
-                    raise self.error(e, f"comparison {type(op).__name__}")
+                    raise self.error(e, f"comparison {type(op).__name__}: only < <= > >= == !=")
             return INT
         if isinstance(e, ast.IfExp):
-            self.type_of(e.test)
+            self.check_truth_value(e.test)
             try:
                 return merge(self.type_of(e.body), self.type_of(e.orelse))
             except TypeError as exc:
@@ -344,8 +452,14 @@ class _Function:
             raise self.error(e, f"index {value!r} of a tuple of {len(t)}")
         return value % len(t)
 
+    def check_int_range(self, value: int, node):
+        if not C_INT_MIN <= value <= C_INT_MAX:
+            raise self.error(node, f"the int {value} is beyond C's int ({C_INT_MIN} .. {C_INT_MAX}); write it as a "
+                                   "float if it is one")
+
     def constant_type(self, value, node) -> Type:
         if isinstance(value, bool) or isinstance(value, int):
+            self.check_int_range(int(value), node)
             return INT
         if isinstance(value, float):
             return DOUBLE
@@ -356,17 +470,21 @@ class _Function:
         if e.keywords:
             raise self.error(e, "keyword arguments")
         f = e.func
-        if isinstance(f, ast.Attribute) and isinstance(f.value, ast.Name) and f.value.id == "math":
-            if f.attr in MATH_FUNCTIONS or f.attr in ("ceil", "isfinite"):
+        if isinstance(f, ast.Attribute) and self.math_module(f.value):
+            if f.attr in MATH_FUNCTIONS or f.attr in MATH_INT_FUNCTIONS:
                 return "math", f.attr
-            raise self.error(e, f"math.{f.attr}")
+            raise self.error(e, f"math.{f.attr} is not translated; only {SUPPORTED_CALLS}")
         if isinstance(f, ast.Name) and f.id not in self.locals:
             value = self.global_value(f.id, e)
-            if value in (abs, min, max, int, float):
+            if f.id in BUILTINS and value is BUILTINS[f.id]:
                 return "builtin", f.id
-            if callable(value):
+            if any(value is member for member in vars(math).values()):
+                raise self.error(e, f"{f.id} is math.{getattr(value, '__name__', f.id)} imported by name; write "
+                                    f"math.{getattr(value, '__name__', f.id)} (import math)")
+            if isinstance(getattr(value, "py_func", value), types.FunctionType):
                 return "kernel", value
-        raise self.error(e, f"call of {ast.unparse(f)}")
+            raise self.error(e, f"call of {f.id} ({type(value).__name__}); only {SUPPORTED_CALLS}")
+        raise self.error(e, f"call of {ast.unparse(f)}; only {SUPPORTED_CALLS}")
 
     def call_type(self, e: ast.Call) -> Type:
         kind, what = self.callee(e)
@@ -389,7 +507,10 @@ class _Function:
             if what == "abs":
                 return arguments[0]
             return INT if arguments == [INT, INT] else DOUBLE
-        return self.translation.function(what, tuple(arguments)).return_type
+        callee = self.translation.function(what, tuple(arguments))
+        if callee.return_type is None:
+            raise self.error(e, f"{what.__name__} calls itself (recursion is not translated)")
+        return callee.return_type
 
     # ------------------------------------------------------------------ C
     def prototype(self) -> str:
@@ -488,7 +609,10 @@ class _Function:
             if isinstance(element, ast.Tuple):
                 lines += self.unpack(element, f"{source}.f{i}", element_type, pad)
             elif element.id in self.read:
-                cast = self.cast(f"{source}.f{i}", element_type, self.locals[element.id])
+                try:
+                    cast = self.cast(f"{source}.f{i}", element_type, self.locals[element.id])
+                except TypeError as exc:
+                    raise self.error(element, str(exc)) from None
                 lines.append(f"{pad}{self.c_name(element.id)} = {cast};")
         return lines
 
