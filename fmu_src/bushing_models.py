@@ -6,7 +6,11 @@ model is adding such a module; this registry, the FMUs, parameter files, the fit
 - ``proposed``: the paper's model, eqs. 1-5, 16 parameters (``proposed_model``);
 - ``spencer``: Spencer et al. (1997), Fig. 7 of the paper (``spencer_model``);
 - ``single_bouc_wen``: the classic single Bouc-Wen element, Fig. 6 of the paper (``single_bouc_wen_model``;
-  ``bouc_wen``, its earlier name, is accepted as an alias in files and on the command line);
+  ``bouc_wen`` is accepted as an alias in files and on the command line);
+- ``berg``: Berg (1998), a progressive spring, Berg's rate-independent friction and two Maxwell
+  elements, for filled rubber (``berg_model``);
+- ``fractional``: the same spring and friction with a fractional-derivative element b*D^alpha x
+  (Sjoberg and Kari 2002), realised by 20 Maxwell elements and a dashpot (``fractional_model``);
 - ``kelvin_voigt``: the linear bushing of ADAMS/RecurDyn, one axis (``kelvin_voigt_model``).
 """
 from __future__ import annotations

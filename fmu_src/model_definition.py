@@ -135,6 +135,12 @@ class SearchBox:
 
 @dataclass(frozen=True)
 class BushingModel:
+    """One bushing model: its names, parameters (paper units, N-mm-s), FMU states and the
+    kernels that every path runs (the pythonfmu FMU, numba, the native FMU's C). Each model
+    module defines one as ``MODEL``; ``fmu_src.bushing_models.get_model(name)`` finds it.
+    The kernels' conventions (arguments, units, status codes) are those of
+    ``docs/adding_a_model.md``; ``step`` (bound when the model is defined) is the step protocol
+    ``integration.step`` over them."""
     name: str                    # command-line name: proposed, spencer, berg, ... (bushing_models)
     identifier: str              # FMI modelIdentifier and the "model" of parameter files
     title: str

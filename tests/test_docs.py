@@ -23,7 +23,8 @@ def _importable(module: str) -> bool:
 
 
 def _require_docs_tools():
-    missing = [module for module in ("mkdocs", "material", "mkdocstrings", "mkdocstrings_handlers.python")
+    missing = [module for module in ("mkdocs", "material", "mkdocstrings", "mkdocstrings_handlers.python",
+                                     "pymdownx", "latex2mathml")
                if not _importable(module)]
     if missing:
         pytest.skip(f"{DOCS_EXTRA}: {', '.join(missing)} not importable")
@@ -60,6 +61,35 @@ def test_mkdocs_builds_strict(tmp_path):
     assert run.returncode == 0, f"mkdocs build --strict failed:\n{run.stdout}\n{run.stderr}"
     assert (tmp_path / "site" / "index.html").exists()
     assert (tmp_path / "site" / "api" / "index.html").exists()
+    _check_api_page((tmp_path / "site" / "api" / "index.html").read_text(encoding="utf-8"))
+    for page in ("models", "numerics"):
+        _check_equations(page, (tmp_path / "site" / page / "index.html").read_text(encoding="utf-8"))
+    assert not list((tmp_path / "site").rglob("*.py")), "the docs' hooks are copied into the site"
+
+
+API_OBJECTS = ("identification.fit", "identification.FitResult", "identification.compare.compare_models",
+               "identification.compare.recommend", "identification.fleet.fit_many",
+               "identification.simulate.simulate", "identification.predict.predict", "identification.characterise",
+               "identification.kdyn_table.KdynTable", "identification.load_measurement", "identification.training_tests",
+               "fmu_src.parameter_files.read_parameter_set", "fmu_src.parameter_files.save_parameters",
+               "build_fmu.build_fmu", "build_fmu.build_native_fmu", "fmu_src.model_definition.BushingModel",
+               "fmu_src.bushing_models.get_model")
+
+
+def _check_api_page(html: str) -> None:
+    """Each public object under its own heading, followed by its signature."""
+    for name in API_OBJECTS:
+        heading = re.search(rf'<h[2-5] id="{re.escape(name)}"[^>]*>.*?</h[2-5]>\s*(<div class="doc-signature)?', html, re.S)
+        assert heading, f"the API reference has no heading for {name}"
+        if not name.endswith(("FitResult", "KdynTable", "BushingModel")):   # functions: the signature follows
+            assert heading.group(1), f"the API reference shows no signature under {name}'s heading"
+
+
+def _check_equations(page: str, html: str) -> None:
+    """The page's equations are MathML made at build time: no TeX left, no script from elsewhere."""
+    assert html.count("<math") >= 20, f"{page}: its equations are not rendered"
+    assert "\\(" not in html and "\\[" not in html, f"{page}: an equation is left as TeX"
+    assert not re.search(r"<script[^>]+src=\"https?:", html), f"{page}: a script from the network"
 
 
 def test_every_nav_page_exists_and_every_page_is_in_the_nav():
@@ -71,6 +101,32 @@ def test_every_nav_page_exists_and_every_page_is_in_the_nav():
     assert not missing, f"nav pages missing from docs/: {missing}"
     pages = sorted(path.relative_to(DOCS).as_posix() for path in DOCS.rglob("*.md"))
     assert sorted(nav) == pages, f"pages not in the nav: {sorted(set(pages) - set(nav))}"
+
+
+def test_nav_is_grouped_with_models_before_identification():
+    config = _config()
+    sections = [next(iter(entry)) for entry in config["nav"]]
+    assert sections == ["Getting started", "FMU", "Models", "Identification", "Reference", "Development"]
+    assert _nav_pages(config["nav"]).index("models.md") < _nav_pages(config["nav"]).index("identification.md")
+    plugins = [next(iter(p)) if isinstance(p, dict) else p for p in config["plugins"]]
+    assert "search" in plugins and "mkdocstrings" in plugins
+
+
+def test_mathml_hook_converts_inline_and_display_tex():
+    _require_docs_tools()
+    spec = importlib.util.spec_from_file_location("docs_mathml_hook", DOCS / "hooks" / "mathml.py")
+    hook = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(hook)
+
+    class Page:
+        class file:
+            src_uri = "models.md"
+
+    html = ('<p>a <span class="arithmatex">\\(x &lt; y\\)</span> b</p>'
+            '<div class="arithmatex">\\[\n\\dot{z} = A \\dot{x}\n\\]</div>')
+    out = hook.on_page_content(html, Page, None, None)
+    assert out.count("<math") == 2 and 'display="block"' in out and "\\(" not in out
+    assert "&#x0003C;" in out or "&lt;" in out   # the escaped < is read as <, written as MathML
 
 
 def test_readme_is_a_front_page():
