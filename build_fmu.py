@@ -1,5 +1,8 @@
 """Build a bushing FMU: ``python build_fmu.py [--model NAME] [--params FILE] [--out DIR] [--native
-[--fmi-version 2|3]]``.
+[--fmi-version 2|3]]``; or the release bundle: ``python build_fmu.py --release [--out DIR]
+[--allow-missing-platforms]`` (:func:`build_release`: every model's native FMU, FMI 2 and 3, linux64 and
+win64, with its default set; the sets as ``.ssv``, README.txt, SHA256SUMS), which a user without a
+compiler applies a parameter set to as start values.
 
 Writes ``DIR/<identifier>.fmu`` (FMI 2.0 co-simulation, pythonfmu; with ``--native``: compiled C,
 FMI 2.0 or 3.0, co-simulation and model exchange, see ``fmu_src/native``) of the model NAME
@@ -34,7 +37,9 @@ import json
 import shutil
 import sys
 import tempfile
+import time
 import zipfile
+from dataclasses import dataclass, field
 from pathlib import Path
 from xml.dom.minidom import parseString
 from xml.etree import ElementTree as ET
@@ -48,7 +53,7 @@ from fmu_src import __version__, bushing_params  # noqa: E402
 from fmu_src.axes import ONE_AXIS, SIX_AXIS_IDENTIFIER  # noqa: E402
 from fmu_src.bushing_models import MODEL_CHOICES, MODEL_NAMES, get_model  # noqa: E402
 from fmu_src.parameter_files import (parameter_document, read_parameter_set, read_six_axis,  # noqa: E402
-                                     six_axis_document)
+                                     save_parameters, save_six_axis, six_axis_document)
 
 
 PACKED_LIBRARY_INIT = '''"""Packed library of the bushing FMU (written by build_fmu.py)."""
@@ -300,11 +305,210 @@ def _add_model_structure(root: ET.Element, axes) -> None:
         ET.SubElement(initial, "Unknown", index=index[axis.output])
 
 
+# ---------------------------------------------------------------------------- the release bundle
+RELEASE_FMI_VERSIONS = (2, 3)
+RELEASE_DIR = Path("dist") / "release"
+CHECKSUMS = "SHA256SUMS"
+README = "README.txt"
+
+
+def release_models() -> tuple[str, ...]:
+    """What a release bundle carries: every one-axis model, then the six-axis FMU."""
+    return (*MODEL_NAMES, SIX_AXIS)
+
+
+def release_fmu_name(model: str, fmi_version: int) -> str:
+    """``BoucWenBushing-fmi2.fmu``: the FMU's identifier and FMI version."""
+    return f"{_identifier(model)}-fmi{fmi_version}.fmu"
+
+
+def release_parameter_name(model: str) -> str:
+    """``BoucWenBushing-default.ssv``: the default parameter set of ``model``'s FMUs."""
+    return f"{_identifier(model)}-default.ssv"
+
+
+def _identifier(model: str) -> str:
+    return SIX_AXIS_IDENTIFIER if model in (SIX_AXIS, SIX_AXIS_IDENTIFIER) else get_model(model).identifier
+
+
+@dataclass
+class ReleaseBundle:
+    """What :func:`build_release` wrote into ``folder``."""
+    folder: Path
+    fmus: dict[tuple[str, int], Path] = field(default_factory=dict)      # (model, FMI version) -> FMU
+    parameter_files: dict[str, Path] = field(default_factory=dict)       # model -> its default set (.ssv)
+    platforms: dict[int, list[str]] = field(default_factory=dict)        # FMI version -> binaries in every FMU
+    missing: dict[int, dict[str, str]] = field(default_factory=dict)     # FMI version -> {platform: why}
+    readme: Path | None = None
+    checksums: Path | None = None
+    seconds: float = 0.0
+
+    @property
+    def files(self) -> list[Path]:
+        """Every file of the bundle, the checksum list last."""
+        return [*self.fmus.values(), *self.parameter_files.values(), self.readme, self.checksums]
+
+
+def _missing_text(missing: dict[int, dict[str, str]]) -> str:
+    return "; ".join(f"{platform} (FMI {version}): {why}" for version, platforms in missing.items()
+                     for platform, why in platforms.items())
+
+
+def build_release(out_dir: str | Path = RELEASE_DIR, allow_missing_platforms: bool = False,
+                  models: tuple[str, ...] | None = None,
+                  fmi_versions: tuple[int, ...] = RELEASE_FMI_VERSIONS) -> ReleaseBundle:
+    """Build the release bundle: the native FMU of every model (FMI 2 and 3, linux64 and win64
+    binaries and the C sources in each, the model's default parameter set as start values), the
+    default sets as SSP 1.0 ``.ssv``, ``README.txt`` and ``SHA256SUMS`` (``sha256sum -c``).
+
+    The FMUs' parameters are start values, so one binary per model serves every parameter set:
+    a user without a compiler applies a fitted set to the bundle's FMU (fmpy's
+    ``simulate_fmu(start_values=...)``, or the host's SSP import of a ``.ssv``).
+
+    Parameters
+    ----------
+    out_dir : str or Path
+        Directory of the bundle (created if missing; the bundle's files in it are replaced, once
+        every FMU is built).
+    allow_missing_platforms : bool
+        Build without a platform whose compiler is missing (the README and ``missing`` say which)
+        instead of refusing.
+    models : tuple of str, optional
+        The models (default: :func:`release_models`, every one); fewer only for tests.
+    fmi_versions : tuple of int
+        Default 2 and 3.
+
+    Returns
+    -------
+    ReleaseBundle
+
+    Raises
+    ------
+    BuildError
+        A platform's compiler is missing (and not ``allow_missing_platforms``), or no platform
+        can be built at all; an FMU fails fmpy's validation.
+    """
+    from fmu_src.native.build import NO_COMPILER, missing_platforms, platform_compilers
+    started = time.perf_counter()
+    models = tuple(models or release_models())
+    missing = {version: why for version in fmi_versions if (why := missing_platforms(version))}
+    if any(len(why) == len(platform_compilers(version)) for version, why in missing.items()):
+        raise BuildError(f"no platform could be built: {_missing_text(missing)}; {NO_COMPILER}")
+    if missing and not allow_missing_platforms:
+        raise BuildError(f"a release bundle carries every platform, and {_missing_text(missing)}; install the "
+                         "compiler, or give --allow-missing-platforms to make a bundle without them")
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    bundle = ReleaseBundle(out_dir, missing=missing)
+    with tempfile.TemporaryDirectory(prefix="bushing_release_") as stage:
+        stage = Path(stage)
+        staged = {}
+        for model in models:
+            default = default_parameter_file(model)
+            name = release_parameter_name(model)
+            _write_default_ssv(default, model, stage / name)
+            staged[name] = ("ssv", model, default)
+            for version in fmi_versions:
+                build = build_native_fmu(default, stage / f"fmi{version}", model, version)
+                fmu = release_fmu_name(model, version)
+                build.path.rename(stage / fmu)
+                staged[fmu] = ("fmu", model, version)
+                bundle.platforms[version] = build.platforms
+        (stage / README).write_text(_release_readme(staged, bundle), encoding="utf-8")
+        names = sorted(staged, key=lambda n: (staged[n][0] != "fmu", n)) + [README]
+        lines = [f"{hashlib.sha256((stage / name).read_bytes()).hexdigest()}  {name}\n" for name in names]
+        (stage / CHECKSUMS).write_text("".join(lines), encoding="utf-8")
+        for name in [*names, CHECKSUMS]:
+            target = out_dir / name
+            shutil.move(stage / name, target)
+            kind, model, detail = staged.get(name, (None, None, None))
+            if kind == "fmu":
+                bundle.fmus[model, detail] = target
+            elif kind == "ssv":
+                bundle.parameter_files[model] = target
+        bundle.readme, bundle.checksums = out_dir / README, out_dir / CHECKSUMS
+    bundle.seconds = time.perf_counter() - started
+    return bundle
+
+
+def _write_default_ssv(default: Path, model: str, path: Path) -> None:
+    if model in (SIX_AXIS, SIX_AXIS_IDENTIFIER):
+        six = read_six_axis(default)
+        save_six_axis(path, {axis: (one.model.identifier, one.parameters) for axis, one in six.axes.items()})
+    else:
+        save_parameters(path, read_parameter_set(default, model).parameters, model)
+
+
+def _release_readme(staged: dict, bundle: ReleaseBundle) -> str:
+    fmus = [(name, model, version) for name, (kind, model, version) in staged.items() if kind == "fmu"]
+    sets = [(name, model, default) for name, (kind, model, default) in staged.items() if kind == "ssv"]
+    width = max(len(name) for name in staged) + 2
+
+    def title(model: str) -> str:
+        return "six uncoupled axes, each one of the models" if model == SIX_AXIS else get_model(model).title
+
+    example_fmu = fmus[0][0]
+    text = [
+        f"boucwen-bushing {__version__}: native bushing FMUs",
+        "=" * (len(__version__) + 37),
+        "",
+        "Compiled C FMUs of the rubber-bushing models, made by `python build_fmu.py --release`:",
+        "co-simulation and model exchange in one FMU, needsExecutionTool=false (no Python in the host).",
+        "Every FMU carries binaries for",
+        *(f"    FMI {version}: {', '.join(names)}" for version, names in bundle.platforms.items()),
+        "and its C sources (sources/), from which an FMI tool builds it for another platform.",
+        "Inputs x [m] and v [m/s] (rotational axes: rad, rad/s), output F [N] (moments: N.m).",
+        "",
+    ]
+    if bundle.missing:
+        text += ["MISSING PLATFORMS: this bundle was made without",
+                 *(f"    {platform} (FMI {version}): {why}" for version, platforms in bundle.missing.items()
+                   for platform, why in platforms.items()),
+                 "Rebuild it where that compiler is installed for a complete bundle.", ""]
+    text += ["Files", "-----", ""]
+    text += [f"{name:<{width}}{title(model)}; FMI {version}.0" for name, model, version in fmus]
+    text += [f"{name:<{width}}default parameter set of its FMUs (SSP 1.0 ParameterValues; {default.name})"
+             for name, model, default in sets]
+    text += [f"{README:<{width}}this file",
+             f"{CHECKSUMS:<{width}}SHA-256 of every file above: check with `sha256sum -c {CHECKSUMS}`",
+             "",
+             "Applying a parameter set (a fit, a set of your own)",
+             "---------------------------------------------------",
+             "",
+             "The FMUs' parameters are start values: one binary per model serves every parameter set, and",
+             "no compiler is needed. The values are in the project's units (N, mm, s; rotational axes of the",
+             "six-axis FMU in N.mm, rad, s), named as in the .ssv files. Write a fitted set as .ssv with",
+             "`bushing-identify fit ... --ssv fit.ssv` (six axes: `bushing-identify assemble --out six.ssv`),",
+             "then:",
+             "",
+             "- fmpy:",
+             "      from fmpy import simulate_fmu",
+             "      from fmu_src.parameter_files import load_parameters",
+             f"      result = simulate_fmu(\"{example_fmu}\", start_values=load_parameters(\"fit.ssv\"),",
+             "                            input=signals, output=[\"F\"], step_size=1e-3, stop_time=1.0)",
+             "  (for six axes: read_six_axis(\"fit.ssv\").flat()). Without the project installed, read the",
+             "  .ssv's <ssv:Real value=...> of each <ssv:Parameter name=...> into the start_values dict.",
+             "- A host that imports SSP parameter values: load the .ssv as the FMU instance's parameter",
+             "  values.",
+             "- Any other FMI host: set each parameter's start value (fmi2SetReal / fmi3SetFloat64 before",
+             "  the exit of initialization mode).",
+             "",
+             "An invalid value is refused at the exit of initialization mode (fmi2Error / fmi3Error), the",
+             "log naming the parameter, its value, unit and allowed range.",
+             "Each *-default.ssv holds its FMUs' own start values: a template for a set of your own.",
+             "",
+             "With a C compiler, `python build_fmu.py --native --params fit.ssv` builds an FMU whose",
+             "defaults are that set instead.",
+             ""]
+    return "\n".join(text)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
         prog="bushing-build-fmu",
         description="Build a bushing FMU (pythonfmu, FMI 2.0 co-simulation; or --native: compiled C, FMI 2.0 "
-                    "or 3.0, co-simulation and model exchange) with a parameter set as its start values.")
+                    "or 3.0, co-simulation and model exchange) with a parameter set as its start values; or "
+                    "--release: the release bundle of native FMUs.")
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     parser.add_argument("--model", choices=(*MODEL_CHOICES, SIX_AXIS), metavar="MODEL",
                         help=f"{', '.join(MODEL_NAMES)} or {SIX_AXIS} (six uncoupled axes, each one of the models); "
@@ -313,35 +517,56 @@ def main(argv: list[str] | None = None) -> int:
                                          "(paper N-mm-s units); default: the paper's Table 5 for the "
                                          "proposed model, data/params_<model>_fit_synthetic_table5.json for the "
                                          f"others, data/{SIX_AXIS_DEFAULT_FILE} for six_axis")
-    parser.add_argument("--out", default="dist", help="output directory (default: dist/ in the working directory)")
+    parser.add_argument("--out", help="output directory (default: dist/ in the working directory; "
+                                      f"with --release: {RELEASE_DIR}/)")
     parser.add_argument("--native", action="store_true",
                         help="build the native FMU: compiled C, co-simulation and model exchange, no Python in the "
                              "host (linux64 with the system's C compiler, win64 where mingw-w64 is installed)")
-    parser.add_argument("--fmi-version", type=int, choices=(2, 3), default=2,
+    parser.add_argument("--fmi-version", type=int, choices=(2, 3),
                         help="FMI version of the native FMU (default 2; the pythonfmu FMU is FMI 2 only)")
+    parser.add_argument("--release", action="store_true",
+                        help="build the release bundle: the native FMU of every model, FMI 2 and 3, linux64 and "
+                             "win64 binaries and sources in each, each with its default parameter set; the "
+                             f"default sets as .ssv, {README} and {CHECKSUMS}. Its parameters are start values: "
+                             "one binary per model serves every parameter set, no compiler needed to apply one")
+    parser.add_argument("--allow-missing-platforms", action="store_true",
+                        help="with --release: make the bundle without a platform whose compiler is missing "
+                             "(the README names it) instead of refusing")
     args = parser.parse_args(argv)
     from fmu_src.native.build import NativeBuildError
+    if args.release and (args.model or args.params or args.fmi_version or args.native):
+        parser.error("--release builds every model, FMI 2 and 3, with its default parameter set: it takes "
+                     "no --model, --params, --fmi-version or --native")
+    if args.allow_missing_platforms and not args.release:
+        parser.error("--allow-missing-platforms goes with --release")
+    out = args.out or (RELEASE_DIR if args.release else "dist")
     try:
+        if args.release:
+            bundle = build_release(out, args.allow_missing_platforms)
+            if bundle.missing:
+                print(f"warning: the bundle has no {_missing_text(bundle.missing)}", file=sys.stderr)
+            print(f"wrote {bundle.folder}: {len(bundle.fmus)} FMUs, {len(bundle.parameter_files)} parameter sets, "
+                  f"{README}, {CHECKSUMS} ({bundle.seconds:.0f} s)")
+            return 0
         if args.model is None:
             args.model = model_of_file(args.params) if args.params else "proposed"
         if args.native:
-            build = build_native_fmu(args.params, args.out, args.model, args.fmi_version)
+            build = build_native_fmu(args.params, out, args.model, args.fmi_version or 2)
             path = build.path
             for platform, why in build.skipped.items():
                 print(f"note: no {platform} binary: {why}", file=sys.stderr)
-        elif args.fmi_version != 2:
+        elif args.fmi_version not in (None, 2):
             raise BuildError("--fmi-version 3 needs --native (pythonfmu builds FMI 2.0 FMUs only)")
         else:
-            path = build_fmu(args.params, args.out, args.model)
+            path = build_fmu(args.params, out, args.model)
     except (bushing_params.ParameterError, BuildError, NativeBuildError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     except OSError as exc:   # an output directory that cannot be made or written
-        print(f"error: --out {args.out}: {exc.strerror or exc}", file=sys.stderr)
+        print(f"error: --out {out}: {exc.strerror or exc}", file=sys.stderr)
         return 2
     print(f"wrote {path}")
     return 0
-
 
 if __name__ == "__main__":
     sys.exit(main())

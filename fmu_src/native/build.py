@@ -19,6 +19,7 @@ import shutil
 import subprocess
 import tempfile
 import zipfile
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -35,6 +36,12 @@ FLAGS = ("-O3", "-fPIC", "-ffp-contract=off", "-fvisibility=hidden")
 -fvisibility=hidden: only the FMI functions are exported."""
 MINGW = "x86_64-w64-mingw32-gcc"
 PLATFORMS = {2: {"linux64": ".so", "win64": ".dll"}, 3: {"x86_64-linux": ".so", "x86_64-windows": ".dll"}}
+
+
+NO_COMPILER = ("without a compiler, use a release bundle's FMU (python build_fmu.py --release on a machine with gcc "
+               "and mingw-w64, or the project's release page) and apply your parameters as start values")
+"""What the build's error says when no platform can be compiled here: one binary per model serves
+every parameter set, since the parameters are start values."""
 
 
 class NativeBuildError(RuntimeError):
@@ -85,20 +92,46 @@ def compile_binary(sources: Path, identifier: str, target: Path, compiler: str, 
         raise NativeBuildError(f"{compiler} failed on {identifier}.c:\n{result.stderr[-4000:]}")
 
 
+def platform_compilers(fmi_version: int) -> dict[str, str]:
+    """The compiler of each binary platform of an FMI ``fmi_version`` FMU: linux64 the system's
+    ``cc`` (or ``$CC``), win64 mingw-w64 (FMI 3: x86_64-linux, x86_64-windows)."""
+    if fmi_version not in (2, 3):
+        raise NativeBuildError(f"FMI version {fmi_version}: give 2 or 3")
+    native = os.environ.get("CC", "cc")
+    return dict(zip(PLATFORMS[fmi_version], (native, MINGW)))
+
+
+def missing_platforms(fmi_version: int, platforms: tuple[str, ...] | None = None) -> dict[str, str]:
+    """{platform: why it cannot be built here} of ``platforms`` (default: every platform) of an FMI
+    ``fmi_version`` FMU; empty when every compiler is installed."""
+    compilers = platform_compilers(fmi_version)
+    missing = {}
+    for platform in platforms or compilers:
+        if platform not in compilers:
+            raise NativeBuildError(f"unknown platform {platform!r} for FMI {fmi_version}; "
+                                   f"choose from {', '.join(compilers)}")
+        compiler = compilers[platform]
+        if shutil.which(compiler) is None:
+            missing[platform] = (f"{compiler} is not installed" + (
+                " (Debian: apt-get install gcc-mingw-w64-x86-64)" if compiler == MINGW else ""))
+    return missing
+
+
 def build_native(axis_models, identifier: str, out_dir: str | Path, fmi_version: int = 2,
                  platforms: tuple[str, ...] | None = None) -> NativeBuild:
     """Write ``out_dir/<identifier>.fmu``, a native FMU (FMI ``fmi_version``, co-simulation and
     model exchange) of the axes ``axis_models`` [(axes.Axis, model on that axis, parameters)].
     ``platforms``: default every platform whose compiler is here (linux64 with the system's
     ``cc``, win64 with mingw-w64); the result says which were skipped and why."""
-    if fmi_version not in (2, 3):
-        raise NativeBuildError(f"FMI version {fmi_version}: give 2 or 3")
-    compilers = {2: {"linux64": os.environ.get("CC", "cc"), "win64": MINGW},
-                 3: {"x86_64-linux": os.environ.get("CC", "cc"), "x86_64-windows": MINGW}}[fmi_version]
+    compilers = platform_compilers(fmi_version)
     wanted = list(platforms or compilers)
     out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
     build = NativeBuild(out_dir / f"{identifier}.fmu")
+    build.skipped = missing_platforms(fmi_version, tuple(wanted))
+    if len(build.skipped) == len(wanted):
+        raise NativeBuildError("no platform could be built: " + "; ".join(
+            f"{p}: {why}" for p, why in build.skipped.items()) + f"; {NO_COMPILER}")
+    out_dir.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="bushing_native_") as stage:
         stage = Path(stage)
         sources = stage / "sources"
@@ -110,22 +143,18 @@ def build_native(axis_models, identifier: str, out_dir: str | Path, fmi_version:
             xml = model_description.fmi3(axis_models, identifier, generated.token)
             (sources / "buildDescription.xml").write_bytes(model_description.build_description(identifier))
         (stage / "modelDescription.xml").write_bytes(xml)
-        for platform in wanted:
-            if platform not in compilers:
-                raise NativeBuildError(f"unknown platform {platform!r} for FMI {fmi_version}; "
-                                       f"choose from {', '.join(compilers)}")
+        build.platforms = [platform for platform in wanted if platform not in build.skipped]
+
+        def compile_platform(platform: str) -> None:
             compiler = compilers[platform]
-            if shutil.which(compiler) is None:
-                build.skipped[platform] = (f"{compiler} is not installed" + (
-                    " (Debian: apt-get install gcc-mingw-w64-x86-64)" if compiler == MINGW else ""))
-                continue
             extra = ("-static-libgcc",) if compiler == MINGW else ()
             binary = stage / "binaries" / platform / f"{identifier}{PLATFORMS[fmi_version][platform]}"
             compile_binary(sources, identifier, binary, compiler, extra)
-            build.platforms.append(platform)
-        if not build.platforms:
-            raise NativeBuildError("no platform could be built: " + "; ".join(f"{p}: {why}"
-                                                                              for p, why in build.skipped.items()))
+
+        # the platforms' compilers run side by side (each its own process)
+        with ThreadPoolExecutor(max_workers=len(build.platforms)) as pool:
+            for done in [pool.submit(compile_platform, platform) for platform in build.platforms]:
+                done.result()
         with zipfile.ZipFile(build.path, "w", zipfile.ZIP_DEFLATED) as archive:
             for path in sorted(stage.rglob("*")):
                 if path.is_file():
