@@ -60,6 +60,22 @@ else:
 np = importlib.import_module("numpy") if STEP_AXES else None
 
 
+# Jumping inputs. The FMU takes x + v*(t - t_k) over a step; where the x set at a step's start
+# differs from where the state is (x_(k-1) + v_(k-1)*h), it takes the difference as a
+# displacement jump, which the dashpots carry. A jump "counts" where |x - x_state| exceeds
+# JUMP_RELATIVE*|v|*h + JUMP_FLOOR (kernel units: mm or rad); more than JUMP_COUNT counting
+# steps among an axis's last JUMP_WINDOW is a v that is not the derivative of the sampled x
+# (a measured velocity fed beside a measured displacement), warned about once per instance. A
+# smooth x(t_k) with v = dx/dt(t_k) jumps by x''*h^2/2 only: near reversals, at most 9 of 50
+# steps of a 10 Hz sine at 1 ms (24 at 30 Hz), none with v the secant. Logging only: the force
+# is the same. bushing_instance.c applies the same test (BW_JUMP_* in bushing_fmu.h).
+JUMP_RELATIVE = 0.1
+JUMP_FLOOR = 1e-6
+JUMP_WINDOW = 50
+JUMP_COUNT = 30
+_JUMP_MASK = (1 << JUMP_WINDOW) - 1
+
+
 class InitializationError(RuntimeError):
     """Start values with which the simulation cannot start (fmi2Fatal at the first doStep)."""
 
@@ -90,6 +106,7 @@ class _AxisState:
         self.last_errors = []          # the parameter errors of the last validation
         self.step_one = None           # the compiled step of this axis's model, if compiled
         self.params_row = None         # the parameters in force as an array (for step_one)
+        self.jump_history = 0          # bit i: the step i steps ago started with a jump (JUMP_*)
 
 
 class BushingSlave(Fmi2Slave):
@@ -119,6 +136,7 @@ class BushingSlave(Fmi2Slave):
         self._initial_state_pending = True  # set at exit of initialization, or first valid step
         self._parameters_changed = True     # some axis's parameters were set since the last check
         self._parameters_usable = False
+        self._jump_warned = False           # the jumping-inputs warning is given once per instance
         for variable in variables.fmu_variables(AXES):
             self._register(variable)
         self.log(STEP, Fmi2Status.ok, "logAll")
@@ -281,6 +299,11 @@ class BushingSlave(Fmi2Slave):
         for a, state, x_end, output in steps:
             if abs(output) > a.output_bound and not a.output_warned:
                 self._warn_implausible(a, output, current_time + step_size)
+            if not self._jump_warned:   # inline: it runs on every axis and step
+                jumped = abs(a.x_now - a.state_x) > JUMP_RELATIVE * (abs(a.v * a.to_kernel) * step_size) + JUMP_FLOOR
+                a.jump_history = ((a.jump_history << 1) | jumped) & _JUMP_MASK
+                if jumped and a.jump_history.bit_count() > JUMP_COUNT:
+                    self._warn_jumping(a, current_time, step_size)
             a.state = state
             a.state_x = a.x_now = x_end
             a.last_output = output
@@ -326,6 +349,24 @@ class BushingSlave(Fmi2Slave):
             for a, row in zip(group, out.tolist()):   # (*state, force, x + v*h)
                 steps.append((a, tuple(row[:-2]), row[-1], row[-2] * a.from_kernel))
         return steps
+
+    def _warn_jumping(self, a, current_time, step_size):
+        """Warn, once per instance, that more than JUMP_COUNT of the axis's last JUMP_WINDOW steps
+        started with a displacement jump (JUMP_*; this step is one of them, not yet committed)."""
+        mismatch = abs(a.x_now - a.state_x)
+        travel = abs(a.v * a.to_kernel) * step_size
+        count = a.jump_history.bit_count()
+        self._jump_warned = True
+        axis = a.axis
+        unit = axis.displacement_unit
+        self.log(f"{axis.label}the displacement input {axis.displacement} jumps in {count} of the last "
+                 f"{JUMP_WINDOW} steps (at t = {current_time:.6g} s by {mismatch / a.to_kernel:.3g} {unit} per "
+                 f"step against |{axis.velocity}|*h = {travel / a.to_kernel:.3g} {unit}): {axis.velocity} is "
+                 f"probably not d{axis.displacement}/dt of the sampled displacement, and the dashpots carry "
+                 f"every jump; build the input with identification.fmu_input (a continuous path, "
+                 f"{axis.velocity} = the secant velocity of {axis.displacement}) or set {axis.velocity} = "
+                 f"({axis.displacement}(t + h) - {axis.displacement}(t))/h",
+                 Fmi2Status.warning, "logStatusWarning")
 
     def _warn_implausible(self, a, output, time):
         """Warn, once per axis, of an output above the plausible bound (units most likely wrong)."""

@@ -56,6 +56,8 @@ typedef struct {
     int initialized;                 /* the exit of initialization mode succeeded */
     bw_log_function log;
     void *fmi_instance;              /* passed back to log */
+    unsigned long long jump_history[BW_AXES];   /* bit i: the step i steps ago started with a jump */
+    int jump_warned;                 /* the jumping-inputs warning is given once per instance */
 } bw_instance;
 
 /* ------------------------------------------------------------------------------- messages */
@@ -252,6 +254,8 @@ static void bw_reset(bw_instance *inst) {
     }
     inst->data.initial_state_pending = 1;
     inst->initialized = 0;
+    memset(inst->jump_history, 0, sizeof inst->jump_history);
+    inst->jump_warned = 0;
 }
 
 static void bw_set_initial_state(bw_instance *inst) {
@@ -442,6 +446,35 @@ static bw_status bw_refuse(bw_instance *inst, const char *format, ...) {
     return BW_DISCARD;
 }
 
+/* Record whether axis a's step starts with a displacement jump (BW_JUMP_*, before the step is
+   committed) and warn, once per instance, when more than BW_JUMP_COUNT of its last
+   BW_JUMP_WINDOW steps do (as bushing_slave.py's _count_jump). */
+static void bw_count_jump(bw_instance *inst, int a, double current_time, double h) {
+    const bw_axis_spec *spec = &bw_axis_specs[a];
+    const bw_axis *axis = &inst->data.axes[a];
+    double mismatch = fabs(axis->x_now - axis->state_x);
+    double travel = fabs(axis->v * spec->to_kernel) * h;
+    int jumped = mismatch > BW_JUMP_RELATIVE * travel + BW_JUMP_FLOOR;
+    unsigned long long bits;
+    int count = 0;
+    inst->jump_history[a] = ((inst->jump_history[a] << 1) | (unsigned long long)jumped)
+                            & ((1ULL << BW_JUMP_WINDOW) - 1ULL);
+    if (!jumped) return;
+    for (bits = inst->jump_history[a]; bits; bits &= bits - 1ULL) count++;
+    if (count > BW_JUMP_COUNT) {
+        const char *unit = spec->rotational ? "rad" : "m";
+        inst->jump_warned = 1;
+        bw_log(inst, BW_WARNING, "logStatusWarning", "%sthe displacement input %s jumps in %d of the last %d steps "
+               "(at t = %.6g s by %.3g %s per step against |%s|*h = %.3g %s): %s is probably not d%s/dt of the "
+               "sampled displacement, and the dashpots carry every jump; build the input with "
+               "identification.fmu_input (a continuous path, %s = the secant velocity of %s) or set %s = "
+               "(%s(t + h) - %s(t))/h", spec->label, spec->displacement, count, BW_JUMP_WINDOW, current_time,
+               mismatch / spec->to_kernel, unit, spec->velocity, travel / spec->to_kernel, unit, spec->velocity,
+               spec->displacement, spec->velocity, spec->displacement, spec->velocity, spec->displacement,
+               spec->displacement);
+    }
+}
+
 /* One communication step of every axis; a step that cannot succeed on any axis is refused
    (BW_DISCARD) and leaves every axis as it was. */
 static bw_status bw_do_step(bw_instance *inst, double current_time, double h) {
@@ -523,6 +556,7 @@ static bw_status bw_do_step(bw_instance *inst, double current_time, double h) {
                    x_port, spec->rotational ? "rad" : "m", spec->velocity, v_port, spec->rotational ? "rad/s" : "m/s",
                    spec->rotational ? "radians" : "metres");
         }
+        if (!inst->jump_warned) bw_count_jump(inst, a, current_time, h);
         memcpy(axis->state, states[a], sizeof axis->state);
         axis->state_x = axis->x_now = x_end[a];
         axis->last_output = outputs[a];
