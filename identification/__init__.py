@@ -35,10 +35,11 @@ The modules, in the order of the workflow:
   (the box), ``loop_start`` (starts from a slow loop), ``objectives`` (the misfit), ``multistart``
   (screening and least-squares stages),
   ``ensemble`` (how sure), ``engine`` (where tasks run), ``progress``, ``fleet`` (many bushings);
-- analysis: ``predict`` (force and band), ``dynamic_stiffness`` (data sheet), ``design`` (the next
+- analysis: ``predict`` (force and band), ``fmu_input`` (a measurement as an FMU's input), ``dynamic_stiffness`` (data sheet), ``design`` (the next
   test), ``sensitivity``, ``report`` (the paper's §5 tables), ``compare`` (fit every model, recommend one),
   ``six_axis`` (one file from six fits), ``plots``;
-- the command line: ``cli`` (arguments), ``commands`` (what each does), ``extras``, ``errors``.
+- the command line: ``cli`` (arguments), ``commands`` (what each does), ``interrupt`` (Ctrl-C and
+  SIGTERM: one line, exit 130/143, outputs whole or untouched), ``extras``, ``errors``.
 """
 from fmu_src.bushing_params import ParameterError
 from fmu_src.parameter_files import (ParameterEnsemble, ParameterSet, read_ensemble, read_parameter_set,
@@ -48,12 +49,14 @@ from identification.errors import IdentificationError
 from identification.extras import MissingExtraError
 from identification.fit_result import FitNotConvergedWarning, FitResult
 from identification.fitting import fit
+from identification.fmu_input import fmu_input, simulate_measurement
 from identification.measurements import MeasurementError, load_measurement
 from identification.predict import predict
 from identification.rig_tests import RigTest, load_manifest, training_tests
 from identification.simulate import simulate
 
 __all__ = ["fit", "FitResult", "FitNotConvergedWarning", "simulate", "predict", "characterise", "load_measurement",
+           "fmu_input", "simulate_measurement",
            "RigTest", "training_tests", "load_manifest",
            "read_parameter_set", "save_parameters", "read_ensemble", "save_ensemble", "ParameterSet", "ParameterEnsemble",
            "IdentificationError", "MeasurementError", "ParameterError", "MissingExtraError"]

@@ -2,12 +2,14 @@
 as they are parsed, and the dispatch to ``identification.commands``.
 
 A command whose extra is not installed, or whose arguments cannot be used, ends with one
-``error:`` line and exit status 2, before any work.
+``error:`` line and exit status 2, before any work. A command stopped by Ctrl-C or SIGTERM ends
+with one ``interrupted:`` line and exit status 130 or 143 (``identification.interrupt``).
 """
 from __future__ import annotations
 
 import argparse
 import os
+import signal
 import sys
 import warnings
 from pathlib import Path
@@ -20,7 +22,9 @@ from identification.dynamic_stiffness import DEFAULT_AMPLITUDES_MM, DEFAULT_FREQ
 from identification.engine import EngineError
 from identification.errors import IdentificationError
 from identification.extras import MissingExtraError, require
+from identification.interrupt import Interrupted, interrupted_message, signals_raise
 from identification.presets import PRESETS, describe
+from identification.progress import close_open_bars
 
 
 def positive_int(text: str) -> int:
@@ -60,7 +64,9 @@ def number_list(text: str) -> list[float]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the command line; return the exit status (0, or 2 for an input that cannot be used)."""
+    """Run the command line; return the exit status: 0, 2 for an input that cannot be used, 130
+    or 143 for a command stopped by SIGINT (Ctrl-C) or SIGTERM (``identification.interrupt``: one
+    line on stderr saying what was written, no worker process left behind)."""
     program = "bushing-identify" if Path(sys.argv[0]).name.startswith("bushing-identify") else "python -m identification"
     parser = argparse.ArgumentParser(prog=program,
                                      description="Identify the bushing model's parameters from measured tests.")
@@ -165,7 +171,7 @@ def main(argv: list[str] | None = None) -> int:
     characterise_parser.add_argument("--json", action="store_true", help="print a summary as JSON")
 
     args = parser.parse_args(argv)
-    with warnings.catch_warnings():
+    with warnings.catch_warnings(), signals_raise():
         # A user reads the warning, not where in our code it was raised.
         warnings.showwarning = lambda message, category, *rest, **keywords: commands.print_warning(str(message))
         try:
@@ -176,6 +182,12 @@ def main(argv: list[str] | None = None) -> int:
                 OSError) as exc:
             print(f"error: {exc}", file=sys.stderr)
             return 2
+        except KeyboardInterrupt as stop:
+            # Interrupted (SIGINT, SIGTERM); the engines stopped their workers on the way here
+            close_open_bars()
+            sys.stdout.flush()
+            print(interrupted_message(), file=sys.stderr)
+            return stop.exit_status if isinstance(stop, Interrupted) else 128 + signal.SIGINT
 
 
 COMMANDS = {"fit": commands.fit_command, "sensitivity": commands.sensitivity_command,

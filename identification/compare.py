@@ -20,7 +20,8 @@ Writes into the output directory: ``params_<model>.json`` per model (with proven
 ``comparison.csv`` (one row per model: everything above and whether it is the recommendation),
 ``validation.csv`` (NRMSE and eq. 10 per file and model), ``kdyn_errors.csv`` (per row of the
 table and model), one PNG per validation file (force over time and force-displacement loops) and
-one for the table. Prints the tables; the last line is ``recommended: <model>``.
+one for the table, each whole or not at all (``interrupt.writing``). Prints the tables; the last
+line is ``recommended: <model>``.
 """
 from __future__ import annotations
 
@@ -38,8 +39,9 @@ from fmu_src.bushing_models import get_model
 from identification.engine import make_engine
 from identification.fit_result import FLOOR_FACTOR, FitResult, TableFit, information_criterion
 from identification.fitting import FitNotConvergedWarning, fit, table_fit
+from identification.interrupt import writing
 from identification.kdyn_table import KDYN_UNCERTAINTY, LOSS_ANGLE_UNCERTAINTY_DEG, KdynTable
-from identification.measurements import load_measurement
+from identification.measurements import load_measurement, measurement_name
 from identification.objectives import nrmse, rms_level_error
 from identification.plots import plot_comparison, plot_table_comparison
 from identification.rig_tests import RigTest
@@ -152,7 +154,7 @@ def compare_models(models: Sequence[str], tests: Sequence[RigTest], validation_f
             errors[name, assessment.model] = (nrmse(predicted, m.force_N), rms_level_error(predicted, m.force_N))
             if name not in training_names:
                 assessment.validation[name] = errors[name, assessment.model]
-        plot_comparison(m, predictions, out_dir / f"compare_{Path(m.source).stem}.png")
+        plot_comparison(m, predictions, out_dir / f"compare_{measurement_name(m.source)}.png")
     if table is not None:
         plot_table_comparison(table, {a.model: a.table for a in assessments}, out_dir / f"compare_{table.name}.png")
     recommendation = recommend(assessments)
@@ -212,7 +214,7 @@ def format_table_errors(table: KdynTable, assessments: Sequence[Assessment]) -> 
 
 def _write_csvs(out_dir: Path, assessments, recommendation: Recommendation, errors: dict, table) -> None:
     best_bic = min(a.information_criterion for a in assessments)
-    with open(out_dir / "comparison.csv", "w", newline="") as handle:
+    with writing(out_dir / "comparison.csv") as temporary, open(temporary, "w", newline="") as handle:
         writer = csv.writer(handle)
         writer.writerow(["model", "free_parameters", "worst_nrmse_over_noise", "at_floor", "converged",
                          "misfit_chi2_per_residual", "residuals", "bic", "delta_bic", "held_out_mean_nrmse",
@@ -226,14 +228,14 @@ def _write_csvs(out_dir: Path, assessments, recommendation: Recommendation, erro
                              _cell(a.information_criterion - best_bic), _cell(a.validation_error),
                              _cell(a.table_error), _cell(kdyn), _cell(angle), f"{a.seconds:.1f}",
                              a.model == recommendation.model])
-    with open(out_dir / "validation.csv", "w", newline="") as handle:
+    with writing(out_dir / "validation.csv") as temporary, open(temporary, "w", newline="") as handle:
         writer = csv.writer(handle)
         writer.writerow(["file", "model", "nrmse", "eq10_rms_level_error"])
         for (name, model), (error, eq10) in errors.items():
             writer.writerow([name, model, f"{error:.6g}", f"{eq10:.6g}"])
     if table is not None:
         kept = table.weight > 0
-        with open(out_dir / "kdyn_errors.csv", "w", newline="") as handle:
+        with writing(out_dir / "kdyn_errors.csv") as temporary, open(temporary, "w", newline="") as handle:
             writer = csv.writer(handle)
             writer.writerow(["model", "amplitude_mm", "frequency_hz", "preload_mm", "kdyn_N_per_mm", "loss_angle_deg",
                              "kdyn_relative_error", "loss_angle_error_deg"])

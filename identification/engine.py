@@ -17,19 +17,32 @@ order) and, in worker processes, one numba thread (the cores are used by the pro
   ``dask scheduler`` on one machine and ``dask worker ADDRESS --nthreads 1`` on each core's
   worth of the others. A scheduler that does not answer, or has no workers, is an
   :class:`EngineError` after ``timeout_s``, not a hang.
+
+An engine is a context manager. Left normally, it closes (``close``: queued tasks cancelled, the
+running ones finished); left by an exception, a Ctrl-C or a SIGTERM (``identification.interrupt``)
+included, it stops at once (``abort``): nobody will read the results of its tasks, so local
+workers are terminated, not awaited, and a Dask client cancels this command's tasks and closes
+(the cluster's scheduler and workers stay). Local workers ignore SIGINT: Ctrl-C in a terminal
+reaches the whole process group, and the main process ends them.
 """
 from __future__ import annotations
 
+import contextlib
 import os
 from typing import Callable, Sequence
 
 import numpy as np
+
+from identification.interrupt import deferred, ignore_interrupts, interrupts_held
 
 CHUNKS_PER_WORKER = 4
 """Items are sent in about this many chunks per worker: fewer copies of ``shared``, still
 enough chunks to balance starts of unequal cost."""
 DEFAULT_TIMEOUT_S = 10.0
 POLL_S = 0.05
+ABORT_TIMEOUT_S = 3.0
+"""How long an aborting engine waits for a terminated worker to exit (then kills it), or for a
+Dask client to close."""
 
 
 class EngineError(RuntimeError):
@@ -79,13 +92,20 @@ class SerialEngine:
         return results
 
     def close(self):
-        pass
+        """Release the engine after its work is done."""
+
+    def abort(self):
+        """Stop now: tasks not yet finished are dropped, not awaited."""
+        self.close()
 
     def __enter__(self):
         return self
 
-    def __exit__(self, *exc):
-        self.close()
+    def __exit__(self, exc_type, exc, traceback):
+        if exc_type is None:
+            self.close()
+        else:
+            self.abort()
 
 
 class ProcessEngine(SerialEngine):
@@ -98,13 +118,16 @@ class ProcessEngine(SerialEngine):
             raise ValueError(f"a process engine needs 2 or more workers, not {workers}")
         self.workers = workers
         self.description = f"{workers} local processes"
-        self._pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"))
+        self._pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"),
+                                         initializer=ignore_interrupts)
 
     def map(self, function, items, shared=None, progress=None, each=None, chunk_size=None):
         from concurrent.futures import as_completed
         chunks = _chunks(items, -(-len(items) // chunk_size) if chunk_size else self.workers * CHUNKS_PER_WORKER)
         starts = np.cumsum([0] + [len(c) for c in chunks])
-        futures = {self._pool.submit(_run_chunk, function, shared, chunk, True): i for i, chunk in enumerate(chunks)}
+        with interrupts_held():    # the first submit starts the workers: see interrupts_held
+            futures = {self._pool.submit(_run_chunk, function, shared, chunk, True): i
+                       for i, chunk in enumerate(chunks)}
         results: list = [None] * len(chunks)
         for future in as_completed(futures):
             index = futures[future]
@@ -114,6 +137,27 @@ class ProcessEngine(SerialEngine):
 
     def close(self):
         self._pool.shutdown(cancel_futures=True)
+
+    def abort(self):
+        """Cancel the queued tasks and terminate the workers (SIGTERM, then SIGKILL after
+        ``ABORT_TIMEOUT_S``): a running task may take a minute, and its result is not wanted."""
+        if hasattr(self._pool, "terminate_workers"):     # Python 3.14
+            self._pool.terminate_workers()
+            processes = []
+        else:
+            # what terminate_workers does, through the pool's table of its processes
+            processes = list((self._pool._processes or {}).values())
+            self._pool.shutdown(wait=False, cancel_futures=True)
+            for process in processes:
+                process.terminate()
+        for process in processes:
+            process.join(ABORT_TIMEOUT_S)
+            if process.exitcode is None:
+                process.kill()
+                process.join(ABORT_TIMEOUT_S)
+        # the pool's manager thread sees its workers gone and ends: wait for it here, so
+        # that the interpreter's exit (which joins it) does not
+        self._pool.shutdown(wait=True, cancel_futures=True)
 
 
 class DaskEngine(SerialEngine):
@@ -133,11 +177,14 @@ class DaskEngine(SerialEngine):
             self._client = scheduler
         try:
             self._client.wait_for_workers(1, timeout=timeout_s)
+            threads = self._client.nthreads()
         except (OSError, TimeoutError):
             self.close()
             raise EngineError(f"the Dask scheduler at {self._client.scheduler.address} has no workers after "
                               f"{timeout_s:g} s; start some with `dask worker ADDRESS --nthreads 1`") from None
-        threads = self._client.nthreads()
+        except BaseException:    # Ctrl-C, SIGTERM while waiting: no engine to close later
+            self.abort()
+            raise
         if any(count > 1 for count in threads.values()):
             self.close()
             raise EngineError(f"the Dask workers of {scheduler!r} run {max(threads.values())} threads each; the fit "
@@ -149,15 +196,28 @@ class DaskEngine(SerialEngine):
         self.description = f"Dask cluster {self._client.scheduler.address} ({self.workers} workers)"
 
     def map(self, function, items, shared=None, progress=None, each=None, chunk_size=None):
-        shared_future = self._client.scatter(shared, broadcast=True, hash=False)
+        # A signal is held while ``shared`` (a few hundred kB) is scattered: interrupted half-way,
+        # the scatter would go on in the client's thread and leave a key this command cannot
+        # cancel, which the scheduler was seen to keep after the client had closed.
+        with deferred():
+            shared_future = self._client.scatter(shared, broadcast=True, hash=False)
         chunks = _chunks(items, -(-len(items) // chunk_size) if chunk_size else self.workers * CHUNKS_PER_WORKER)
         starts = np.cumsum([0] + [len(c) for c in chunks])
-        futures = [self._client.submit(_run_chunk, function, shared_future, chunk, True, pure=False)
-                   for chunk in chunks]
-        index = {future.key: i for i, future in enumerate(futures)}
-        for future in self._completed(futures):
-            _report(future.result(), int(starts[index[future.key]]), progress, each)
-        results = self._client.gather(futures)
+        futures = []
+        try:
+            for chunk in chunks:
+                futures.append(self._client.submit(_run_chunk, function, shared_future, chunk, True, pure=False))
+            index = {future.key: i for i, future in enumerate(futures)}
+            for future in self._completed(futures):
+                _report(future.result(), int(starts[index[future.key]]), progress, each)
+            results = self._client.gather(futures)
+        except BaseException:
+            # this command's tasks, not anybody else's: the cluster goes on serving its other
+            # clients. A client that has lost its scheduler cannot cancel, and has nothing there
+            # to cancel: the error to report is the one that brought us here.
+            with contextlib.suppress(Exception):
+                self._client.cancel(futures + [shared_future])
+            raise
         return [result for chunk in results for result in chunk]
 
     def _completed(self, futures):
@@ -182,6 +242,16 @@ class DaskEngine(SerialEngine):
     def close(self):
         if self._own_client:
             self._client.close()
+
+    def abort(self):
+        """Close this command's client within ``ABORT_TIMEOUT_S`` (its tasks were cancelled
+        by ``map``; the scheduler forgets what a closed client wanted); a client given by
+        the caller stays open."""
+        if self._own_client:
+            # the process is ending: a close that fails or times out is not worth a second error
+            # (the scheduler forgets a client whose connection closes)
+            with contextlib.suppress(Exception):
+                self._client.close(timeout=ABORT_TIMEOUT_S)
 
 
 def make_engine(workers: int | None = None, scheduler=None, timeout_s: float = DEFAULT_TIMEOUT_S):

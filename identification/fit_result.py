@@ -21,6 +21,7 @@ import numpy as np
 
 from fmu_src.parameter_files import ParameterSet, save_ensemble, save_parameters
 from identification.errors import IdentificationError
+from identification.interrupt import deferred, writing
 from identification.kdyn_table import FIT_CYCLES, KDYN_UNCERTAINTY, LOSS_ANGLE_UNCERTAINTY_DEG
 from identification.noise import NoiseEstimate
 from identification.objectives import MIN_NOISE_FRACTION
@@ -318,7 +319,8 @@ class FitResult:
         Returns
         -------
         list of Path
-            The files written.
+            The files written. Each is written beside its place and renamed into it: an
+            existing file is replaced whole or left as it was.
 
         Raises
         ------
@@ -331,12 +333,17 @@ class FitResult:
             raise IdentificationError(f"no ensemble to write to {ensemble}: this fit ran with ensemble=False "
                                       "(--no-ensemble); fit again without it for the ensemble")
         provenance = dict(self.provenance(), data=[str(d) for d in data])
-        written = [save_parameters(path, self.parameters.parameters, self.model, provenance)]
-        if ssv is not None:
-            written.append(save_parameters(ssv, self.parameters.parameters, self.model))
-        if ensemble is not None:
-            written.append(save_ensemble(ensemble, self.ensemble, self.model, provenance))
-        return written
+        # each file whole or not at all, and a Ctrl-C or SIGTERM held until the set is written
+        with deferred():
+            with writing(path) as temporary:
+                save_parameters(temporary, self.parameters.parameters, self.model, provenance)
+            if ssv is not None:
+                with writing(ssv) as temporary:
+                    save_parameters(temporary, self.parameters.parameters, self.model)
+            if ensemble is not None:
+                with writing(ensemble) as temporary:
+                    save_ensemble(temporary, self.ensemble, self.model, provenance)
+        return [Path(file) for file in (path, ssv, ensemble) if file is not None]
 
 
 def agreeing_starts(records: list[StartRecord], stage: int, best_misfit: float, threshold: float) -> int:

@@ -24,6 +24,7 @@ optimum is exact, so only the floor is checked).
 """
 from __future__ import annotations
 
+import contextlib
 import time
 import warnings
 from dataclasses import replace
@@ -160,12 +161,11 @@ def fit(measurements, model: str = "proposed", preset: str = "default", seed: in
             settings = _settings(PRESETS[preset], screening, starts)
             owned = engine is None
             engine = engine or make_engine(workers, scheduler)
-            try:
+            # an engine made here is closed here, and aborted if the search is left by an exception
+            # (Ctrl-C, SIGTERM): see identification.engine
+            with engine if owned else contextlib.nullcontext():
                 result = _search(tests, noise, bushing.name, preset, settings, seed, engine, progress, started, table,
                                  ensemble)
-            finally:
-                if owned:
-                    engine.close()
     if not result.converged:
         warnings.warn(result.warning, FitNotConvergedWarning, stacklevel=2)
     return result

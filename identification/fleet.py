@@ -13,7 +13,9 @@ The measurements are read here and sent to the workers (which need no access to 
 bushing whose folder, data or fit fails for any reason is a row with its error (and the
 exception's type) in the summary, and the fleet goes on; if the engine itself fails (a worker
 process killed), the bushings not yet fitted get that error, and the summary is still written.
-One progress bar over the fleet.
+Stopped by Ctrl-C or SIGTERM, the fleet keeps the bushings' files already written and writes no
+summary. Every file is written whole or not at all (``interrupt.writing``). One progress bar
+over the fleet.
 """
 from __future__ import annotations
 
@@ -28,6 +30,7 @@ from fmu_src.bushing_models import MODEL_CHOICES
 from fmu_src.bushing_params import ParameterError
 from fmu_src.parameter_files import parameter_document
 from identification.engine import make_engine
+from identification.interrupt import writing
 from identification.measurements import MeasurementError
 from identification.progress import bar as progress_bar
 from identification.rig_tests import load_manifest
@@ -112,7 +115,8 @@ def fit_many(folder: str | Path, out_dir: str | Path, workers: int | None = None
         row, document = result
         rows[row.name] = row
         if document is not None:
-            (out_dir / f"{row.name}.json").write_text(json.dumps(document, indent=2) + "\n", encoding="utf-8")
+            with writing(out_dir / f"{row.name}.json") as temporary:
+                temporary.write_text(json.dumps(document, indent=2) + "\n", encoding="utf-8")
         if bar is not None:
             bar.update(1)
             bar.set_postfix_str(f"{row.name}: {'converged' if row.converged else 'NOT converged'}"
@@ -127,10 +131,12 @@ def fit_many(folder: str | Path, out_dir: str | Path, workers: int | None = None
             rows.setdefault(job.name, FleetRow(job.name, error=f"not fitted: the engine failed "
                                                                f"({type(exc).__name__}: {exc})"))
     finally:
+        # a KeyboardInterrupt (Ctrl-C, SIGTERM) passes the `except` above: the fleet stops
+        # without a summary, and an earlier run's summary.csv stays as it was
         if bar is not None:
             bar.close()
-        ordered = [rows.get(path.name, FleetRow(path.name, error="not fitted")) for path in bushings]
-        write_summary(out_dir / "summary.csv", ordered)
+    ordered = [rows.get(path.name, FleetRow(path.name, error="not fitted")) for path in bushings]
+    write_summary(out_dir / "summary.csv", ordered)
     return ordered
 
 
@@ -143,7 +149,7 @@ def _label(source: str, folder: Path) -> str:
 
 def write_summary(path: Path, rows: list[FleetRow]) -> Path:
     files = sorted({name for row in rows for name in row.nrmse})
-    with open(path, "w", newline="", encoding="utf-8") as stream:
+    with writing(path) as temporary, open(temporary, "w", newline="", encoding="utf-8") as stream:
         writer = csv.writer(stream)
         writer.writerow(["name", "misfit", "converged", *[f"nrmse_{name}" for name in files], "seconds", "error"])
         for row in rows:

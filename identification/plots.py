@@ -8,6 +8,7 @@ from typing import Sequence
 import numpy as np
 
 from fmu_src.bushing_models import get_model
+from identification.interrupt import writing
 from identification.measurements import Measurement
 from identification.objectives import nrmse
 
@@ -19,10 +20,14 @@ def _pyplot():
 
 
 def _save(figure, path) -> Path:
+    """Write ``figure`` as a PNG at ``path``, whole or not at all (``interrupt.writing``)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    figure.savefig(path, dpi=90)
-    _pyplot().close(figure)
+    try:
+        with writing(path) as temporary:
+            figure.savefig(temporary, dpi=90)   # the format from the suffix, which the temporary keeps
+    finally:
+        _pyplot().close(figure)
     return path
 
 

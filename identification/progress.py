@@ -7,8 +7,12 @@ bar. Without tqdm (the base install) there are no bars.
 from __future__ import annotations
 
 import sys
+import weakref
 
 from identification.presets import SearchSettings
+
+_open_bars = weakref.WeakSet()
+"""The bars made by :func:`bar` and not yet garbage (a closed bar's close() does nothing)."""
 
 
 def watched() -> bool:
@@ -31,7 +35,16 @@ def bar(total: int, description: str, unit: str, enabled: bool = True, leave: bo
         from tqdm import tqdm
     except ImportError:   # the base install: work goes on without a bar
         return None
-    return tqdm(total=total, desc=description, unit=unit, leave=leave, file=sys.stderr)
+    made = tqdm(total=total, desc=description, unit=unit, leave=leave, file=sys.stderr)
+    _open_bars.add(made)
+    return made
+
+
+def close_open_bars() -> None:
+    """Close every bar still drawn (a command interrupted in the middle of its work), so that the
+    next line on stderr starts on a line of its own."""
+    for open_bar in list(_open_bars):
+        open_bar.close()
 
 
 class SearchProgress:
