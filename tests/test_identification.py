@@ -262,7 +262,7 @@ def test_reduced_budget_fit_reaches_the_floor_through_the_cli_and_a_built_fmu(tm
 # -------------------------------------------------------------------- sensitivity and report
 def test_table5_sensitivity_ranks_agree_with_the_papers_tables_1_and_3():
     # The paper ranked the parameters in ADAMS (Tables 1 and 3); our implementation of
-    # eqs. 1-5 with Table 5 must rank them alike. Measured Spearman rho: 0.87, 0.84, 0.74.
+    # eqs. 1-5 with Table 5 must rank them alike (rho per measure: benchmarks/bench_sensitivity_ranks.py).
     from scipy.stats import spearmanr
     from identification.sensitivity import MEASURES, PAPER_RANKS, sensitivity
     table = sensitivity(paper_parameters("table5"))
