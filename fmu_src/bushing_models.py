@@ -59,3 +59,9 @@ def get_model(name: str) -> BushingModel:
             return model
     raise ParameterError(f"unknown model {name!r}; choose one of {', '.join(MODEL_NAMES)} "
                          f"(identifiers {', '.join(m.identifier for m in MODELS.values())})")
+
+
+def resolve_model(model: str | BushingModel) -> BushingModel:
+    """``model`` itself if it is a ``BushingModel``, else the model of that name (:func:`get_model`):
+    what a front door that takes either resolves once, to pass the model on."""
+    return model if isinstance(model, BushingModel) else get_model(model)

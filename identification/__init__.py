@@ -22,10 +22,14 @@ about a minute on two cores)::
 Units: s, mm, mm/s, N; parameters in the paper's N-mm-s units. With ``workers`` > 1 the fit
 starts worker processes: guard a script's top level with ``if __name__ == "__main__":``.
 
+A ``model`` (``fit``, ``simulate``, ``predict``, ``characterise``, ``compare.compare_models``) is a
+model's name or the model itself (a ``BushingModel``, ``fmu_src.bushing_models.get_model``):
+resolved once at the front door, the model object is what the modules below pass on.
+
 The modules, in the order of the workflow:
 
 - reading the tests: ``measurements`` (CSV files), ``rig_tests`` (which file is which test, the
-  manifest), ``kdyn_table`` (a supplier's dynamic-stiffness table), ``noise`` (each test's noise
+  manifest), ``kdyn_table`` (the dynamic-stiffness table's CSV file, read and written), ``noise`` (each test's noise
   level), ``protocols`` (the paper's test signals);
 - the forward model: ``simulate`` (the front door), ``parameter_input`` (what counts as
   parameters), ``forward_model`` (the input between samples), ``compiled_core`` and
@@ -39,18 +43,18 @@ The modules, in the order of the workflow:
   test), ``sensitivity``, ``report`` (the paper's §5 tables), ``compare`` (fit every model, recommend one),
   ``six_axis`` (one file from six fits), ``plots``;
 - the command line: ``cli`` (arguments), ``commands`` (what each does), ``interrupt`` (Ctrl-C and
-  SIGTERM: one line, exit 130/143, outputs whole or untouched), ``extras``, ``errors``.
+  SIGTERM: one line, exit 130/143, outputs whole or untouched), ``extras``, ``errors`` (every error
+  and warning type).
 """
 from fmu_src.bushing_params import ParameterError
 from fmu_src.parameter_files import (ParameterEnsemble, ParameterSet, read_ensemble, read_parameter_set,
                                      save_ensemble, save_parameters)
 from identification.dynamic_stiffness import characterise
-from identification.errors import IdentificationError
-from identification.extras import MissingExtraError
-from identification.fit_result import FitNotConvergedWarning, FitResult
+from identification.errors import FitNotConvergedWarning, IdentificationError, MeasurementError, MissingExtraError
+from identification.fit_result import FitResult
 from identification.fitting import fit
 from identification.fmu_input import fmu_input, simulate_measurement
-from identification.measurements import MeasurementError, load_measurement
+from identification.measurements import load_measurement
 from identification.predict import predict
 from identification.rig_tests import RigTest, load_manifest, training_tests
 from identification.simulate import simulate

@@ -19,9 +19,8 @@ from fmu_src.bushing_models import MODEL_CHOICES, MODEL_NAMES
 from fmu_src.bushing_params import ParameterError
 from identification import commands
 from identification.dynamic_stiffness import DEFAULT_AMPLITUDES_MM, DEFAULT_FREQUENCIES_HZ
-from identification.engine import EngineError
-from identification.errors import IdentificationError
-from identification.extras import MissingExtraError, require
+from identification.errors import EngineError, IdentificationError, MissingExtraError, UsageError
+from identification.extras import require
 from identification.interrupt import Interrupted, interrupted_message, signals_raise
 from identification.presets import PRESETS, describe
 from identification.progress import close_open_bars
@@ -178,7 +177,7 @@ def main(argv: list[str] | None = None) -> int:
             _require_extras(args)
             return COMMANDS[args.command](args)
         # OSError: a file that could not be read or written after all
-        except (IdentificationError, ParameterError, EngineError, commands.UsageError, MissingExtraError,
+        except (IdentificationError, ParameterError, EngineError, UsageError, MissingExtraError,
                 OSError) as exc:
             print(f"error: {exc}", file=sys.stderr)
             return 2

@@ -18,12 +18,9 @@ import numpy as np
 
 from fmu_src.bushing_models import MODEL_CHOICES, MODEL_NAMES, get_model
 from fmu_src.parameter_files import read_parameter_set
+from identification.errors import FitNotConvergedWarning, UsageError
 from identification.measurements import load_measurement
 from identification.rig_tests import load_manifest, training_tests
-
-
-class UsageError(Exception):
-    """A command-line option with a value that cannot be used."""
 
 
 def training_tests_of(args):
@@ -90,7 +87,7 @@ def print_warning(message: str) -> None:
 
 
 def fit_command(args) -> int:
-    from identification.fitting import FitNotConvergedWarning, fit
+    from identification.fitting import fit
     from identification.plots import plot_comparison, plot_waterfall
     from identification.simulate import simulate
 
@@ -105,7 +102,8 @@ def fit_command(args) -> int:
     model = args.model or manifest_model or "proposed"
     if model not in MODEL_CHOICES:
         raise UsageError(f"the manifest's model {model!r} is not one of {', '.join(MODEL_NAMES)}")
-    model = get_model(model).name          # an alias (bouc_wen) under its name
+    bushing = get_model(model)             # resolved once; an alias (bouc_wen) under its name
+    model = bushing.name
     table = None
     if args.kdyn is not None:
         from identification.kdyn_table import load_kdyn_table
@@ -116,7 +114,7 @@ def fit_command(args) -> int:
           file=sys.stderr)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", FitNotConvergedWarning)   # printed below as WARNING
-        result = fit(tests, model=model, preset=args.preset, seed=args.seed, workers=args.workers,
+        result = fit(tests, model=bushing, preset=args.preset, seed=args.seed, workers=args.workers,
                      scheduler=args.scheduler, progress=not args.quiet, screening=args.screening,
                      starts=args.starts, kdyn=table, ensemble=not args.no_ensemble)
     written = _save_or_rescue(result, args, [t.measurement.source for t in tests]
@@ -316,7 +314,7 @@ def compare_command(args) -> int:
     unknown = [name for name in models if name not in MODEL_CHOICES]
     if unknown:
         raise UsageError(f"unknown models {unknown}; choose from {', '.join(MODEL_NAMES)}")
-    models = [get_model(name).name for name in models]
+    models = [get_model(name) for name in models]          # resolved once, passed on
     prepare_directory(args.out, "--out")
     validation = args.validate or [Path(t.measurement.source) for t in tests]
     compare_models(models, tests, validation, args.out, preset=args.preset, seed=args.seed, workers=args.workers,

@@ -35,10 +35,11 @@ from typing import Sequence
 
 import numpy as np
 
-from fmu_src.bushing_models import get_model
+from fmu_src.bushing_models import BushingModel, resolve_model
 from identification.engine import make_engine
+from identification.errors import FitNotConvergedWarning
 from identification.fit_result import FLOOR_FACTOR, FitResult, TableFit, information_criterion
-from identification.fitting import FitNotConvergedWarning, fit, table_fit
+from identification.fitting import fit, table_fit
 from identification.interrupt import writing
 from identification.kdyn_table import KDYN_UNCERTAINTY, LOSS_ANGLE_UNCERTAINTY_DEG, KdynTable
 from identification.measurements import load_measurement, measurement_name
@@ -115,14 +116,17 @@ def recommend(assessments: Sequence[Assessment], tolerance: float = PREDICTION_T
     return Recommendation(chosen.model, "; ".join(why))
 
 
-def compare_models(models: Sequence[str], tests: Sequence[RigTest], validation_files: Sequence[Path], out_dir: Path,
-                   preset: str = "default", seed: int = 0, workers: int | None = None, scheduler=None,
-                   screening: int | None = None, starts: int | None = None, ensemble: bool = True,
+def compare_models(models: Sequence[str | BushingModel], tests: Sequence[RigTest], validation_files: Sequence[Path],
+                   out_dir: Path, preset: str = "default", seed: int = 0, workers: int | None = None,
+                   scheduler=None, screening: int | None = None, starts: int | None = None, ensemble: bool = True,
                    table: KdynTable | None = None) -> dict:
     """Fit every model on ``tests``, assess it on the training tests, on the ``validation_files``
     and on the held-out dynamic-stiffness ``table``, write the files (module docstring) and
-    recommend one. Returns ``{"parameters": {model: params}, "errors": {(file, model): (nrmse,
-    eq10)}, "assessments": [Assessment], "recommendation": Recommendation}``."""
+    recommend one. ``models``: names or ``BushingModel``s, each resolved once here and passed on.
+    Returns ``{"parameters": {model: params}, "errors": {(file, model): (nrmse, eq10)},
+    "assessments": [Assessment], "recommendation": Recommendation}`` (keyed by model name)."""
+    bushings = [resolve_model(model) for model in models]
+    models = [bushing.name for bushing in bushings]
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     validation = [load_measurement(path) for path in validation_files]
@@ -130,9 +134,10 @@ def compare_models(models: Sequence[str], tests: Sequence[RigTest], validation_f
     parameters, assessments = {}, []
     with make_engine(workers, scheduler) as engine, warnings.catch_warnings():
         warnings.simplefilter("ignore", FitNotConvergedWarning)   # reported below, per model
-        for model in models:
-            print(f"fitting {get_model(model).title} ...", file=sys.stderr)
-            result = fit(tests, model=model, preset=preset, seed=seed, engine=engine, screening=screening,
+        for bushing in bushings:
+            model = bushing.name
+            print(f"fitting {bushing.title} ...", file=sys.stderr)
+            result = fit(tests, model=bushing, preset=preset, seed=seed, engine=engine, screening=screening,
                          starts=starts, ensemble=ensemble)
             result.save(out_dir / f"params_{model}.json", data=[t.measurement.source for t in tests])
             parameters[model] = result.parameters.parameters
@@ -146,9 +151,9 @@ def compare_models(models: Sequence[str], tests: Sequence[RigTest], validation_f
     errors = {}
     for m in validation:
         name = Path(m.source).name
-        predictions = {model: simulate(parameters[model], m.time_s, m.displacement_mm, m.measured_velocity_mm_s,
-                                       model=model)
-                       for model in models}
+        predictions = {bushing.name: simulate(parameters[bushing.name], m.time_s, m.displacement_mm,
+                                              m.measured_velocity_mm_s, model=bushing)
+                       for bushing in bushings}
         for assessment in assessments:
             predicted = predictions[assessment.model]
             errors[name, assessment.model] = (nrmse(predicted, m.force_N), rms_level_error(predicted, m.force_N))

@@ -9,7 +9,8 @@ takes a few seconds on a model's first use; numba caches the machine code on dis
 processes load it.
 
 Units as in the models: mm, mm/s, N, s; parameters in the paper's N-mm-s units, each model's
-own in its spec order (``parameter_matrix``).
+own in its spec order (``parameter_matrix``). ``model``: a ``BushingModel`` (what the front door
+resolved and passes on) or a model's name.
 """
 from __future__ import annotations
 
@@ -21,7 +22,7 @@ from fmu_src.jit import numba
 import numpy as np
 
 from fmu_src import compiled_kernels as _kernels, integration
-from fmu_src.bushing_models import get_model
+from fmu_src.bushing_models import BushingModel, resolve_model
 from fmu_src.proposed_model import PARAMETER_NAMES  # noqa: F401  (the proposed model's order, for callers)
 from identification import steady_state
 
@@ -91,16 +92,16 @@ def _population_appendix(model) -> str:
 _compiled_models: dict[str, types.ModuleType] = {}
 
 
-def compiled_model(model: str = "proposed") -> types.ModuleType:
+def compiled_model(model: str | BushingModel = "proposed") -> types.ModuleType:
     """The generated, compiled module of ``model`` with the population loop (loaded on first use)."""
-    bushing = get_model(model)
+    bushing = resolve_model(model)
     if bushing.name not in _compiled_models:
         _compiled_models[bushing.name] = _kernels.compiled_module(bushing, _population_appendix(bushing))
     return _compiled_models[bushing.name]
 
 
 def simulate_population_held(parameter_sets, time_s, displacement_mm, velocity_mm_s,
-                             max_substeps: int = _MAX_SUBSTEPS, model: str = "proposed") -> np.ndarray:
+                             max_substeps: int = _MAX_SUBSTEPS, model: str | BushingModel = "proposed") -> np.ndarray:
     """Forces [N], shape (P, samples), of P parameter sets of ``model`` under the FMU's input
     convention.
 
@@ -115,6 +116,7 @@ def simulate_population_held(parameter_sets, time_s, displacement_mm, velocity_m
     """
     t, x, v = _input_arrays(time_s, displacement_mm, velocity_mm_s)
     out_velocity = np.concatenate([v[:1], v[:-1]])
+    model = resolve_model(model)
     return compiled_model(model)._simulate_population(parameter_matrix(parameter_sets, model), t, x, v,
                                                       np.arange(t.size), out_velocity, max_substeps,
                                                       *_step_sizes(t))
@@ -122,7 +124,7 @@ def simulate_population_held(parameter_sets, time_s, displacement_mm, velocity_m
 
 def simulate_population_at(parameter_sets, time_s, displacement_mm, velocity_mm_s, output_index,
                            output_velocity_mm_s, max_substeps: int = _MAX_SUBSTEPS,
-                           model: str = "proposed") -> np.ndarray:
+                           model: str | BushingModel = "proposed") -> np.ndarray:
     """Forces [N], shape (P, outputs), at the communication points ``time_s[output_index]``
     (increasing), with the force's viscous feedthrough taken at ``output_velocity_mm_s``; the
     input between communication points as in :func:`simulate_population_held`."""
@@ -132,6 +134,7 @@ def simulate_population_at(parameter_sets, time_s, displacement_mm, velocity_mm_
     if not (out_index.ndim == 1 and out_index.size >= 1 and out_index.shape == out_velocity.shape
             and np.all(np.diff(out_index) > 0) and 0 <= out_index[0] and out_index[-1] < t.size):
         raise ValueError("output_index must be increasing indices into time_s, one output velocity each")
+    model = resolve_model(model)
     return compiled_model(model)._simulate_population(parameter_matrix(parameter_sets, model), t, x, v, out_index,
                                                       out_velocity, max_substeps, *_step_sizes(t))
 
@@ -160,24 +163,26 @@ def _input_arrays(time_s, displacement_mm, velocity_mm_s):
     return t, x, v
 
 
-def parameter_matrix(parameter_sets, model: str = "proposed") -> np.ndarray:
+def parameter_matrix(parameter_sets, model: str | BushingModel = "proposed") -> np.ndarray:
     """(P, m) float array of P parameter sets of ``model`` in its parameter order (its specs'),
     from a sequence of mappings or an array."""
-    names = get_model(model).parameter_names
+    bushing = resolve_model(model)
+    names = bushing.parameter_names
     if isinstance(parameter_sets, np.ndarray):
         matrix = np.atleast_2d(np.asarray(parameter_sets, dtype=float))
     else:
         matrix = np.array([[float(p[name]) for name in names] for p in parameter_sets])
     if matrix.ndim != 2 or matrix.shape[1] != len(names):
-        raise ValueError(f"expected a (P, {len(names)}) parameter matrix of the {get_model(model).name} model "
+        raise ValueError(f"expected a (P, {len(names)}) parameter matrix of the {bushing.name} model "
                          f"in the order {', '.join(names)}, got shape {matrix.shape}")
     return np.ascontiguousarray(matrix)
 
 
-def simulate_model_held(model: str, params: Mapping[str, float], time_s, displacement_mm,
+def simulate_model_held(model: str | BushingModel, params: Mapping[str, float], time_s, displacement_mm,
                         velocity_mm_s) -> np.ndarray:
-    """Force [N] of one parameter set of any model of ``bushing_models`` (by name) under the
-    FMU's input convention (:func:`simulate_population_held`). Raises ParameterError for an
-    invalid set."""
-    values = get_model(model).check(params)
+    """Force [N] of one parameter set of any model of ``bushing_models`` (the model or its name)
+    under the FMU's input convention (:func:`simulate_population_held`). Raises ParameterError
+    for an invalid set."""
+    model = resolve_model(model)
+    values = model.check(params)
     return simulate_population_held([values], time_s, displacement_mm, velocity_mm_s, model=model)[0]

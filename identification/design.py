@@ -114,7 +114,7 @@ def design(ensemble, noise_N: float | None = None, candidates: list[Candidate] |
     if noise_N is None:
         noise_N = _training_noise(ensemble)
     candidates = candidates or candidate_tests()
-    matrix = parameter_matrix(sets, bushing.name)
+    matrix = parameter_matrix(sets, bushing)
     ranked = []
     bar = progress_bar(len(candidates), "candidate tests", "test", progress)
     for candidate in candidates:
@@ -124,7 +124,7 @@ def design(ensemble, noise_N: float | None = None, candidates: list[Candidate] |
         t = sample_times(protocol.duration_s, RATE_HZ)
         x, v = protocol.signals(t)
         driven = prepare_input(t, x, v, decimate_holds=True)
-        forces = simulate_driven(matrix, driven, model=bushing.name)
+        forces = simulate_driven(matrix, driven, model=bushing)
         runs = np.all(np.isfinite(forces), axis=1)
         if runs.sum() < 2 or not runs[0]:
             continue   # the best set, or all but one, cannot be simulated on it: not a test to propose

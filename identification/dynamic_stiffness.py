@@ -24,7 +24,6 @@ Units: mm, Hz, N/mm, degrees, mJ, N; parameters in the paper's N-mm-s units.
 """
 from __future__ import annotations
 
-import csv
 import math
 import warnings
 from dataclasses import dataclass, field
@@ -33,7 +32,10 @@ from typing import Sequence
 
 import numpy as np
 
-from identification.errors import IdentificationError
+from fmu_src.bushing_models import BushingModel
+from identification.errors import CharacterisationWarning, IdentificationError
+from identification.kdyn_table import (PLAUSIBLE_AMPLITUDE_MM, PLAUSIBLE_FREQUENCY_HZ, SHEET_COLUMNS,
+                                       SHEET_RESULT_COLUMNS, ensemble_columns, write_kdyn_table)
 
 DEFAULT_AMPLITUDES_MM = (0.1, 0.5, 1.0, 2.0, 3.0)
 DEFAULT_FREQUENCIES_HZ = (1.0, 2.0, 5.0, 10.0, 20.0, 30.0, 50.0)
@@ -44,17 +46,10 @@ TOLERANCE = 1e-5
 """Steady state: the first harmonic changes by at most this (relative) from cycle to cycle, with
 what a geometric approach has left (``identification.steady_state``)."""
 MAX_SUBSTEPS = 20000
-PLAUSIBLE_AMPLITUDE_MM = 50.0
-PLAUSIBLE_FREQUENCY_HZ = 500.0
-COLUMNS = ("amplitude_mm", "frequency_hz", "preload_mm", "kdyn_N_per_mm", "loss_angle_deg", "storage_N_per_mm",
-           "loss_N_per_mm", "energy_per_cycle_mJ", "peak_force_N")
-RESULT_COLUMNS = COLUMNS[3:]
+COLUMNS = SHEET_COLUMNS
+"""A table's columns, as its CSV file has them (``identification.kdyn_table`` owns the file)."""
+RESULT_COLUMNS = SHEET_RESULT_COLUMNS
 """The columns computed per case (the first three describe the case)."""
-
-
-class CharacterisationWarning(UserWarning):
-    """A case did not reach its steady state within the cycle cap (its numbers are the last cycle's)."""
-
 
 @dataclass
 class DynamicStiffness:
@@ -95,22 +90,13 @@ class DynamicStiffness:
 
     def to_csv(self, path: str | Path, comments: Sequence[str] = ()) -> Path:
         """COLUMNS, one row per case; an ensemble adds ``<column>_min``, ``<column>_max``;
-        ``comments`` go first, as ``# `` lines."""
-        path = Path(path)
-        header = list(COLUMNS)
+        ``comments`` go first, as ``# `` lines. The file of ``kdyn_table.write_kdyn_table``:
+        ``load_kdyn_table`` reads it back."""
+        columns = {name: self.column(name) for name in COLUMNS}
         if self.minimum:
-            header += [f"{name}_{bound}" for name in RESULT_COLUMNS for bound in ("min", "max")]
-        with open(path, "w", newline="") as handle:
-            handle.writelines(f"# {line}\n" for line in comments)
-            writer = csv.writer(handle)
-            writer.writerow(header)
-            for i in range(len(self)):
-                row = [f"{self.column(name)[i]:.10g}" for name in COLUMNS]
-                if self.minimum:
-                    row += [f"{table[name][i]:.10g}" for name in RESULT_COLUMNS
-                            for table in (self.minimum, self.maximum)]
-                writer.writerow(row)
-        return path
+            columns.update(zip(ensemble_columns(RESULT_COLUMNS),
+                               (table[name] for name in RESULT_COLUMNS for table in (self.minimum, self.maximum))))
+        return write_kdyn_table(path, columns, comments)
 
     def summary(self) -> dict:
         """For ``--json``: the cases, their cycles and convergence, and how far the loop's area is
@@ -142,7 +128,7 @@ class DynamicStiffness:
 
 
 def characterise(parameters, amplitudes_mm: Sequence[float] = DEFAULT_AMPLITUDES_MM,
-                 frequencies_hz: Sequence[float] = DEFAULT_FREQUENCIES_HZ, model: str | None = None,
+                 frequencies_hz: Sequence[float] = DEFAULT_FREQUENCIES_HZ, model: str | BushingModel | None = None,
                  preload_mm: float = 0.0, steps_per_cycle: int = STEPS_PER_CYCLE, tolerance: float = TOLERANCE,
                  max_cycles: int = MAX_CYCLES) -> DynamicStiffness:
     """Dynamic stiffness |K*| and loss angle on every pair of amplitudes and frequencies: the
@@ -157,8 +143,8 @@ def characterise(parameters, amplitudes_mm: Sequence[float] = DEFAULT_AMPLITUDES
         Sine amplitudes [mm].
     frequencies_hz : sequence of float
         Frequencies [Hz].
-    model : str, optional
-        The model the parameters must be for.
+    model : str or BushingModel, optional
+        The model the parameters must be for (or its name).
     preload_mm : float
         Static displacement [mm] the sines are about.
     steps_per_cycle : int
@@ -202,7 +188,7 @@ def characterise(parameters, amplitudes_mm: Sequence[float] = DEFAULT_AMPLITUDES
     case_frequency = np.tile(frequencies, amplitudes.size)
     cases = case_amplitude.size
     members = len(sets)
-    result, last = run_sines(parameter_matrix(sets, bushing.name), bushing.name, case_amplitude, case_frequency,
+    result, last = run_sines(parameter_matrix(sets, bushing), bushing, case_amplitude, case_frequency,
                              np.full(cases, float(preload_mm)), int(steps_per_cycle), int(max_cycles), tolerance)
     failed = (result[:, 3] == 2) | ~np.all(np.isfinite(last), axis=1)
     if failed[:cases].any():
@@ -237,7 +223,7 @@ def characterise(parameters, amplitudes_mm: Sequence[float] = DEFAULT_AMPLITUDES
     return table
 
 
-def run_sines(matrix: np.ndarray, model: str, amplitude_mm: np.ndarray, frequency_hz: np.ndarray,
+def run_sines(matrix: np.ndarray, model: str | BushingModel, amplitude_mm: np.ndarray, frequency_hz: np.ndarray,
               preload_mm: np.ndarray, steps_per_cycle: int, max_cycles: int, tolerance: float,
               max_substeps: int = MAX_SUBSTEPS):
     """Every parameter set (rows of ``matrix``) on every case (equal-length arrays): the compiled

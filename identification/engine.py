@@ -33,6 +33,7 @@ from typing import Callable, Sequence
 
 import numpy as np
 
+from identification.errors import EngineError
 from identification.interrupt import deferred, ignore_interrupts, interrupts_held
 
 CHUNKS_PER_WORKER = 4
@@ -43,10 +44,6 @@ POLL_S = 0.05
 ABORT_TIMEOUT_S = 3.0
 """How long an aborting engine waits for a terminated worker to exit (then kills it), or for a
 Dask client to close."""
-
-
-class EngineError(RuntimeError):
-    """The engine cannot run tasks (e.g. the Dask scheduler cannot be reached)."""
 
 
 def _run_chunk(function: Callable, shared, chunk: Sequence, single_threaded: bool) -> list:

@@ -221,7 +221,7 @@ def _profile_task(shared: ProfileProblem, item):
     displacement = driven.displacement_mm[driven.output_index]
 
     def probe_measure(thetas):
-        forces = simulate_driven(space.to_parameters(np.atleast_2d(thetas)), driven, model=space.model)
+        forces = simulate_driven(space.to_parameters(np.atleast_2d(thetas)), driven, model=space.bushing)
         if measure == "energy":   # trapezoidal integral of F dx over the samples
             return np.sum(0.5 * (forces[:, 1:] + forces[:, :-1]) * np.diff(displacement), axis=1)
         return np.sqrt(np.average(forces ** 2, axis=1, weights=weights))

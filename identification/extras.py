@@ -10,6 +10,8 @@ from __future__ import annotations
 import importlib.util
 import sys
 
+from identification.errors import MissingExtraError
+
 DISTRIBUTION = "boucwen-bushing"
 EXTRAS = {
     "fit": ("numba", "threadpoolctl", "emcee", "pymoo", "tqdm", "matplotlib"),
@@ -17,10 +19,6 @@ EXTRAS = {
     "dask": ("distributed",),
     "cosim": ("libcosimpy",),
 }
-
-
-class MissingExtraError(ImportError):
-    """A feature whose extra is not installed; the message says which one to install."""
 
 
 def missing_modules(extra: str) -> list[str]:

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Sequence
 import numpy as np
 
 from fmu_src.parameter_files import ParameterSet, save_ensemble, save_parameters
-from identification.errors import IdentificationError
+from identification.errors import FitNotConvergedWarning, IdentificationError  # noqa: F401  (also imported from here)
 from identification.interrupt import deferred, writing
 from identification.kdyn_table import FIT_CYCLES, KDYN_UNCERTAINTY, LOSS_ANGLE_UNCERTAINTY_DEG
 from identification.noise import NoiseEstimate
@@ -36,10 +36,6 @@ FLOOR_FACTOR = 1.25
 """A test is at its noise floor when the fit's NRMSE on it is at most this times its noise level."""
 MIN_AGREEING = 2
 """Starts of the last stage that must reach the best misfit for a fit to be converged."""
-
-
-class FitNotConvergedWarning(UserWarning):
-    """A fit that ended above the noise floor or whose starts do not agree."""
 
 
 @dataclass

@@ -32,14 +32,14 @@ from pathlib import Path
 
 import numpy as np
 
-from fmu_src.bushing_models import get_model
+from fmu_src.bushing_models import BushingModel, resolve_model
 from fmu_src.parameter_files import ParameterSet
 from identification.compiled_core import parameter_matrix
 from identification.engine import make_engine
 from identification.ensemble import (PROBES, PROFILE_EVALUATIONS, PROFILE_ROUNDS, PUSH, STEPS, WALKERS,
                                      identifiability, misfit_threshold, posterior_samples, profile_extremes,
                                      push_to_boundary, select_members, threshold_scale)
-from identification.errors import IdentificationError
+from identification.errors import CharacterisationWarning, IdentificationError
 from identification.extras import require
 from identification.fit_result import (FLOOR_FACTOR, MIN_AGREEING, FitNotConvergedWarning, FitResult,  # noqa: F401
                                        RigTestFit, TableFit, agreeing_starts)
@@ -81,8 +81,8 @@ def as_tests(measurements) -> list[RigTest]:
     return tests
 
 
-def fit(measurements, model: str = "proposed", preset: str = "default", seed: int = 0, workers: int | None = None,
-        scheduler=None, engine=None, progress: bool = True, screening: int | None = None,
+def fit(measurements, model: str | BushingModel = "proposed", preset: str = "default", seed: int = 0,
+        workers: int | None = None, scheduler=None, engine=None, progress: bool = True, screening: int | None = None,
         starts: int | None = None, kdyn=None, ensemble: bool = True) -> FitResult:
     """Identify a model's parameters from rig tests, and say how sure the fit is.
 
@@ -91,9 +91,10 @@ def fit(measurements, model: str = "proposed", preset: str = "default", seed: in
     measurements : Manifest, sequence of RigTest, Measurement, str or Path
         The training tests (``training_tests``, ``load_manifest``); a Measurement or a CSV path
         counts as a random-input test. May be empty when ``kdyn`` is given.
-    model : str
-        ``proposed`` (default), ``spencer``, ``single_bouc_wen`` or ``kelvin_voigt`` (linear
-        least squares).
+    model : str or BushingModel
+        ``proposed`` (default), ``spencer``, ``single_bouc_wen``, ``berg``, ``fractional`` or
+        ``kelvin_voigt`` (linear least squares), or the model itself
+        (``fmu_src.bushing_models.get_model``); resolved once and passed on.
     preset : str
         ``default`` (Sobol screening) or ``paper`` (the paper's GA); see ``presets``.
     seed : int
@@ -146,7 +147,7 @@ def fit(measurements, model: str = "proposed", preset: str = "default", seed: in
     table = kdyn if kdyn is None or isinstance(kdyn, KdynTable) else load_kdyn_table(kdyn)
     empty = measurements is None or (isinstance(measurements, (list, tuple)) and not measurements)
     tests = [] if (empty and table is not None) else as_tests(measurements)
-    bushing = get_model(model)
+    bushing = resolve_model(model)
     if seed < 0:
         raise IdentificationError(f"seed = {seed}: give an integer >= 0")
     noise = [_noise_of(t) for t in tests]
@@ -154,7 +155,7 @@ def fit(measurements, model: str = "proposed", preset: str = "default", seed: in
     # and the scales and the Jacobian's SVD computed here must not depend on the engine.
     with threadpool_limits(limits=1):
         if bushing.name == "kelvin_voigt":
-            result = _fit_kelvin_voigt(tests, noise, started, table)
+            result = _fit_kelvin_voigt(bushing, tests, noise, started, table)
         else:
             if preset not in PRESETS:
                 raise IdentificationError(f"unknown preset {preset!r}; choose one of {', '.join(PRESETS)}")
@@ -164,7 +165,7 @@ def fit(measurements, model: str = "proposed", preset: str = "default", seed: in
             # an engine made here is closed here, and aborted if the search is left by an exception
             # (Ctrl-C, SIGTERM): see identification.engine
             with engine if owned else contextlib.nullcontext():
-                result = _search(tests, noise, bushing.name, preset, settings, seed, engine, progress, started, table,
+                result = _search(tests, noise, bushing, preset, settings, seed, engine, progress, started, table,
                                  ensemble)
     if not result.converged:
         warnings.warn(result.warning, FitNotConvergedWarning, stacklevel=2)
@@ -196,7 +197,7 @@ def _search(tests, noise, model, preset, settings, seed, engine, progress, start
     measurements = [t.measurement for t in tests]
     space = SearchSpace.from_measurements(measurements, model, steps=[t.kind == "step" for t in tests], table=table)
     # with a table, the screening and the early stages run its coarser loop (kdyn_table)
-    problem = Problem(Objective(tests, noise, model=space.model, table=table, search=table is not None), space)
+    problem = Problem(Objective(tests, noise, model=space.bushing, table=table, search=table is not None), space)
     ga_evaluations = PAPER_GA["population"] * PAPER_GA["generations"]
     notes = []
     loop = slow_loop_start(tests, space) if preset != "paper" else None
@@ -275,13 +276,12 @@ def _search(tests, noise, model, preset, settings, seed, engine, progress, start
     return result
 
 
-def _fit_kelvin_voigt(tests, noise, started, table=None) -> FitResult:
+def _fit_kelvin_voigt(bushing: BushingModel, tests, noise, started, table=None) -> FitResult:
     """F = k*x + c*v by linear least squares with k, c >= 0 on the tests other than steps (a
     linear spring cannot show the step's relaxation; all tests if there are only steps). With
     a dynamic-stiffness table: scipy's bounded least squares on the whole objective (tests and
     table), from that solution or, with a table alone, from the table's median K' and K''/omega."""
     from scipy.optimize import least_squares
-    bushing = get_model("kelvin_voigt")
     if tests:
         linear = KelvinVoigtFit.fit([t.measurement for t in tests if t.kind != "step"]
                                     or [t.measurement for t in tests], nonnegative=True)
@@ -289,16 +289,16 @@ def _fit_kelvin_voigt(tests, noise, started, table=None) -> FitResult:
     else:
         scales = SearchSpace.from_table(table)
         values = {"k": scales.k_ref, "c": scales.c_ref, "preload": 0.0}
-    objective = Objective(tests, noise, model=bushing.name, table=table)
+    objective = Objective(tests, noise, model=bushing, table=table)
     if table is not None:
         def residuals(kc):
             return objective.residual_matrix(parameter_matrix([{"k": kc[0], "c": kc[1], "preload": 0.0}],
-                                                              bushing.name))[0]
+                                                              bushing))[0]
         solution = least_squares(residuals, [values["k"], values["c"]], bounds=([0.0, 0.0], [np.inf, np.inf]),
                                  x_scale="jac")
         values = {"k": float(solution.x[0]), "c": float(solution.x[1]), "preload": 0.0}
     parameters = ParameterSet(bushing, values)
-    misfit = float(objective(parameter_matrix([values], bushing.name))[0])
+    misfit = float(objective(parameter_matrix([values], bushing))[0])
     result = FitResult(parameters, misfit, _test_fits(tests, noise, parameters), [], 0.0, [values], None,
                        "linear", 0, 1, time.perf_counter() - started, table=table_fit(table, parameters),
                        residuals=objective.size)
@@ -351,12 +351,11 @@ def table_fit(table: KdynTable | None, parameters: ParameterSet) -> TableFit | N
     a fitted table, or one held out (``compare``)."""
     if table is None:
         return None
-    from identification.dynamic_stiffness import (MAX_CYCLES, STEPS_PER_CYCLE, TOLERANCE, CharacterisationWarning,
-                                                  run_sines, stiffness_from_sums)
+    from identification.dynamic_stiffness import MAX_CYCLES, STEPS_PER_CYCLE, TOLERANCE, run_sines, stiffness_from_sums
     from identification.objectives import PreparedTable
     prepared = PreparedTable.of(table)
     rows = prepared.rows
-    model = parameters.model.name
+    model = parameters.model
     matrix = parameter_matrix([parameters.parameters], model)
 
     def steady(steps):

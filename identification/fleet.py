@@ -30,8 +30,8 @@ from fmu_src.bushing_models import MODEL_CHOICES
 from fmu_src.bushing_params import ParameterError
 from fmu_src.parameter_files import parameter_document
 from identification.engine import make_engine
+from identification.errors import FitNotConvergedWarning, MeasurementError
 from identification.interrupt import writing
-from identification.measurements import MeasurementError
 from identification.progress import bar as progress_bar
 from identification.rig_tests import load_manifest
 
@@ -64,7 +64,7 @@ class _Job:
 def _fit_bushing(_, job: _Job):
     """One bushing, fitted serially in a worker; returns (row, parameter document or None)."""
     from identification.engine import SerialEngine
-    from identification.fitting import FitNotConvergedWarning, fit
+    from identification.fitting import fit
     started = time.perf_counter()
     try:
         with warnings.catch_warnings():

@@ -1,10 +1,20 @@
-"""A dynamic-stiffness table as training data: what a supplier's data sheet gives.
+"""The dynamic-stiffness table: its CSV file (the one module that reads and writes it) and the
+table as training data, what a supplier's data sheet gives.
 
-CSV columns ``amplitude_mm,frequency_hz,kdyn_N_per_mm,loss_angle_deg``, optionally
-``preload_mm`` (default 0) and ``weight`` (default 1; 0 leaves a row out), in any order, ``#``
-comment lines allowed: exactly what ``python -m identification characterise`` writes, so a
-computed table reads back. Each row is one sine of amplitude X about the preload P at frequency
-f, its dynamic stiffness |K*| [N/mm] and loss angle delta [deg] (first harmonic, steady state).
+The file: ``#`` comment lines, a header, one row per case. Each row is one sine of amplitude X
+[mm] about the preload P [mm] at frequency f [Hz], its dynamic stiffness |K*| [N/mm] and loss
+angle delta [deg] (first harmonic, steady state). Read (``load_kdyn_table``): the columns
+``amplitude_mm,frequency_hz,kdyn_N_per_mm,loss_angle_deg`` (REQUIRED), optionally
+``preload_mm`` (default 0) and ``weight`` (default 1; 0 leaves a row out), in any order, other
+columns ignored. Written (``write_kdyn_table``, which ``DynamicStiffness.to_csv`` and so
+``python -m identification characterise`` use): SHEET_COLUMNS (the case, then |K*|, delta,
+K' = |K*|cos(delta), K'' = |K*|sin(delta) [N/mm], the energy per cycle [mJ] and the peak force
+[N]), an ensemble's ``<column>_min``, ``<column>_max`` after them, every number with
+NUMBER_FORMAT (10 significant digits): a computed table reads back, each number the one written.
+Checks on reading: a value that is not a finite number, an amplitude, frequency or |K*| <= 0, a
+loss angle outside 0-90 deg, a negative weight, a case given twice are errors naming line and
+column; an amplitude above PLAUSIBLE_AMPLITUDE_MM or a frequency above PLAUSIBLE_FREQUENCY_HZ
+warns (a unit mistake, most likely).
 
 Residuals (``identification.objectives``): per row, the relative |K*| error over
 KDYN_UNCERTAINTY and the loss-angle error over LOSS_ANGLE_UNCERTAINTY_DEG, each times the row's
@@ -27,11 +37,11 @@ import math
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Mapping, Sequence
 
 import numpy as np
 
-from identification.dynamic_stiffness import PLAUSIBLE_AMPLITUDE_MM, PLAUSIBLE_FREQUENCY_HZ, CharacterisationWarning
-from identification.errors import IdentificationError
+from identification.errors import CharacterisationWarning, IdentificationError
 
 KDYN_UNCERTAINTY = 0.01
 LOSS_ANGLE_UNCERTAINTY_DEG = 0.2
@@ -49,9 +59,47 @@ basins the last stage refines: a quarter of the cost, within 6.9e-3 of the stead
 2.2e-3 and 0.084 deg). The Table 4 round trip (benchmarks/bench_kdyn_fit.py) is as accurate with
 either, and 20 s faster with 3."""
 REQUIRED = ("amplitude_mm", "frequency_hz", "kdyn_N_per_mm", "loss_angle_deg")
+"""The columns a table to read must have (units in the names)."""
 OPTIONAL = {"preload_mm": 0.0, "weight": 1.0}
+"""The columns a table to read may have, with the value a missing one stands for."""
 COLUMNS = ("amplitude_mm", "frequency_hz", "preload_mm", "kdyn_N_per_mm", "loss_angle_deg", "weight")
 """KdynTable's columns, in its field order."""
+SHEET_COLUMNS = ("amplitude_mm", "frequency_hz", "preload_mm", "kdyn_N_per_mm", "loss_angle_deg", "storage_N_per_mm",
+                 "loss_N_per_mm", "energy_per_cycle_mJ", "peak_force_N")
+"""The columns ``characterise`` writes (``dynamic_stiffness.COLUMNS``), in their order."""
+SHEET_RESULT_COLUMNS = SHEET_COLUMNS[3:]
+"""The columns computed per case (the first three describe the case); an ensemble's min and max
+of each follow them (``ensemble_columns``)."""
+NUMBER_FORMAT = ".10g"
+"""How ``write_kdyn_table`` writes every number."""
+PLAUSIBLE_AMPLITUDE_MM = 50.0
+PLAUSIBLE_FREQUENCY_HZ = 500.0
+"""Above these, a bushing test is unlikely: a table or a grid that goes beyond warns."""
+
+
+def ensemble_columns(names: Sequence[str] = SHEET_RESULT_COLUMNS) -> list[str]:
+    """The columns of an ensemble's min and max: ``<column>_min``, ``<column>_max`` per column."""
+    return [f"{name}_{bound}" for name in names for bound in ("min", "max")]
+
+
+def write_kdyn_table(path: str | Path, columns: Mapping[str, np.ndarray], comments: Sequence[str] = ()) -> Path:
+    """Write a table: ``comments`` first, as ``# `` lines, then the header (``columns``' names, in
+    their order; REQUIRED among them) and one row per case, every number with NUMBER_FORMAT.
+    ``load_kdyn_table`` reads it back. Returns ``path``."""
+    path = Path(path)
+    missing = [name for name in REQUIRED if name not in columns]
+    if missing:
+        raise IdentificationError(f"{path}: a dynamic-stiffness table needs the column(s) {', '.join(missing)}")
+    arrays = [np.asarray(values) for values in columns.values()]
+    if len({array.shape for array in arrays}) != 1 or arrays[0].ndim != 1:
+        raise IdentificationError(f"{path}: the table's columns must be 1-D arrays of equal length")
+    with open(path, "w", newline="") as handle:
+        handle.writelines(f"# {line}\n" for line in comments)
+        writer = csv.writer(handle)
+        writer.writerow(list(columns))
+        for i in range(arrays[0].size):
+            writer.writerow([format(array[i], NUMBER_FORMAT) for array in arrays])
+    return path
 
 
 @dataclass(frozen=True)
@@ -107,11 +155,12 @@ class KdynTable:
 
 
 def load_kdyn_table(path: str | Path) -> KdynTable:
-    """Read and check a table (see the module docstring). IdentificationError names the line
-    and column of what is wrong: a missing column, a value that is not a number, an amplitude
-    or frequency <= 0, |K*| <= 0, a loss angle outside 0-90 deg, a negative weight, a case
-    (amplitude, frequency, preload) given twice. Warns (CharacterisationWarning) about an
-    amplitude above 50 mm or a frequency above 500 Hz (a unit mistake, most likely)."""
+    """Read and check a table (see the module docstring), such as ``write_kdyn_table`` writes.
+    IdentificationError names the line and column of what is wrong: a missing column, a value
+    that is not a number, an amplitude or frequency <= 0, |K*| <= 0, a loss angle outside 0-90
+    deg, a negative weight, a case (amplitude, frequency, preload) given twice. Warns
+    (CharacterisationWarning) about an amplitude above 50 mm or a frequency above 500 Hz (a unit
+    mistake, most likely)."""
     path = Path(path)
     try:
         with open(path, newline="", encoding="utf-8-sig") as handle:   # -sig: a spreadsheet's BOM

@@ -33,7 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
-from identification.errors import IdentificationError
+from identification.errors import MeasurementError, MeasurementWarning  # noqa: F401  (also imported from here)
 
 LENGTH_TO_MM = {"mm": 1.0, "m": 1000.0, "in": 25.4}
 FORCE_TO_N = {"N": 1.0, "kN": 1000.0, "lbf": 4.4482216152605, "kip": 4448.2216152605}
@@ -44,14 +44,6 @@ MIN_PLAUSIBLE_FORCE_N = 10.0
 PLAUSIBLE_STIFFNESS_N_PER_MM = (1.0, 1e6)
 PLAUSIBLE_SAMPLE_RATE_HZ = (10.0, 1e6)
 MAX_STEP_OVER_RMS = 0.5
-
-
-class MeasurementWarning(UserWarning):
-    """A measurement that loads but looks implausible for a bushing test (likely wrong units)."""
-
-
-class MeasurementError(IdentificationError):
-    """A measurement file that cannot be used; the message names the file, column and row."""
 
 
 @dataclass

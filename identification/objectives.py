@@ -30,6 +30,7 @@ from typing import Sequence
 
 import numpy as np
 
+from fmu_src.bushing_models import BushingModel, resolve_model
 from identification.forward_model import DrivenInput, prepare_input
 from identification.kdyn_table import (FIT_CYCLES, FIT_STEPS_PER_CYCLE, KDYN_UNCERTAINTY, LOSS_ANGLE_UNCERTAINTY_DEG,
                                        SEARCH_CYCLES, SEARCH_STEPS_PER_CYCLE, KdynTable)
@@ -72,7 +73,7 @@ class PreparedTable:
     def size(self) -> int:
         return 2 * len(self.rows)
 
-    def stiffness(self, matrix: np.ndarray, model: str) -> tuple[np.ndarray, np.ndarray]:
+    def stiffness(self, matrix: np.ndarray, model: str | BushingModel) -> tuple[np.ndarray, np.ndarray]:
         """|K*| [N/mm] and the loss angle [deg] of P candidates on every row, each (P, rows):
         ``cycles`` cycles of ``steps_per_cycle`` steps from rest (``identification.kdyn_table``)."""
         from identification.dynamic_stiffness import run_sines, stiffness_from_sums
@@ -84,7 +85,7 @@ class PreparedTable:
         failed = result[..., 3] == 2
         return np.where(failed, np.nan, kdyn), np.where(failed, np.nan, angle)
 
-    def residuals(self, matrix: np.ndarray, model: str) -> np.ndarray:
+    def residuals(self, matrix: np.ndarray, model: str | BushingModel) -> np.ndarray:
         """(P, 2*rows): relative |K*| errors over KDYN_UNCERTAINTY, then loss-angle errors over
         LOSS_ANGLE_UNCERTAINTY_DEG, each times its row's weight (NaN where a candidate fails)."""
         kdyn, angle = self.stiffness(matrix, model)
@@ -98,14 +99,15 @@ class Objective:
     """Misfit (chi^2/n) of candidate parameter sets of ``model``; see the module docstring."""
 
     def __init__(self, tests: Sequence[RigTest], noise: Sequence[NoiseEstimate] | None = None,
-                 steps: Sequence[int | None] | None = None, model: str = "proposed", table: KdynTable | None = None,
-                 search: bool = False):
+                 steps: Sequence[int | None] | None = None, model: str | BushingModel = "proposed",
+                 table: KdynTable | None = None, search: bool = False):
         """``steps``: communication steps per sample of each test (None: chosen from the
         signal, ``forward_model.steps_per_sample``); ``identification.refinement`` raises them
         where a candidate's response needs it. ``table``: a dynamic-stiffness table whose rows
         add two residuals each (``identification.kdyn_table``), with the search's coarser loop
         if ``search``. Candidates are (P, m) matrices of ``model``'s parameters in its order
-        (``compiled_core.parameter_matrix``)."""
+        (``compiled_core.parameter_matrix``). ``model``: the model or its name, resolved here
+        (``bushing``; ``model`` is its name); a worker receives the name and resolves it once."""
         if not tests and table is None:
             raise ValueError("the objective needs at least one training test or a dynamic-stiffness table")
         noise = list(noise) if noise is not None else [estimate_noise(t.measurement.force_N) for t in tests]
@@ -115,7 +117,8 @@ class Objective:
         if len(steps) != len(tests):
             raise ValueError(f"{len(steps)} step counts for {len(tests)} tests")
         self.noise = noise
-        self.model = model
+        self.bushing = resolve_model(model)
+        self.model = model if isinstance(model, str) else self.bushing.name
         self.tests: list[PreparedTest] = []
         for test, level, m_steps in zip(tests, noise, steps):
             m = test.measurement
@@ -131,14 +134,22 @@ class Objective:
     def with_steps(self, tests: Sequence[RigTest], steps: Sequence[int]) -> "Objective":
         """The same objective (of ``tests``, the ones it was made of) with other steps per
         sample (the table's loop as it is)."""
-        return Objective(tests, self.noise, steps, self.model, self._source_table, self.search)
+        return Objective(tests, self.noise, steps, self.bushing, self._source_table, self.search)
 
     def with_fit_loop(self, tests: Sequence[RigTest]) -> "Objective":
         """The same objective with the table's fit loop instead of its search loop (itself if it
         has none)."""
         if not self.search:
             return self
-        return Objective(tests, self.noise, self.steps_per_sample, self.model, self._source_table, False)
+        return Objective(tests, self.noise, self.steps_per_sample, self.bushing, self._source_table, False)
+
+    def __getstate__(self):
+        """Everything but the model, which does not pickle: a worker resolves its name."""
+        return {name: value for name, value in self.__dict__.items() if name != "bushing"}
+
+    def __setstate__(self, state):
+        self.__dict__.update(state)
+        self.bushing = resolve_model(self.model)
 
     @property
     def steps_per_sample(self) -> list[int]:
@@ -150,10 +161,10 @@ class Objective:
         scale = 1.0 / math.sqrt(self.size)
         parts = []
         for test in self.tests:
-            predicted = simulate_driven(matrix, test.driven, FIT_MAX_SUBSTEPS, self.model)
+            predicted = simulate_driven(matrix, test.driven, FIT_MAX_SUBSTEPS, self.bushing)
             parts.append((predicted - test.measured_N) * (scale / test.sigma_N))
         if self.table is not None:
-            parts.append(self.table.residuals(matrix, self.model) * scale)
+            parts.append(self.table.residuals(matrix, self.bushing) * scale)
         residual = np.concatenate(parts, axis=1)
         return np.where(np.isfinite(residual), residual, FAILED_RESIDUAL * scale)
 

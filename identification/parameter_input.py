@@ -11,19 +11,21 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Mapping
 
-from fmu_src.bushing_models import BushingModel, get_model
+from fmu_src.bushing_models import BushingModel, get_model, resolve_model
 from fmu_src.parameter_files import ParameterEnsemble, ParameterSet, read_ensemble
 from identification.errors import IdentificationError
 
 
-def parameter_sets(parameters, model: str | None = None) -> tuple[BushingModel, list[dict[str, float]]]:
+def parameter_sets(parameters, model: str | BushingModel | None = None) -> tuple[BushingModel, list[dict[str, float]]]:
     """The model and the validated parameter sets (best first) of any accepted ``parameters``.
 
-    ``model``: the model's name or FMI identifier; for a mapping or a list of mappings it says
-    which model they are for (default ``"proposed"``), for the others it is checked against the
-    model they name. Raises ``ParameterError`` for an invalid set, ``IdentificationError`` for a
-    model that differs, ``TypeError`` for anything else.
+    ``model``: a ``BushingModel``, or the model's name or FMI identifier (resolved here, once);
+    for a mapping or a list of mappings it says which model they are for (default
+    ``"proposed"``), for the others it is checked against the model they name. Raises
+    ``ParameterError`` for an invalid set, ``IdentificationError`` for a model that differs,
+    ``TypeError`` for anything else.
     """
+    expected = resolve_model(model) if model is not None else None
     if hasattr(parameters, "ensemble") and hasattr(parameters, "parameters") and hasattr(parameters, "misfit"):
         bushing, sets = parameters.parameters.model, parameters.ensemble          # a FitResult
     elif isinstance(parameters, (str, Path)):
@@ -34,14 +36,15 @@ def parameter_sets(parameters, model: str | None = None) -> tuple[BushingModel, 
     elif isinstance(parameters, ParameterSet):
         bushing, sets = parameters.model, [parameters.parameters]
     elif isinstance(parameters, Mapping):
-        bushing, sets = get_model(model or "proposed"), [parameters]
+        bushing, sets = expected or get_model("proposed"), [parameters]
     else:
         sets = list(parameters) if isinstance(parameters, (list, tuple)) else []
         if not sets or not all(isinstance(s, Mapping) for s in sets):
             raise TypeError(f"parameters: give a mapping of names to values, a ParameterSet, a ParameterEnsemble, "
                             f"a FitResult, a parameter file's path or a list of mappings, not "
                             f"{type(parameters).__name__}")
-        bushing = get_model(model or "proposed")
-    if model is not None and get_model(model) is not bushing:
-        raise IdentificationError(f"the parameters are for the {bushing.name} model, not {model}")
+        bushing = expected or get_model("proposed")
+    if expected is not None and expected is not bushing:
+        raise IdentificationError(f"the parameters are for the {bushing.name} model, not "
+                                  f"{model if isinstance(model, str) else expected.name}")
     return bushing, [bushing.check(s) for s in sets]

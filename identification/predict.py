@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from fmu_src.bushing_models import BushingModel
 from identification.compiled_core import parameter_matrix
 from identification.errors import IdentificationError
 from identification.forward_model import prepare_input
@@ -70,7 +71,8 @@ class Prediction:
         return path
 
 
-def predict(parameters, time_s, displacement_mm, velocity_mm_s=None, model: str | None = None) -> Prediction:
+def predict(parameters, time_s, displacement_mm, velocity_mm_s=None,
+            model: str | BushingModel | None = None) -> Prediction:
     """Predict a test: the best set's force and the ensemble's band at every sample.
 
     Parameters
@@ -81,8 +83,8 @@ def predict(parameters, time_s, displacement_mm, velocity_mm_s=None, model: str 
         Sample times [s] and displacement [mm].
     velocity_mm_s : array_like, optional
         Measured velocity [mm/s] at the samples.
-    model : str, optional
-        The model the parameters must be for.
+    model : str or BushingModel, optional
+        The model the parameters must be for (or its name).
 
     Returns
     -------
@@ -97,7 +99,7 @@ def predict(parameters, time_s, displacement_mm, velocity_mm_s=None, model: str 
     """
     bushing, sets = parameter_sets(parameters, model)
     driven = prepare_input(time_s, displacement_mm, velocity_mm_s)
-    forces = simulate_driven(parameter_matrix(sets, bushing.name), driven, model=bushing.name)
+    forces = simulate_driven(parameter_matrix(sets, bushing), driven, model=bushing)
     failed = ~np.isfinite(forces[0])
     if failed.any():
         raise IdentificationError(f"the simulation of the best parameter set fails from t = "

@@ -71,14 +71,14 @@ def refine_steps(objective: Objective, tests: Sequence[RigTest], row: np.ndarray
     steps, errors, work = [], [], 0
     for test, prepared in zip(tests, objective.tests):
         first = m = prepared.driven.steps_per_sample
-        coarse = simulate_driven(candidate, prepared.driven, FIT_MAX_SUBSTEPS, objective.model)[0]
+        coarse = simulate_driven(candidate, prepared.driven, FIT_MAX_SUBSTEPS, objective.bushing)[0]
         work += m
         error = math.nan
         while 2 * m <= MAX_REFINED_STEPS:
             measurement = test.measurement
             finer = prepare_input(measurement.time_s, measurement.displacement_mm, measurement.measured_velocity_mm_s,
                                   decimate_holds=True, steps=2 * m)
-            fine = simulate_driven(candidate, finer, FIT_MAX_SUBSTEPS, objective.model)[0]
+            fine = simulate_driven(candidate, finer, FIT_MAX_SUBSTEPS, objective.bushing)[0]
             work += 2 * m
             runs, ran = bool(np.all(np.isfinite(fine))), bool(np.all(np.isfinite(coarse)))
             if ran and not runs:

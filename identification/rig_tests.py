@@ -23,13 +23,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Sequence
 
-from identification.measurements import Measurement, MeasurementError, load_measurement
+from identification.errors import ManifestError  # noqa: F401  (also imported from here)
+from identification.measurements import Measurement, load_measurement
 
 KINDS = ("sine", "step", "random")
-
-
-class ManifestError(MeasurementError):
-    """A tests manifest or a set of training tests that cannot be used."""
 
 
 @dataclass(frozen=True)

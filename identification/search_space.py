@@ -46,7 +46,7 @@ from typing import Mapping, Sequence
 import numpy as np
 from scipy.optimize import lsq_linear
 
-from fmu_src.bushing_models import MODELS, get_model
+from fmu_src.bushing_models import MODELS, BushingModel, resolve_model
 from fmu_src.model_definition import SearchCoordinate
 from identification.errors import IdentificationError
 from identification.measurements import Measurement
@@ -88,6 +88,9 @@ _ORDER = ("stiffness", "gain", "damping", "exponent", "force", "travel", "cubic"
 
 @dataclass(frozen=True)
 class SearchSpace:
+    """The box of one model scaled by the data. ``model``: the model's name, or the model (a
+    ``BushingModel``, kept under its name): resolved once, here, as ``bushing``; sent to a worker
+    by name (a model does not pickle), which resolves it there once."""
     k_ref: float                  # N/mm
     c_ref: float                  # N*s/mm
     F_ref: float                  # N
@@ -95,15 +98,30 @@ class SearchSpace:
     model: str = "proposed"
     x_ref: float = 1.0            # mm: the tests' largest displacement amplitude
 
+    def __post_init__(self):
+        bushing = resolve_model(self.model)
+        if not isinstance(self.model, str):
+            object.__setattr__(self, "model", bushing.name)
+        object.__setattr__(self, "_bushing", bushing)
+
+    def __getstate__(self):
+        return {name: value for name, value in self.__dict__.items() if name != "_bushing"}
+
+    def __setstate__(self, state):
+        for name, value in state.items():
+            object.__setattr__(self, name, value)
+        object.__setattr__(self, "_bushing", resolve_model(self.model))
+
     @classmethod
-    def from_measurements(cls, measurements: Sequence[Measurement], model: str = "proposed",
+    def from_measurements(cls, measurements: Sequence[Measurement], model: str | BushingModel = "proposed",
                           steps: Sequence[bool] = (), table=None) -> "SearchSpace":
         """The space for these tests; ``steps`` marks which are step tests (left out of the
         scales unless all are). ``table``: a dynamic-stiffness table (``kdyn_table.KdynTable``),
         which sets the scales when no test other than steps is given (:meth:`from_table`)."""
-        if get_model(model).search is None:
+        model = resolve_model(model)
+        if model.search is None:
             searched = [name for name, bushing in MODELS.items() if bushing.search is not None]
-            raise ValueError(f"no search space for the {model!r} model; choose one of {', '.join(searched)} "
+            raise ValueError(f"no search space for the {model.name!r} model; choose one of {', '.join(searched)} "
                              "(kelvin_voigt is fitted by linear least squares)")
         steps = list(steps) or [False] * len(measurements)
         scaling = [m for m, is_step in zip(measurements, steps) if not is_step]
@@ -132,7 +150,7 @@ class SearchSpace:
         return cls(k_ref, c_ref, peak, interval, model, amplitude)
 
     @classmethod
-    def from_table(cls, table, model: str = "proposed") -> "SearchSpace":
+    def from_table(cls, table, model: str | BushingModel = "proposed") -> "SearchSpace":
         """Scales from a dynamic-stiffness table's rows of weight > 0: k_ref the median storage
         stiffness K', c_ref the median K''/omega (the Kelvin-Voigt c of each row), F_ref the
         largest |K*|*X, the interval that of the fit's sine loop at the highest frequency."""
@@ -157,8 +175,9 @@ class SearchSpace:
         return tuple(c.parameter for c in self.coordinates)
 
     @property
-    def bushing(self):
-        return get_model(self.model)
+    def bushing(self) -> BushingModel:
+        """The model (resolved once, when the space is made)."""
+        return self._bushing
 
     @property
     def tau_ref(self) -> float:

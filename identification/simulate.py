@@ -15,12 +15,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from fmu_src.bushing_models import BushingModel
 from identification.compiled_core import parameter_matrix, simulate_population_at
 from identification.forward_model import DrivenInput, prepare_input
 from identification.parameter_input import parameter_sets
 
 
-def simulate(parameters, time_s, displacement_mm, velocity_mm_s=None, model: str | None = None,
+def simulate(parameters, time_s, displacement_mm, velocity_mm_s=None, model: str | BushingModel | None = None,
              steps_per_sample: int | None = None) -> np.ndarray:
     """Simulate a model on a sampled displacement: the force at every sample.
 
@@ -35,8 +36,8 @@ def simulate(parameters, time_s, displacement_mm, velocity_mm_s=None, model: str
         Displacement [mm] at the samples.
     velocity_mm_s : array_like, optional
         Velocity [mm/s] at the samples, if measured (else from the displacement's interpolant).
-    model : str, optional
-        The model's name or FMI identifier; default: the one the parameters name, else
+    model : str or BushingModel, optional
+        The model, or its name or FMI identifier; default: the one the parameters name, else
         ``"proposed"``.
     steps_per_sample : int, optional
         Communication steps per sample interval (default: chosen from the signal); more give a
@@ -57,11 +58,11 @@ def simulate(parameters, time_s, displacement_mm, velocity_mm_s=None, model: str
     """
     values, bushing = _parameters_and_model(parameters, model)
     driven = prepare_input(time_s, displacement_mm, velocity_mm_s, steps=steps_per_sample)
-    return simulate_driven(parameter_matrix([values], bushing.name), driven, model=bushing.name)[0]
+    return simulate_driven(parameter_matrix([values], bushing), driven, model=bushing)[0]
 
 
 def simulate_driven(matrix: np.ndarray, driven: DrivenInput, max_substeps: int | None = None,
-                    model: str = "proposed") -> np.ndarray:
+                    model: str | BushingModel = "proposed") -> np.ndarray:
     """Forces [N], shape (P, outputs), of a (P, m) matrix of ``model``'s parameters
     (``compiled_core.parameter_matrix``) on a prepared input, at its output samples
     (``driven.sample_index``). NaN from where a candidate fails."""

@@ -219,6 +219,33 @@ def test_a_written_table_reads_back(tmp_path):
     assert np.all(read.preload_mm == 0.5) and np.all(read.weight == 1.0)
 
 
+def test_the_command_line_table_reads_back_identically(tmp_path, capsys):
+    """What ``characterise`` writes (the command, an ensemble's min/max columns included) is what
+    load_kdyn_table reads: the case bit for bit, |K*| and delta the very numbers written
+    (kdyn_table.NUMBER_FORMAT), within its 10 digits of the computed table; the file is the one
+    DynamicStiffness.to_csv writes, byte for byte."""
+    from identification.kdyn_table import NUMBER_FORMAT, ensemble_columns
+    softer = dict(TABLE5, k0=0.8 * TABLE5["k0"], c0=1.5 * TABLE5["c0"])
+    ensemble = save_ensemble(tmp_path / "e.json", [TABLE5, softer])
+    out = tmp_path / "kdyn.csv"
+    assert main(["characterise", "--params", str(ensemble), "--amplitudes-mm", "0.5,2", "--frequencies-hz", "1,10,30",
+                 "--preload-mm", "0.25", "--out", str(out), "--json"]) == 0
+    capsys.readouterr()
+    computed = characterise(read_ensemble(ensemble), [0.5, 2.0], [1.0, 10.0, 30.0], preload_mm=0.25)
+    assert out.read_bytes() == computed.to_csv(tmp_path / "again.csv").read_bytes()
+    with open(out, newline="") as handle:
+        assert next(csv.reader(handle)) == list(COLUMNS) + ensemble_columns()
+    read = load_kdyn_table(out)
+    assert len(read) == len(computed) == 6 and read.source == str(out)
+    for name in ("amplitude_mm", "frequency_hz", "preload_mm"):
+        np.testing.assert_array_equal(getattr(read, name), computed.column(name), err_msg=name)
+    for name in ("kdyn_N_per_mm", "loss_angle_deg"):
+        written = np.array([float(format(value, NUMBER_FORMAT)) for value in computed.column(name)])
+        np.testing.assert_array_equal(getattr(read, name), written, err_msg=name)
+        np.testing.assert_allclose(getattr(read, name), computed.column(name), rtol=5e-10, atol=0, err_msg=name)
+    np.testing.assert_array_equal(read.weight, np.ones(6))
+
+
 @pytest.mark.parametrize("text, message", [
     ("amplitude_mm,frequency_hz,kdyn_N_per_mm\n1,10,1000\n", "missing column.*loss_angle_deg"),
     ("amplitude_mm,frequency_hz,kdyn_N_per_mm,loss_angle_deg\n1,10,1000,5\n0,10,1000,5\n",
