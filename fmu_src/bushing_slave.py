@@ -60,19 +60,9 @@ else:
 np = importlib.import_module("numpy") if STEP_AXES else None
 
 
-# Jumping inputs. The FMU takes x + v*(t - t_k) over a step; where the x set at a step's start
-# differs from where the state is (x_(k-1) + v_(k-1)*h), it takes the difference as a
-# displacement jump, which the dashpots carry. A jump "counts" where |x - x_state| exceeds
-# JUMP_RELATIVE*|v|*h + JUMP_FLOOR (kernel units: mm or rad); more than JUMP_COUNT counting
-# steps among an axis's last JUMP_WINDOW is a v that is not the derivative of the sampled x
-# (a measured velocity fed beside a measured displacement), warned about once per instance. A
-# smooth x(t_k) with v = dx/dt(t_k) jumps by x''*h^2/2 only: near reversals, at most 9 of 50
-# steps of a 10 Hz sine at 1 ms (24 at 30 Hz), none with v the secant. Logging only: the force
-# is the same. bushing_instance.c applies the same test (BW_JUMP_* in bushing_fmu.h).
-JUMP_RELATIVE = 0.1
-JUMP_FLOOR = 1e-6
-JUMP_WINDOW = 50
-JUMP_COUNT = 30
+# Jumping inputs (integration.JUMP_*, which say why; logging only, the force is the same)
+JUMP_RELATIVE, JUMP_FLOOR = integration.JUMP_RELATIVE, integration.JUMP_FLOOR
+JUMP_WINDOW, JUMP_COUNT = integration.JUMP_WINDOW, integration.JUMP_COUNT
 _JUMP_MASK = (1 << JUMP_WINDOW) - 1
 
 
@@ -106,7 +96,8 @@ class _AxisState:
         self.last_errors = []          # the parameter errors of the last validation
         self.step_one = None           # the compiled step of this axis's model, if compiled
         self.params_row = None         # the parameters in force as an array (for step_one)
-        self.jump_history = 0          # bit i: the step i steps ago started with a jump (JUMP_*)
+        self.jump_history = 0          # bit i: the step i steps ago started with a jump (JUMP_*;
+                                       # for an axis of a compiled batch: the batch's array)
 
 
 class BushingSlave(Fmi2Slave):
@@ -127,11 +118,13 @@ class BushingSlave(Fmi2Slave):
         groups = {}
         for a in self._axes:
             groups.setdefault(a.model.name, []).append(a)
-        self._batches = [[STEP_AXES[name][0], group, None] for name, group in groups.items()
-                         if name in STEP_AXES and len(group) > 1]
+        # [step, axes, parameter rows, jump histories, the next step's jump histories]
+        self._batches = [[STEP_AXES[name][0], group, None, np.zeros(len(group), dtype=np.int64),
+                          np.zeros(len(group), dtype=np.int64)]
+                         for name, group in groups.items() if name in STEP_AXES and len(group) > 1]
         for a in self._axes:
             a.step_one = STEP_AXES[a.model.name][1] if a.model.name in STEP_AXES else None
-        batched = {id(a) for _, group, _ in self._batches for a in group}
+        batched = {id(a) for batch in self._batches for a in batch[1]}
         self._unbatched = [a for a in self._axes if id(a) not in batched]
         self._initial_state_pending = True  # set at exit of initialization, or first valid step
         self._parameters_changed = True     # some axis's parameters were set since the last check
@@ -290,20 +283,24 @@ class BushingSlave(Fmi2Slave):
         # every axis first, then commit all: a refusal leaves every axis as it was
         compiled = self._step_compiled(step_size) if self._batches else None
         # None: no compiled call, or an axis failed in it: every axis one by one (for the message)
-        steps = compiled if compiled is not None else []
+        steps, crossings = compiled if compiled is not None else ([], ())
         for a in (self._unbatched if compiled is not None else self._axes):
             step = self._step_axis(a, current_time, step_size)
             if step is None:
                 return False
             steps.append(step)
-        for a, state, x_end, output in steps:
+        for batch, crossed in crossings:   # the compiled step counted its axes' jumps: keep them
+            batch[3], batch[4] = batch[4], batch[3]
+            if crossed >= 0 and not self._jump_warned:
+                self._warn_jumping(batch[1][crossed], current_time, step_size, int(batch[3][crossed]))
+        for a, state, x_end, output, jumps_counted in steps:
             if abs(output) > a.output_bound and not a.output_warned:
                 self._warn_implausible(a, output, current_time + step_size)
-            if not self._jump_warned:   # inline: it runs on every axis and step
+            if not (jumps_counted or self._jump_warned):   # inline: it runs on every axis and step
                 jumped = abs(a.x_now - a.state_x) > JUMP_RELATIVE * (abs(a.v * a.to_kernel) * step_size) + JUMP_FLOOR
                 a.jump_history = ((a.jump_history << 1) | jumped) & _JUMP_MASK
                 if jumped and a.jump_history.bit_count() > JUMP_COUNT:
-                    self._warn_jumping(a, current_time, step_size)
+                    self._warn_jumping(a, current_time, step_size, a.jump_history)
             a.state = state
             a.state_x = a.x_now = x_end
             a.last_output = output
@@ -311,8 +308,8 @@ class BushingSlave(Fmi2Slave):
         return True
 
     def _step_axis(self, a, current_time, step_size):
-        """(axis, new state, displacement at the end, output) of one axis's step, or None after
-        logging why it cannot be taken."""
+        """(axis, new state, displacement at the end, output, False: its jumps not yet counted) of
+        one axis's step, or None after logging why it cannot be taken."""
         axis = a.axis
         x, v = a.x_now, a.v * a.to_kernel
         if a.step_one is not None:   # compiled: one call (the same kernels as advance and force)
@@ -320,7 +317,7 @@ class BushingSlave(Fmi2Slave):
                                                       integration.DEFAULT_MAX_SUBSTEPS)
             output *= a.from_kernel
             if status == integration.OK and math.isfinite(output):
-                return a, state, x_end, output
+                return a, state, x_end, output, False
         try:
             state, _ = integration.advance(a.model, a.constants, a.state, a.state_x, x, v, step_size)
         except integration.StepError as exc:
@@ -331,31 +328,35 @@ class BushingSlave(Fmi2Slave):
             return self._refuse(f"doStep at t = {current_time} s refused: {axis.output} would be {output} "
                                 f"{axis.output_unit} ({axis.displacement} = {a.x} {axis.displacement_unit}, "
                                 f"{axis.velocity} = {a.v} {axis.velocity_unit}); check the units of the inputs") or None
-        return a, state, x_end, output
+        return a, state, x_end, output, False
 
     def _step_compiled(self, step_size):
-        """Every axis's step in one compiled call per model (``compiled_kernels._step_axes``, the
-        same kernels and arithmetic as :meth:`_step_axis`); None if any axis's step fails, so that
-        the axis-by-axis step redoes it and words the refusal."""
-        steps = []
+        """(steps, [(batch, the first axis whose jumps crossed JUMP_COUNT or -1)]): every axis's
+        step in one compiled call per model (``compiled_kernels._step_axes``, the same kernels and
+        arithmetic as :meth:`_step_axis`, and the same jump count as :meth:`do_step`'s); None if
+        any axis's step fails, so that the axis-by-axis step redoes it and words the refusal."""
+        steps, crossings = [], []
         for batch in self._batches:
-            step_axes, group, params = batch
+            step_axes, group, params, histories, next_histories = batch
             if params is None:
                 params = batch[2] = np.array([a.model.values(a.values) for a in group])
             rows = np.array([(a.x_now, a.v * a.to_kernel, a.state_x, *a.state) for a in group])
-            out, failures = step_axes(params, rows, step_size, integration.DEFAULT_MAX_SUBSTEPS)
+            out, failures, crossed = step_axes(params, rows, step_size, integration.DEFAULT_MAX_SUBSTEPS,
+                                               histories, next_histories)
             if failures:
                 return None
+            crossings.append((batch, crossed))
             for a, row in zip(group, out.tolist()):   # (*state, force, x + v*h)
-                steps.append((a, tuple(row[:-2]), row[-1], row[-2] * a.from_kernel))
-        return steps
+                steps.append((a, tuple(row[:-2]), row[-1], row[-2] * a.from_kernel, True))
+        return steps, crossings
 
-    def _warn_jumping(self, a, current_time, step_size):
+    def _warn_jumping(self, a, current_time, step_size, history):
         """Warn, once per instance, that more than JUMP_COUNT of the axis's last JUMP_WINDOW steps
-        started with a displacement jump (JUMP_*; this step is one of them, not yet committed)."""
+        started with a displacement jump (``history``, JUMP_*; this step is one of them, not yet
+        committed)."""
         mismatch = abs(a.x_now - a.state_x)
         travel = abs(a.v * a.to_kernel) * step_size
-        count = a.jump_history.bit_count()
+        count = history.bit_count()
         self._jump_warned = True
         axis = a.axis
         unit = axis.displacement_unit

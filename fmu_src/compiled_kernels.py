@@ -189,14 +189,17 @@ against 1.2 us for numba's dispatch (Table 5, measured 2026-11-23); prepare() an
 initial_state() run once."""
 
 
-def _step_axes(params, rows, h, max_substeps):
+def _step_axes(params, rows, h, max_substeps, histories, next_histories):
     """One communication step of every axis of one model, in one compiled call: what the FMU's
     ``integration.advance`` and ``force`` do axis by axis. ``params``: each axis's values in spec
     order; ``rows``: each axis's step input and committed state, (x, v, state_x, *state) in the
-    kernels' units (mm or rad, per s; state_x the displacement the state belongs to); ``h`` [s].
-    Returns (rows of (*new state, force at x + v*h with velocity v, x + v*h), failures): where
-    any axis fails (a status other than OK, or a force that is not finite), the FMU redoes the
-    step one axis at a time, which words the refusal.
+    kernels' units (mm or rad, per s; state_x the displacement the state belongs to); ``h`` [s];
+    ``histories``: each axis's jumping-input history (``integration.JUMP_*``: bit i, the step i
+    steps ago jumped), into ``next_histories`` with this step's bit (the FMU keeps them if it
+    commits the step). Returns (rows of (*new state, force at x + v*h with velocity v, x + v*h),
+    failures, the first axis whose history now holds more than JUMP_COUNT jumps with this step
+    one of them, or -1): where any axis fails (a status other than OK, or a force that is not
+    finite), the FMU redoes the step one axis at a time, which words the refusal.
 
     Written here, never called here: its source is compiled in the model's generated module
     (:func:`_fmu_appendix`), where ``prepare``, ``step`` and ``force`` are that model's compiled
@@ -204,9 +207,20 @@ def _step_axes(params, rows, h, max_substeps):
     count, width = rows.shape
     out = np.empty((count, width - 1))
     failures = 0
+    crossed = -1
     for i in range(count):
         m = prepare(_VALUES(params[i]))
         x, v, state_x = rows[i, 0], rows[i, 1], rows[i, 2]
+        jumped = abs(x - state_x) > _JUMP_RELATIVE * (abs(v) * h) + _JUMP_FLOOR
+        bits = ((histories[i] << 1) | (1 if jumped else 0)) & ((np.int64(1) << _JUMP_WINDOW) - 1)
+        next_histories[i] = bits
+        if jumped and crossed < 0:
+            jumps = 0
+            while bits:
+                bits &= bits - 1
+                jumps += 1
+            if jumps > _JUMP_COUNT:
+                crossed = i
         state, used, status = step(m, _STATE(rows[i, 3:]), state_x, x, v, h, max_substeps)
         _STORE(out, i, state)
         x_end = x + v * h
@@ -214,7 +228,7 @@ def _step_axes(params, rows, h, max_substeps):
         out[i, width - 2] = x_end
         if status != _OK or not math.isfinite(out[i, width - 3]):
             failures += 1
-    return out, failures
+    return out, failures, crossed
 
 
 def _step_one(params, state, state_x, x, v, h, max_substeps):
@@ -237,7 +251,9 @@ def _fmu_appendix(model) -> str:
     """The FMU's batched step for ``model`` (:func:`_step_axes`) and its helpers."""
     size = len(model.states)
     stores = "".join(f"    out[i, {j}] = state[{j}]\n" for j in range(size)) or "    pass\n"
-    return ("\n\nimport math\nimport numpy as np\nfrom " + integration_module() + " import OK as _OK\n\n"
+    return ("\n\nimport math\nimport numpy as np\nfrom " + integration_module()
+            + " import OK as _OK, JUMP_RELATIVE as _JUMP_RELATIVE, JUMP_FLOOR as _JUMP_FLOOR, "
+            "JUMP_WINDOW as _JUMP_WINDOW, JUMP_COUNT as _JUMP_COUNT\n\n"
             + _row_tuple("_VALUES", len(model.specs)) + _row_tuple("_STATE", size)
             + "@numba.njit(cache=True)\ndef _STORE(out, i, state):\n" + stores + "\n\n"
             + inspect.getsource(_step_axes)
@@ -265,7 +281,8 @@ def compiled_model(model):
     constants = model.prepare(values)
     state, _ = kernels["jump"](constants, model.initial_state(constants, 0.0), 1e-3)
     kernels["integrate"](constants, state, 1e-3, 0.0, 1e-3, 10)
-    kernels["step_axes"](np.array([values]), np.array([[1e-3, 0.0, 0.0, *state]]), 1e-3, 10)
+    kernels["step_axes"](np.array([values]), np.array([[1e-3, 0.0, 0.0, *state]]), 1e-3, 10,
+                         np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.int64))
     kernels["step_one"](np.array(values), tuple(float(value) for value in state), 0.0, 1e-3, 0.0, 1e-3, 10)
     return kernels, time.perf_counter() - started
 

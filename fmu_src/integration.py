@@ -62,6 +62,18 @@ DEFAULT_MAX_SUBSTEPS = 20000
 OK, TOO_MANY_SUBSTEPS, NOT_FINITE = 0, 1, 2
 """Status codes of the kernels."""
 
+JUMP_RELATIVE, JUMP_FLOOR, JUMP_WINDOW, JUMP_COUNT = 0.1, 1e-6, 50, 30
+"""Jumping inputs, which the FMUs warn about (logging only; the force is the same). An FMU takes
+x + v*(t - t_k) over a step; where the x set at a step's start differs from where the state is
+(x_(k-1) + v_(k-1)*h), it takes the difference as a displacement jump, which the dashpots carry.
+A step "jumps" where |x - x_state| > JUMP_RELATIVE*|v|*h + JUMP_FLOOR (kernel units: mm or rad);
+more than JUMP_COUNT jumping steps among an axis's last JUMP_WINDOW (<= 62: the history is the
+bits of one integer) is a v that is not the derivative of the sampled x (a measured velocity fed
+beside a measured displacement). A smooth x(t_k) with v = dx/dt(t_k) jumps by x''*h^2/2 only:
+near reversals, at most 9 of 50 steps of a 10 Hz sine at 1 ms (24 at 30 Hz), none with v the
+secant. The pythonfmu slave, the compiled batched step (compiled_kernels._step_axes) and the
+native C (BW_JUMP_*, generated from these) apply the same test."""
+
 
 class StepError(ArithmeticError):
     """The step cannot be computed (overflow, non-finite result, too many substeps)."""

@@ -168,3 +168,27 @@ def test_a_sampled_sine_through_the_helper_matches_simulate(bushing_fmu, fitted)
     force = simulate_measurement(bushing_fmu, (t, x), start_values=PARAMS, step_size=2.5e-4)
     reference = simulate(PARAMS, t, x, steps_per_sample=4)
     assert np.max(np.abs(force - reference)) <= FORCE_TOLERANCE * np.max(np.abs(reference))
+
+
+def test_a_six_axis_fmus_compiled_batch_counts_jumps_as_the_native_fmu_does(pythonfmu_model_fmus,
+                                                                           native_model_fmus):
+    """The six-axis FMU steps x and y (both the proposed model) in one compiled call, which counts
+    their jumps itself: a velocity 30 % off dy/dt on axis y alone is warned about once, naming y,
+    with the native FMU's words."""
+    from fmu_src.axes import SIX_AXES
+    t = np.arange(200) * 1e-3
+    warnings = {}
+    for name, path in (("pythonfmu", pythonfmu_model_fmus["six_axis"]), ("native", native_model_fmus["six_axis"])):
+        fmu = BushingFmu(path, name, initial_inputs={})
+        for k in range(t.size - 1):
+            for number, axis in enumerate(SIX_AXES):
+                omega, amplitude = 2.0 * math.pi * (5.0 + number), (1e-3 if number < 3 else 1e-2)
+                fmu.set(axis.displacement, amplitude * math.sin(omega * t[k]))
+                scale = 1.3 if axis.name == "y" else 1.0
+                fmu.set(axis.velocity, scale * amplitude * omega * math.cos(omega * t[k]))
+            assert fmu.do_step(1e-3) == "ok"
+        warnings[name] = [message for message in fmu.messages_with("warning") if "jumps in" in message]
+        fmu.free()
+        assert len(warnings[name]) == 1, warnings[name]
+        assert "the displacement input dy jumps in" in warnings[name][0]
+    assert warnings["pythonfmu"] == warnings["native"]

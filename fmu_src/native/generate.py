@@ -248,5 +248,9 @@ def model_source(axis_models, identifier: str) -> GeneratedModel:
         f"#define BW_KERNEL_OK {integration.OK}\n"
         f"#define BW_KERNEL_TOO_MANY_SUBSTEPS {integration.TOO_MANY_SUBSTEPS}\n"
         f"#define BW_KERNEL_NOT_FINITE {integration.NOT_FINITE}\n"
-        f"#define BW_MAX_SUBSTEPS {integration.DEFAULT_MAX_SUBSTEPS}\n\n")
+        f"#define BW_MAX_SUBSTEPS {integration.DEFAULT_MAX_SUBSTEPS}\n"
+        f"#define BW_JUMP_RELATIVE {integration.JUMP_RELATIVE!r}\n"
+        f"#define BW_JUMP_FLOOR {integration.JUMP_FLOOR!r}\n"
+        f"#define BW_JUMP_WINDOW {integration.JUMP_WINDOW}\n"
+        f"#define BW_JUMP_COUNT {integration.JUMP_COUNT}\n\n")
     return GeneratedModel(header + body, token, indicators)

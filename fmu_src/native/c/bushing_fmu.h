@@ -103,13 +103,4 @@ typedef struct {
     const double *defaults;     /* the parameters' start values */
 } bw_axis_spec;
 
-/* Jumping inputs (fmu_src/bushing_slave.py, JUMP_*): a step counts as starting with a jump where
- * |x - x_state| > BW_JUMP_RELATIVE*|v|*h + BW_JUMP_FLOOR (kernel units: mm or rad); more than
- * BW_JUMP_COUNT of an axis's last BW_JUMP_WINDOW steps is a v that is not dx/dt of the sampled x,
- * warned about once per instance. Logging only: the force is the same. */
-#define BW_JUMP_RELATIVE 0.1
-#define BW_JUMP_FLOOR 1e-6
-#define BW_JUMP_WINDOW 50
-#define BW_JUMP_COUNT 30
-
 #endif

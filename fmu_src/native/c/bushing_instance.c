@@ -446,9 +446,9 @@ static bw_status bw_refuse(bw_instance *inst, const char *format, ...) {
     return BW_DISCARD;
 }
 
-/* Record whether axis a's step starts with a displacement jump (BW_JUMP_*, before the step is
-   committed) and warn, once per instance, when more than BW_JUMP_COUNT of its last
-   BW_JUMP_WINDOW steps do (as bushing_slave.py's _count_jump). */
+/* Record whether axis a's step starts with a displacement jump (BW_JUMP_*, generated from
+   integration.JUMP_*, which say why; before the step is committed) and warn, once per instance,
+   when more than BW_JUMP_COUNT of its last BW_JUMP_WINDOW steps do (as bushing_slave.py does). */
 static void bw_count_jump(bw_instance *inst, int a, double current_time, double h) {
     const bw_axis_spec *spec = &bw_axis_specs[a];
     const bw_axis *axis = &inst->data.axes[a];
