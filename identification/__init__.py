@@ -46,18 +46,22 @@ The modules, in the order of the workflow:
   SIGTERM: one line, exit 130/143, outputs whole or untouched), ``extras``, ``errors`` (every error
   and warning type).
 """
-from fmu_src.bushing_params import ParameterError
-from fmu_src.parameter_files import (ParameterEnsemble, ParameterSet, read_ensemble, read_parameter_set,
+from identification.interrupt import exit_quietly_on_early_ctrl_c
+
+exit_quietly_on_early_ctrl_c()   # first: before the imports below take their second or two
+
+from fmu_src.bushing_params import ParameterError  # noqa: E402
+from fmu_src.parameter_files import (ParameterEnsemble, ParameterSet, read_ensemble, read_parameter_set,  # noqa: E402
                                      save_ensemble, save_parameters)
-from identification.dynamic_stiffness import characterise
-from identification.errors import FitNotConvergedWarning, IdentificationError, MeasurementError, MissingExtraError
-from identification.fit_result import FitResult
-from identification.fitting import fit
-from identification.fmu_input import fmu_input, simulate_measurement
-from identification.measurements import load_measurement
-from identification.predict import predict
-from identification.rig_tests import RigTest, load_manifest, training_tests
-from identification.simulate import simulate
+from identification.dynamic_stiffness import characterise  # noqa: E402
+from identification.errors import FitNotConvergedWarning, IdentificationError, MeasurementError, MissingExtraError  # noqa: E402
+from identification.fit_result import FitResult  # noqa: E402
+from identification.fitting import fit  # noqa: E402
+from identification.fmu_input import fmu_input, simulate_measurement  # noqa: E402
+from identification.measurements import load_measurement  # noqa: E402
+from identification.predict import predict  # noqa: E402
+from identification.rig_tests import RigTest, load_manifest, training_tests  # noqa: E402
+from identification.simulate import simulate  # noqa: E402
 
 __all__ = ["fit", "FitResult", "FitNotConvergedWarning", "simulate", "predict", "characterise", "load_measurement",
            "fmu_input", "simulate_measurement",

@@ -20,6 +20,7 @@ from __future__ import annotations
 import contextlib
 import os
 import signal
+import sys
 import tempfile
 import threading
 from pathlib import Path
@@ -75,7 +76,8 @@ def signals_raise():
     finally:
         _command_running[0] = False
         for handled, handler in previous.items():
-            signal.signal(handled, handler)
+            # the early Ctrl-C handler says "nothing written": after a command, Python's own
+            signal.signal(handled, signal.default_int_handler if handler is _exit_on_ctrl_c else handler)
 
 
 @contextlib.contextmanager
@@ -161,6 +163,36 @@ def interrupts_held():
         yield
     finally:
         signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+
+
+COMMAND_NAMES = ("bushing-identify",)
+"""The console script's name (``python -m identification`` is told by the interpreter's arguments)."""
+
+
+def started_as_command() -> bool:
+    """Whether this process is the command line (``python -m identification ...`` or
+    ``bushing-identify ...``), not a program that imports the package: while Python imports the
+    package, before ``cli.main`` runs, only the interpreter's own arguments tell."""
+    arguments = list(getattr(sys, "orig_argv", ()))
+    if "-m" in arguments:
+        return arguments[arguments.index("-m") + 1:arguments.index("-m") + 2] == ["identification"]
+    return bool(sys.argv) and Path(sys.argv[0]).name.startswith(COMMAND_NAMES)
+
+
+def _exit_on_ctrl_c(signal_number, frame):
+    sys.stderr.write("interrupted: nothing written\n")
+    sys.stderr.flush()
+    os._exit(128 + signal_number)   # during imports: nothing written, no worker started
+
+
+def exit_quietly_on_early_ctrl_c() -> None:
+    """In the command line only (:func:`started_as_command`), from the first line of the
+    package's import until ``cli.main`` installs :func:`signals_raise`'s handlers: Ctrl-C ends the
+    process with the one line and exit status 130 instead of a traceback from the middle of an
+    import. (SIGTERM keeps its default then: the process ends at once, as a shell's 143, with no
+    file written and no worker started.)"""
+    if started_as_command() and threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, _exit_on_ctrl_c)
 
 
 def ignore_interrupts() -> None:

@@ -239,3 +239,29 @@ def test_a_write_that_fails_leaves_the_earlier_file_and_no_partial_one(tmp_path)
             raise ValueError("the writer failed")
     assert target.read_text() == "old\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["result.csv"]
+
+
+def test_ctrl_c_while_the_command_still_imports_ends_it_with_the_one_line(tmp_path, command):
+    # Between the package's first line and cli.main (a second or two of imports) only the early
+    # handler stands between Ctrl-C and a traceback from the middle of an import. The window is
+    # told from outside: numpy is loaded (the package's imports are under way) and the SIGTERM
+    # handler of cli.main is not yet installed.
+    run = command("fit", "--sine", SINE, "--out", tmp_path / "fit.json")
+
+    def importing():
+        status = open(f"/proc/{run.process.pid}/status").read()
+        caught = int(next(line.split()[1] for line in status.splitlines() if line.startswith("SigCgt:")), 16)
+        assert not caught & (1 << (signal.SIGTERM - 1)), "the command reached main before the test saw it import"
+        return "numpy" in open(f"/proc/{run.process.pid}/maps").read()
+    run.wait_until(importing, "numpy being imported")
+    run.stop(signal.SIGINT, whole_group=True)
+    assert_stopped_cleanly(run, signal.SIGINT)
+    assert not (tmp_path / "fit.json").exists()
+
+
+def test_the_early_handler_is_only_the_command_lines():
+    # A program that imports the package keeps Python's Ctrl-C (KeyboardInterrupt where it is).
+    script = ("import signal, identification; "
+              "print(signal.getsignal(signal.SIGINT) is signal.default_int_handler)")
+    output = subprocess.run([sys.executable, "-c", script], cwd=REPO, capture_output=True, text=True, check=True)
+    assert output.stdout.strip() == "True"
