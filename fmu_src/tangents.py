@@ -76,11 +76,10 @@ import inspect
 import itertools
 import linecache
 import math
-import textwrap
 import types
 from typing import Callable
 
-from .unrolling import UnrollError, unroll
+from .unrolling import UnrollError, kernel_definition, kernel_global, kernel_statements
 
 SLOPE_CAP = 1e100
 """Largest magnitude of the slope factor a^(b-1) of ``a ** b`` (and of d sqrt) near a = 0 (module docstring)."""
@@ -176,10 +175,8 @@ class _Spec:
         self.activities = activities
         self.name = name
         self.where = f"{function.__module__}.{function.__name__}"
-        self.line_offset = function.__code__.co_firstlineno - 1
-        source = textwrap.dedent(inspect.getsource(function))
         try:
-            self.tree = unroll(ast.parse(source), function.__globals__, self.where, self.line_offset).body[0]
+            self.tree, self.line_offset = kernel_definition(function)
         except UnrollError as exc:
             raise TangentError(str(exc)) from None
         if not isinstance(self.tree, ast.FunctionDef):
@@ -204,10 +201,7 @@ class _Spec:
 
     @property
     def body(self):
-        body = self.tree.body
-        if body and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant):
-            body = body[1:]
-        return body
+        return kernel_statements(self.tree)
 
     # ------------------------------------------------------------------ activity analysis
     def analyse(self):
@@ -271,12 +265,10 @@ class _Spec:
         return ast.copy_location(ast.BinOp(ast.Name(s.target.id, ast.Load()), s.op, s.value), s)
 
     def global_value(self, name: str, node):
-        namespace = self.function.__globals__
-        if name in namespace:
-            return namespace[name]
-        if hasattr(builtins, name):
-            return getattr(builtins, name)
-        raise self.error(node, f"unknown name {name!r}")
+        try:
+            return kernel_global(self.function, name)
+        except NameError:
+            raise self.error(node, f"unknown name {name!r}") from None
 
     def callee(self, e: ast.Call):
         """('math', name), ('builtin', name) or ('kernel', function)."""

@@ -26,6 +26,9 @@ that used one is refused by numba and by the C translation, which names the line
 from __future__ import annotations
 
 import ast
+import builtins
+import inspect
+import textwrap
 from typing import Mapping
 
 
@@ -43,6 +46,34 @@ def unroll(tree: ast.AST, namespace: Mapping[str, object], where: str = "", line
     tree's line 1, minus 1)."""
     tree = _Unroller(namespace, where, line_offset).visit(tree)
     return ast.fix_missing_locations(tree)
+
+
+def kernel_definition(function) -> tuple[ast.FunctionDef, int]:
+    """(``function``'s definition as the compiled paths read it: its source unrolled by
+    :func:`unroll` in its module's namespace, the offset of its first line in its file). Raises
+    UnrollError."""
+    line_offset = function.__code__.co_firstlineno - 1
+    source = textwrap.dedent(inspect.getsource(function))
+    tree = unroll(ast.parse(source), function.__globals__, f"{function.__module__}.{function.__name__}", line_offset)
+    return tree.body[0], line_offset
+
+
+def kernel_statements(definition: ast.FunctionDef) -> list:
+    """A function definition's statements without its docstring."""
+    body = definition.body
+    if body and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant):
+        body = body[1:]
+    return body
+
+
+def kernel_global(function, name: str):
+    """What ``name`` means in ``function``'s module: a global of it, else a builtin; NameError if
+    neither."""
+    if name in function.__globals__:
+        return function.__globals__[name]
+    if hasattr(builtins, name):
+        return getattr(builtins, name)
+    raise NameError(name)
 
 
 class _Unroller(ast.NodeTransformer):

@@ -44,15 +44,12 @@ bitwise where it can).
 from __future__ import annotations
 
 import ast
-import builtins
-import inspect
 import math
-import textwrap
 import types
 from dataclasses import dataclass, field
 from typing import Callable, Union
 
-from ..unrolling import UnrollError, unroll
+from ..unrolling import UnrollError, kernel_definition, kernel_global, kernel_statements
 
 DOUBLE, INT = "double", "int"
 Type = Union[str, tuple]
@@ -166,11 +163,8 @@ class _Function:
         self.python = python
         self.argument_types = argument_types
         self.name = name
-        source = textwrap.dedent(inspect.getsource(python))
-        self.line_offset = python.__code__.co_firstlineno - 1
         try:
-            self.tree = unroll(ast.parse(source), python.__globals__, f"{python.__module__}.{python.__name__}",
-                               self.line_offset).body[0]
+            self.tree, self.line_offset = kernel_definition(python)
         except UnrollError as exc:
             raise TranslationError(str(exc)) from None
         self.arguments = [a.arg for a in self.tree.args.args]
@@ -280,10 +274,7 @@ class _Function:
 
     @property
     def body(self):
-        body = self.tree.body
-        if body and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant):
-            body = body[1:]     # the docstring
-        return body
+        return kernel_statements(self.tree)
 
     def assign_type(self, target, t: Type, node):
         if isinstance(target, ast.Name):
@@ -357,12 +348,10 @@ class _Function:
         return call.args if len(call.args) == 2 else [ast.Constant(0), call.args[0]]
 
     def global_value(self, name: str, node):
-        namespace = self.python.__globals__
-        if name in namespace:
-            return namespace[name]
-        if hasattr(builtins, name):
-            return getattr(builtins, name)
-        raise self.error(node, f"unknown name {name!r}")
+        try:
+            return kernel_global(self.python, name)
+        except NameError:
+            raise self.error(node, f"unknown name {name!r}") from None
 
     def type_of(self, e) -> Type:
         if isinstance(e, ast.Constant):
