@@ -19,7 +19,7 @@ import numpy as np
 from fmu_src.bushing_models import MODEL_CHOICES, MODEL_NAMES, get_model
 from fmu_src.parameter_files import read_parameter_set
 from identification.errors import FitNotConvergedWarning, UsageError
-from identification.measurements import load_measurement
+from identification.measurements import load_measurement, measurement_name
 from identification.rig_tests import load_manifest, training_tests
 
 
@@ -127,7 +127,7 @@ def fit_command(args) -> int:
         for test in tests:
             m = test.measurement
             predicted = simulate(result.parameters, m.time_s, m.displacement_mm, m.measured_velocity_mm_s)
-            written.append(plot_comparison(m, {model: predicted}, args.plots / f"fit_{Path(m.source).stem}.png"))
+            written.append(plot_comparison(m, {model: predicted}, args.plots / f"fit_{measurement_name(m.source)}.png"))
         if table is not None:
             written += _plot_table_fit(result, table, args.plots)
     print("wrote " + ", ".join(str(path) for path in written))
@@ -205,7 +205,7 @@ def report_command(args) -> int:
         print(format_data_errors(data_errors(params, measurements, kelvin_voigt, model)))
         if args.plots:
             for m in measurements:
-                path = plot_measurement(params, m, args.plots / (Path(m.source).stem + ".png"), kelvin_voigt, model)
+                path = plot_measurement(params, m, args.plots / (measurement_name(m.source) + ".png"), kelvin_voigt, model)
                 print(f"wrote {path}")
     return 0
 
