@@ -149,6 +149,15 @@ def native_model_fmus(tmp_path_factory) -> dict:
 
 
 @pytest.fixture(scope="session")
+def native_model_fmi3_fmus(tmp_path_factory) -> dict:
+    """Each model's native FMU as FMI 3.0, and the six-axis one, with their default parameters."""
+    from fmu_src.bushing_models import MODELS
+    folder = tmp_path_factory.mktemp("native_fmi3")
+    return {name: build_fmu.build_native_fmu(out_dir=folder, model=name, fmi_version=3).path
+            for name in (*MODELS, "six_axis")}
+
+
+@pytest.fixture(scope="session")
 def pythonfmu_model_fmus(tmp_path_factory) -> dict:
     """Each model's pythonfmu FMU, and the six-axis one, with their default parameters."""
     from fmu_src.bushing_models import MODELS

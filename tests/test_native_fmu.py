@@ -212,10 +212,9 @@ def test_the_win64_dll_under_wine_gives_the_forces_of_linux64(native_fmus, tmp_p
 
 
 @pytest.fixture(scope="module")
-def native_fmi3_fmus(tmp_path_factory):
-    """Each model's native FMU as FMI 3.0."""
-    folder = tmp_path_factory.mktemp("native_fmi3")
-    return {name: build_fmu.build_native_fmu(out_dir=folder, model=name, fmi_version=3).path for name in FMUS}
+def native_fmi3_fmus(native_model_fmi3_fmus):
+    """Each model's native FMU as FMI 3.0 (conftest)."""
+    return native_model_fmi3_fmus
 
 
 @pytest.mark.parametrize("name", FMUS)

@@ -6,6 +6,9 @@ From the FMU's axes [(axes.Axis, model on that axis, parameters)] it writes
   ``force``, ``derivatives``, ``switches``, ``update`` where a model has one, and the shared
   machinery they call), translated from
   their Python source by ``python_to_c``;
+- their tangents (``tangents``: ``force`` and ``derivatives`` in a direction of the state and
+  the inputs, ``jump`` in the jump), generated from the same source and translated the same way,
+  for the FMU's directional derivatives;
 - per model, wrappers with the array interface of ``bw_model`` (``c/bushing_fmu.h``), and its
   parameter rules (``ParameterSpec``, ``Constraint``) as tables;
 - the FMU's axes with their start values, its variables (``variables.fmu_variables`` and the
@@ -22,6 +25,7 @@ import uuid
 from dataclasses import dataclass
 
 from .. import integration
+from ..tangents import tangent
 from ..model_definition import BushingModel
 from ..variables import FmuVariable, derivative_variables, fmu_variables, indicator_variables
 from .python_to_c import DOUBLE, INT, Translation, describe
@@ -70,6 +74,11 @@ class ModelCode:
             "derivatives": translation.function(model.derivatives, (m, s, DOUBLE, DOUBLE)),
             "switches": translation.function(model.switches, (m, s, DOUBLE, DOUBLE)),
         }
+        tangent_arguments = (m, s, DOUBLE, DOUBLE, s, DOUBLE, DOUBLE)
+        self.kernels["force_tangent"] = translation.function(tangent(model.force), tangent_arguments)
+        self.kernels["derivatives_tangent"] = translation.function(tangent(model.derivatives), tangent_arguments)
+        self.kernels["jump_tangent"] = translation.function(tangent(model.jump, inactive=("m", "state")),
+                                                            (m, s, DOUBLE, DOUBLE))
         if model.update is not None:
             self.kernels["update"] = translation.function(model.update, (m, s, DOUBLE, DOUBLE))
         self.switches = len(self.kernels["switches"].return_type)
@@ -127,7 +136,46 @@ class ModelCode:
                 f"{self.state_literal('s')}, x, v);\n"
                 + ("".join(f"    {out}[{i}] = r.f{i};\n" for i in range(count)) or
                    f"    (void)r;\n    (void){out};\n" + ("    (void)s;\n" if not states else "")) + "}\n")
+        lines.append(self.tangent_wrappers())
         return "\n".join(lines)
+
+    def tangent_wrappers(self) -> str:
+        """The array interface of ``bw_model``'s tangents: ``force_tangent`` returns dF,
+        ``derivatives_tangent`` writes d(rates), both in the direction (ds, dx, dv);
+        ``jump_tangent`` takes the state through the jump (as ``jump``) and writes its
+        derivative with respect to the jump."""
+        k, name = self.kernels, self.name
+        constants = f"((const bw_constants *)c)->{name}"
+        states = len(self.state_type)
+        unused = "".join(f"    (void){a};\n" for a in ("s", "ds")) if not states else ""
+
+        def elements(expression: str, t) -> list[str]:
+            # A tangent whose value does not depend on the direction at all is the scalar 0.0.
+            return [f"{expression}.f{i}" for i in range(states)] if isinstance(t, tuple) else [expression] * states
+
+        force = k["force_tangent"]
+        derivatives = k["derivatives_tangent"]
+        jump = k["jump_tangent"]
+        call = f"({constants}, {self.state_literal('s')}, x, v, {self.state_literal('ds')}, dx, dv)"
+        rates = elements("r.f1", derivatives.return_type[1])
+        jumped_state = elements("r.f0.f0", jump.return_type[0][0])
+        jump_derivative = jump.return_type[1]
+        d_state = elements("r.f1.f0", jump_derivative[0]) if isinstance(jump_derivative, tuple) else ["0.0"] * states
+        return (
+            f"static double bw_{name}_force_tangent(const void *c, const double *s, double x, double v, "
+            f"const double *ds, double dx, double dv) {{\n{unused}"
+            f"    return {force.name}{call}.f1;\n}}\n\n"
+            f"static void bw_{name}_derivatives_tangent(const void *c, const double *s, double x, double v, "
+            f"const double *ds, double dx, double dv, double *d_rates) {{\n"
+            + unused + f"    {self.translation.c_type(derivatives.return_type)} r = {derivatives.name}{call};\n"
+            + ("".join(f"    d_rates[{i}] = {e};\n" for i, e in enumerate(rates)) or "    (void)r;\n    (void)d_rates;\n")
+            + "}\n\n"
+            f"static int bw_{name}_jump_tangent(const void *c, double *s, double jump, double *ds) {{\n"
+            f"    {self.translation.c_type(jump.return_type)} r = {jump.name}({constants}, {self.state_literal('s')}, "
+            f"jump, 1.0);\n"
+            + "".join(f"    s[{i}] = {e};\n" for i, e in enumerate(jumped_state))
+            + "".join(f"    ds[{i}] = {e};\n" for i, e in enumerate(d_state))
+            + ("    (void)s;\n    (void)ds;\n" if not states else "") + "    return r.f0.f1;\n}\n")
 
     def tables(self, suffix: str, model: BushingModel) -> str:
         """The parameter rules of ``model`` (this model on one kind of axis: its units) and its
@@ -156,7 +204,7 @@ class ModelCode:
             out += f"static const bw_constraint bw_constraints_{name}[] = {{\n" + ",\n".join(constraints) + "\n};\n"
         kernels = ", ".join(f"bw_{self.name}_{kernel}" for kernel in
                             ("prepare", "initial_state", "step", "jump", "force", "derivatives", "switches",
-                             "update"))
+                             "update", "force_tangent", "derivatives_tangent", "jump_tangent"))
         out += (f"static const bw_model bw_model_{name} = {{{c_string(self.name)}, {len(model.specs)}, "
                 f"{len(self.state_type)}, {self.switches}, bw_specs_{name}, {len(constraints)}, "
                 f"{'bw_constraints_' + name if constraints else 'NULL'}, {kernels}}};\n")

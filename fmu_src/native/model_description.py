@@ -12,6 +12,7 @@ from xml.etree import ElementTree as ET
 from .. import __version__
 from ..bushing_params import UNIT_DEFINITIONS
 from ..variables import FmuVariable, fmu_description
+from .dependencies import V, X, axis_dependencies
 from .generate import all_variables, c_double, nominal
 
 LOG_CATEGORIES = (("logStatusWarning", "Warnings: values accepted but doubtful (units, the paper's constraints)"),
@@ -52,9 +53,36 @@ def _common_attributes(identifier: str, token_name: str, token: str, axis_models
             "variableNamingConvention": "structured"}
 
 
-def _state_dependencies(variables, axis) -> list[FmuVariable]:
-    """What an axis's output depends on: its inputs and, in model exchange, its states."""
-    return [v for v in variables if v.axis == axis and v.kind in ("displacement", "velocity", "state")]
+def _dependencies(variables: list[FmuVariable], axis_models) -> dict[int, list[FmuVariable]]:
+    """{value reference of an output or a state's derivative: the knowns it depends on} in model
+    exchange (states and inputs), and for each output, under the key -(value reference) - 1, in
+    co-simulation (inputs only), from ``dependencies.axis_dependencies`` of the axis's model."""
+    found = {}
+    by_model = {}
+    for v in variables:
+        if v.kind not in ("output", "derivative"):
+            continue
+        model = axis_models[v.axis][1]
+        if model.name not in by_model:
+            by_model[model.name] = axis_dependencies(model)
+        dependencies = by_model[model.name]
+
+        def knowns(wanted):
+            return [k for k in variables if k.axis == v.axis and (
+                (k.kind == "state" and k.index in wanted) or (k.kind == "displacement" and X in wanted)
+                or (k.kind == "velocity" and V in wanted))]
+        if v.kind == "output":
+            found[v.value_reference] = knowns(dependencies.output)
+            found[-v.value_reference - 1] = knowns(dependencies.cosimulation_output)
+        else:
+            state = next(s for s in variables if s.value_reference == v.state)
+            found[v.value_reference] = knowns(dependencies.rates[state.index])
+    return found
+
+
+def _unknown(parent: ET.Element, tag: str, key: str, value: str, knowns: list[FmuVariable], reference) -> None:
+    ET.SubElement(parent, tag, {key: value, "dependencies": " ".join(str(reference(k)) for k in knowns),
+                                "dependenciesKind": " ".join("dependent" for _ in knowns)})
 
 
 def fmi2(axis_models, identifier: str, token: str, interfaces=INTERFACES, event_indicators: int = 0,
@@ -68,7 +96,7 @@ def fmi2(axis_models, identifier: str, token: str, interfaces=INTERFACES, event_
     capabilities = {"modelIdentifier": identifier, "needsExecutionTool": "false",
                     "canBeInstantiatedOnlyOncePerProcess": "false", "canNotUseMemoryManagementFunctions": "false",
                     "canGetAndSetFMUstate": "true", "canSerializeFMUstate": "true",
-                    "providesDirectionalDerivative": "false"}
+                    "providesDirectionalDerivative": "true"}
     for interface in interfaces:
         if interface == "me":
             element = ET.SubElement(root, "ModelExchange", dict(capabilities, completedIntegratorStepNotNeeded="true"))
@@ -95,18 +123,21 @@ def fmi2(axis_models, identifier: str, token: str, interfaces=INTERFACES, event_
         ET.SubElement(element, "Real", real)
     structure = ET.SubElement(root, "ModelStructure")
     outputs = ET.SubElement(structure, "Outputs")
+    dependencies = _dependencies(variables, axis_models)
+
+    def position(k):
+        return index[k.value_reference]
     for v in variables:
         if v.kind == "output":
-            knowns = _state_dependencies(variables, v.axis) if "me" in interfaces else \
-                [k for k in variables if k.axis == v.axis and k.kind in ("displacement", "velocity")]
-            ET.SubElement(outputs, "Unknown", index=str(index[v.value_reference]),
-                          dependencies=" ".join(str(index[k.value_reference]) for k in knowns),
-                          dependenciesKind=" ".join("dependent" for _ in knowns))
+            knowns = dependencies[v.value_reference] if "me" in interfaces else dependencies[-v.value_reference - 1]
+            if "me" in interfaces and "cs" in interfaces:     # the inputs the co-simulation output depends on too
+                knowns = [k for k in variables if k in knowns or k in dependencies[-v.value_reference - 1]]
+            _unknown(outputs, "Unknown", "index", str(position(v)), knowns, position)
     if "me" in interfaces and any(v.kind == "derivative" for v in variables):
         derivatives = ET.SubElement(structure, "Derivatives")
         for v in variables:
             if v.kind == "derivative":
-                ET.SubElement(derivatives, "Unknown", index=str(index[v.value_reference]))
+                _unknown(derivatives, "Unknown", "index", str(position(v)), dependencies[v.value_reference], position)
     initial = ET.SubElement(structure, "InitialUnknowns")
     for v in variables:
         if v.kind == "output" or ("me" in interfaces and v.kind in ("state", "derivative")):
@@ -121,7 +152,8 @@ def fmi3(axis_models, identifier: str, token: str) -> bytes:
                                                                 "3.0"))
     capabilities = {"modelIdentifier": identifier, "needsExecutionTool": "false",
                     "canBeInstantiatedOnlyOncePerProcess": "false", "canGetAndSetFMUState": "true",
-                    "canSerializeFMUState": "true", "providesDirectionalDerivatives": "false"}
+                    "canSerializeFMUState": "true", "providesDirectionalDerivatives": "true",
+                    "providesAdjointDerivatives": "true"}
     ET.SubElement(root, "ModelExchange", dict(capabilities, needsCompletedIntegratorStep="false"))
     ET.SubElement(root, "CoSimulation", dict(capabilities, canHandleVariableCommunicationStepSize="true",
                                              maxOutputDerivativeOrder="0"))
@@ -139,15 +171,19 @@ def fmi3(axis_models, identifier: str, token: str) -> bytes:
             attributes["nominal"] = c_double(nominal(v))
         ET.SubElement(model_variables, "Float64", attributes)
     structure = ET.SubElement(root, "ModelStructure")
+    dependencies = _dependencies(variables, axis_models)
+
+    def reference(k):
+        return k.value_reference
     for v in variables:
-        if v.kind == "output":
-            knowns = _state_dependencies(variables, v.axis)
-            ET.SubElement(structure, "Output", valueReference=str(v.value_reference),
-                          dependencies=" ".join(str(k.value_reference) for k in knowns),
-                          dependenciesKind=" ".join("dependent" for _ in knowns))
+        if v.kind == "output":     # model exchange's states and inputs, and the co-simulation output's inputs
+            knowns = [k for k in variables if k in dependencies[v.value_reference]
+                      or k in dependencies[-v.value_reference - 1]]
+            _unknown(structure, "Output", "valueReference", str(v.value_reference), knowns, reference)
     for v in variables:
         if v.kind == "derivative":
-            ET.SubElement(structure, "ContinuousStateDerivative", valueReference=str(v.value_reference))
+            _unknown(structure, "ContinuousStateDerivative", "valueReference", str(v.value_reference),
+                     dependencies[v.value_reference], reference)
     for v in variables:
         if v.kind in ("output", "state", "derivative"):
             ET.SubElement(structure, "InitialUnknown", valueReference=str(v.value_reference))

@@ -131,7 +131,13 @@ class Translation:
         if key not in self.functions:
             same_name = sum(f.python is function for f in self.functions.values())
             name = f"{self.prefix}_{function.__module__.rsplit('.', 1)[-1]}_{function.__name__}".replace("__", "_")
-            translated = _Function(self, function, argument_types, name + (f"_{same_name}" if same_name else ""))
+            # Generated functions (tangents.py) of different origin can share a Python name.
+            taken = {f.name for f in self.functions.values()}
+            unique, count = name + (f"_{same_name}" if same_name else ""), same_name
+            while unique in taken:
+                count += 1
+                unique = f"{name}_{count}"
+            translated = _Function(self, function, argument_types, unique)
             self.functions[key] = translated
             translated.translate()
             self.order.append(translated)

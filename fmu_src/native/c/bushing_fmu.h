@@ -85,6 +85,14 @@ typedef struct {
     void (*derivatives)(const void *constants, const double *state, double x, double v, double *rates);
     void (*switch_values)(const void *constants, const double *state, double x, double v, double *values);
     int (*update)(const void *constants, double *state, double x, double v);   /* 1 if the state changed */
+    /* Tangents generated from the kernels (fmu_src/tangents.py), in the direction (d_state, dx, dv):
+       dF, and d(rates); jump_tangent takes the state through a jump, as jump does, and writes
+       d(state after the jump)/d(jump). */
+    double (*force_tangent)(const void *constants, const double *state, double x, double v, const double *d_state,
+                            double dx, double dv);
+    void (*derivatives_tangent)(const void *constants, const double *state, double x, double v, const double *d_state,
+                                double dx, double dv, double *d_rates);
+    int (*jump_tangent)(const void *constants, double *state, double jump, double *d_state);
 } bw_model;
 
 /* An axis of the FMU (fmu_src/axes.py): its ports, units and model. */

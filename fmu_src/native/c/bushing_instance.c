@@ -685,6 +685,156 @@ static void bw_nominals(double *values, size_t count) {
     }
 }
 
+/* ------------------------------------------------------------------------------- directional derivatives
+   The Jacobian of the unknowns (the outputs, and in model exchange the states' derivatives) with
+   respect to the knowns (the inputs, and in model exchange the states) at the current inputs and
+   state, in port units, from the tangents generated from the kernels (fmu_src/tangents.py: exact
+   to rounding where the kernels are smooth, a stated one-sided value where they switch). The
+   axes are independent, so the Jacobian is block diagonal: one tangent per axis and direction.
+   In co-simulation the output is the one bw_output returns, the committed state taken through
+   the displacement jump to x (which the dashpots carry): dF/dx includes the jump's derivative,
+   also where x equals the committed state's displacement (a jump of 0). */
+
+typedef struct {
+    double d_state[BW_MAX_STATES];   /* kernel units */
+    double dx, dv;                   /* kernel units */
+} bw_direction;
+
+static bw_status bw_derivative_refused(bw_instance *inst, const char *function, const char *role, unsigned int reference,
+                                       const char *allowed) {
+    if (reference >= BW_VARIABLES) {
+        bw_log(inst, BW_ERROR, "logStatusError", "%s: the %s value reference %u does not exist (this FMU has 0 to %d)",
+               function, role, reference, BW_VARIABLES - 1);
+    } else {
+        bw_log(inst, BW_ERROR, "logStatusError", "%s: %s (value reference %u) cannot be a%s %s: %s", function,
+               bw_variables[reference].name, reference, role[0] == 'u' ? "n" : "", role, allowed);
+    }
+    return BW_ERROR;
+}
+
+/* Unknowns must be outputs (or, in model exchange, states' derivatives), knowns inputs (or, in
+   model exchange, states); the parameters must be usable. */
+static bw_status bw_check_derivative_variables(bw_instance *inst, const char *function, const unsigned int unknowns[],
+                                               size_t n_unknowns, const unsigned int knowns[], size_t n_knowns) {
+    const char *unknown_rule = inst->model_exchange ? "the unknowns are outputs and states' derivatives"
+                                                    : "in co-simulation the unknowns are the outputs";
+    const char *known_rule = inst->model_exchange ? "the knowns are inputs and continuous states"
+                                                  : "in co-simulation the knowns are the inputs";
+    size_t i;
+    for (i = 0; i < n_unknowns; i++) {
+        unsigned int r = unknowns[i];
+        if (r >= BW_VARIABLES || !(bw_variables[r].kind == BW_OUTPUT ||
+                                   (inst->model_exchange && bw_variables[r].kind == BW_DERIVATIVE))) {
+            return bw_derivative_refused(inst, function, "unknown", r, unknown_rule);
+        }
+    }
+    for (i = 0; i < n_knowns; i++) {
+        unsigned int r = knowns[i];
+        if (r >= BW_VARIABLES || !(bw_variables[r].kind == BW_DISPLACEMENT || bw_variables[r].kind == BW_VELOCITY ||
+                                   (inst->model_exchange && bw_variables[r].kind == BW_STATE))) {
+            return bw_derivative_refused(inst, function, "known", r, known_rule);
+        }
+    }
+    if (!bw_check_parameters(inst)) {
+        bw_log(inst, BW_ERROR, "logStatusError", "%s: the derivatives cannot be computed: the parameters are invalid "
+               "(see the errors above)", function);
+        return BW_ERROR;
+    }
+    return BW_OK;
+}
+
+/* Add a known's seed (port units) to its axis's direction (kernel units). */
+static void bw_seed(bw_direction *direction, unsigned int known, double seed) {
+    const bw_variable *var = &bw_variables[known];
+    const bw_axis_spec *spec = &bw_axis_specs[var->axis];
+    switch (var->kind) {
+    case BW_DISPLACEMENT: direction->dx += seed * spec->to_kernel; break;
+    case BW_VELOCITY: direction->dv += seed * spec->to_kernel; break;
+    case BW_STATE: direction->d_state[var->index] += seed / var->scale; break;
+    default: break;
+    }
+}
+
+/* Axis a's output and states' derivatives in a direction: d_output in port units, d_rates in
+   kernel units (NULL: not wanted). */
+static bw_status bw_axis_tangent(bw_instance *inst, const char *function, int a, const bw_direction *direction,
+                                 double *d_output, double *d_rates) {
+    const bw_axis_spec *spec = &bw_axis_specs[a];
+    bw_axis *axis = &inst->data.axes[a];
+    const bw_model *model = spec->model;
+    double state[BW_MAX_STATES], d_state[BW_MAX_STATES], v = axis->v * spec->to_kernel;
+    int i;
+    memcpy(state, axis->state, sizeof state);
+    memcpy(d_state, direction->d_state, sizeof d_state);
+    if (!isfinite(axis->x_now) || !isfinite(v)) {
+        bw_log(inst, BW_ERROR, "logStatusError", "%s: %sthe inputs %s, %s are not finite numbers", function,
+               spec->label, spec->displacement, spec->velocity);
+        return BW_ERROR;
+    }
+    if (!inst->model_exchange) {
+        double d_jump[BW_MAX_STATES];
+        if (model->jump_tangent(&axis->constants, state, axis->x_now - axis->state_x, d_jump) != BW_KERNEL_OK) {
+            bw_log(inst, BW_ERROR, "logStatusError", "%s: %sthe output cannot be differentiated: the displacement jump "
+                   "of %g mm from the committed state cannot be taken (check the units of %s: metres)", function,
+                   spec->label, axis->x_now - axis->state_x, spec->displacement);
+            return BW_ERROR;
+        }
+        for (i = 0; i < model->states; i++) d_state[i] = d_jump[i] * direction->dx;
+    }
+    *d_output = model->force_tangent(&axis->constants, state, axis->x_now, v, d_state, direction->dx, direction->dv)
+                * spec->from_kernel;
+    if (!isfinite(*d_output)) {
+        bw_log(inst, BW_ERROR, "logStatusError", "%s: the derivative of %s is not finite (%g): check the units of the "
+               "inputs and the states set", function, spec->output, *d_output);
+        return BW_ERROR;
+    }
+    if (d_rates) {
+        model->derivatives_tangent(&axis->constants, state, axis->x_now, v, d_state, direction->dx, direction->dv,
+                                   d_rates);
+        for (i = 0; i < model->states; i++) {
+            if (!isfinite(d_rates[i])) {
+                bw_log(inst, BW_ERROR, "logStatusError", "%s: %sthe derivative of the rate of state %d is not finite "
+                       "(%g): check the units of the inputs and the states set", function, spec->label, i, d_rates[i]);
+                return BW_ERROR;
+            }
+        }
+    }
+    return BW_OK;
+}
+
+/* An unknown's value in its axis's tangent (port units). */
+static double bw_unknown_tangent(unsigned int unknown, double d_output, const double *d_rates) {
+    const bw_variable *var = &bw_variables[unknown];
+    return var->kind == BW_OUTPUT ? d_output : d_rates[var->index] * var->scale;
+}
+
+/* fmi?GetDirectionalDerivative: sensitivity = J * seed (J: d unknowns / d knowns). */
+static bw_status bw_directional_derivative(bw_instance *inst, const char *function, const unsigned int unknowns[],
+                                           size_t n_unknowns, const unsigned int knowns[], size_t n_knowns,
+                                           const double seed[], double sensitivity[]) {
+    bw_direction directions[BW_AXES];
+    double d_output[BW_AXES] = {0.0}, d_rates[BW_AXES][BW_MAX_STATES] = {{0.0}};
+    int wanted[BW_AXES] = {0};
+    size_t i;
+    int a;
+    bw_status status = bw_check_derivative_variables(inst, function, unknowns, n_unknowns, knowns, n_knowns);
+    if (status != BW_OK) return status;
+    memset(directions, 0, sizeof directions);
+    for (i = 0; i < n_knowns; i++) bw_seed(&directions[bw_variables[knowns[i]].axis], knowns[i], seed[i]);
+    for (i = 0; i < n_unknowns; i++) wanted[bw_variables[unknowns[i]].axis] = 1;
+    for (a = 0; a < BW_AXES; a++) {
+        if (!wanted[a]) continue;
+        status = bw_axis_tangent(inst, function, a, &directions[a], &d_output[a],
+                                 inst->model_exchange ? d_rates[a] : NULL);
+        if (status != BW_OK) return status;
+    }
+    for (i = 0; i < n_unknowns; i++) {
+        a = bw_variables[unknowns[i]].axis;
+        sensitivity[i] = bw_unknown_tangent(unknowns[i], d_output[a], d_rates[a]);
+    }
+    return BW_OK;
+}
+
 /* ------------------------------------------------------------------------------- FMU state */
 
 #define BW_STATE_MAGIC 0x42575346u   /* "BWSF" */

@@ -271,13 +271,13 @@ fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedSta
 fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference vUnknown_ref[], size_t nUnknown,
                                         const fmi2ValueReference vKnown_ref[], size_t nKnown,
                                         const fmi2Real dvKnown[], fmi2Real dvUnknown[]) {
-    (void)vUnknown_ref;
-    (void)nUnknown;
-    (void)vKnown_ref;
-    (void)nKnown;
-    (void)dvKnown;
-    (void)dvUnknown;
-    return bw_fmi2_unsupported(c, "fmi2GetDirectionalDerivative");
+    BW_NOT_NULL(c);
+    if ((nUnknown && (!vUnknown_ref || !dvUnknown)) || (nKnown && (!vKnown_ref || !dvKnown))) {
+        bw_error(&BW_INSTANCE(c)->core, "%s", "fmi2GetDirectionalDerivative: an array argument is NULL");
+        return fmi2Error;
+    }
+    return bw_fmi2_status(bw_directional_derivative(&BW_INSTANCE(c)->core, "fmi2GetDirectionalDerivative",
+                                                    vUnknown_ref, nUnknown, vKnown_ref, nKnown, dvKnown, dvUnknown));
 }
 
 /* ------------------------------------------------------------------------------- co-simulation */

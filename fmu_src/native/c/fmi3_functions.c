@@ -355,35 +355,81 @@ fmi3Status fmi3DeserializeFMUState(fmi3Instance instance, const fmi3Byte seriali
     return fmi3OK;
 }
 
-/* ------------------------------------------------------------------------------- not supported */
+/* ------------------------------------------------------------------------------- derivatives */
+
+/* The arguments of fmi3Get{Directional,Adjoint}Derivative: every variable is a scalar, so the
+   seed has one value per known (adjoint: per unknown) and the sensitivity one per unknown
+   (adjoint: per known). */
+static int bw3_derivative_arguments(fmi3Instance instance, const char *function, const fmi3ValueReference unknowns[],
+                                    size_t nUnknowns, const fmi3ValueReference knowns[], size_t nKnowns,
+                                    const fmi3Float64 seed[], size_t nSeed, size_t seeds, fmi3Float64 sensitivity[],
+                                    size_t nSensitivity, size_t sensitivities) {
+    if ((nUnknowns && !unknowns) || (nKnowns && !knowns) || (nSeed && !seed) || (nSensitivity && !sensitivity)) {
+        bw_log(&BW3(instance)->core, BW_ERROR, "logStatusError", "%s: an array argument is NULL", function);
+        return 0;
+    }
+    if (nSeed != seeds || nSensitivity != sensitivities) {
+        bw_log(&BW3(instance)->core, BW_ERROR, "logStatusError", "%s: nSeed = %lu and nSensitivity = %lu must be %lu "
+               "and %lu (every variable of this FMU is a scalar)", function, (unsigned long)nSeed,
+               (unsigned long)nSensitivity, (unsigned long)seeds, (unsigned long)sensitivities);
+        return 0;
+    }
+    return 1;
+}
+
+/* fmi3GetAdjointDerivative (FMI 3 only, so here rather than in bushing_instance.c): sensitivity = J^T * seed, one tangent per known (the column of J
+   that the known's entry of J^T * seed needs), so it equals the transposed Jacobian of
+   bw_directional_derivative to rounding. */
+static bw_status bw_adjoint_derivative(bw_instance *inst, const char *function, const unsigned int unknowns[],
+                                       size_t n_unknowns, const unsigned int knowns[], size_t n_knowns,
+                                       const double seed[], double sensitivity[]) {
+    double d_rates[BW_MAX_STATES] = {0.0};
+    size_t i, j;
+    bw_status status = bw_check_derivative_variables(inst, function, unknowns, n_unknowns, knowns, n_knowns);
+    if (status != BW_OK) return status;
+    for (j = 0; j < n_knowns; j++) {
+        bw_direction direction;
+        double d_output, sum = 0.0;
+        int a = bw_variables[knowns[j]].axis;
+        memset(&direction, 0, sizeof direction);
+        bw_seed(&direction, knowns[j], 1.0);
+        status = bw_axis_tangent(inst, function, a, &direction, &d_output, inst->model_exchange ? d_rates : NULL);
+        if (status != BW_OK) return status;
+        for (i = 0; i < n_unknowns; i++) {
+            if (bw_variables[unknowns[i]].axis == a) sum += seed[i] * bw_unknown_tangent(unknowns[i], d_output, d_rates);
+        }
+        sensitivity[j] = sum;
+    }
+    return BW_OK;
+}
 
 fmi3Status fmi3GetDirectionalDerivative(fmi3Instance instance, const fmi3ValueReference unknowns[], size_t nUnknowns,
                                         const fmi3ValueReference knowns[], size_t nKnowns, const fmi3Float64 seed[],
                                         size_t nSeed, fmi3Float64 sensitivity[], size_t nSensitivity) {
-    (void)unknowns;
-    (void)nUnknowns;
-    (void)knowns;
-    (void)nKnowns;
-    (void)seed;
-    (void)nSeed;
-    (void)sensitivity;
-    (void)nSensitivity;
-    return bw_fmi3_unsupported(instance, "fmi3GetDirectionalDerivative");
+    const char *function = "fmi3GetDirectionalDerivative";
+    BW3_NOT_NULL(instance);
+    if (!bw3_derivative_arguments(instance, function, unknowns, nUnknowns, knowns, nKnowns, seed, nSeed, nKnowns,
+                                  sensitivity, nSensitivity, nUnknowns)) {
+        return fmi3Error;
+    }
+    return bw_fmi3_status(bw_directional_derivative(&BW3(instance)->core, function, unknowns, nUnknowns, knowns,
+                                                    nKnowns, seed, sensitivity));
 }
 
 fmi3Status fmi3GetAdjointDerivative(fmi3Instance instance, const fmi3ValueReference unknowns[], size_t nUnknowns,
                                     const fmi3ValueReference knowns[], size_t nKnowns, const fmi3Float64 seed[],
                                     size_t nSeed, fmi3Float64 sensitivity[], size_t nSensitivity) {
-    (void)unknowns;
-    (void)nUnknowns;
-    (void)knowns;
-    (void)nKnowns;
-    (void)seed;
-    (void)nSeed;
-    (void)sensitivity;
-    (void)nSensitivity;
-    return bw_fmi3_unsupported(instance, "fmi3GetAdjointDerivative");
+    const char *function = "fmi3GetAdjointDerivative";
+    BW3_NOT_NULL(instance);
+    if (!bw3_derivative_arguments(instance, function, unknowns, nUnknowns, knowns, nKnowns, seed, nSeed, nUnknowns,
+                                  sensitivity, nSensitivity, nKnowns)) {
+        return fmi3Error;
+    }
+    return bw_fmi3_status(bw_adjoint_derivative(&BW3(instance)->core, function, unknowns, nUnknowns, knowns, nKnowns,
+                                                seed, sensitivity));
 }
+
+/* ------------------------------------------------------------------------------- not supported */
 
 fmi3Status fmi3EnterConfigurationMode(fmi3Instance instance) {
     return bw_fmi3_unsupported(instance, "fmi3EnterConfigurationMode (no structural parameters)");
