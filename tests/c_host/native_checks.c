@@ -83,9 +83,10 @@ int main(int argc, char **argv) {
         LOAD(fmi2GetContinuousStates)
         LOAD(fmi2SetContinuousStates)
         LOAD(fmi2GetEventIndicators)
+        LOAD(fmi2GetDirectionalDerivative)
         fmi2Component c;
         fmi2FMUstate saved = NULL, restored = NULL;
-        double inputs[2], force, first[50], again[50], nan_value = NAN, values[8];
+        double inputs[2], force, first[50], again[50], nan_value = NAN, values[8], seed[2] = {1.0, 0.5}, dF[2];
         size_t size;
         fmi2Byte *bytes;
 
@@ -190,6 +191,22 @@ int main(int argc, char **argv) {
         bytes[0] ^= 0xff;           /* not a state of this FMU */
         EXPECT(fmi2DeSerializeFMUstate(c, bytes, size, &restored), fmi2Error);
         free(bytes);
+
+        /* directional derivatives: finite where they can be computed, an error (never a crash) where not */
+        EXPECT(fmi2GetDirectionalDerivative(c, &f_ref, 1, xv, 2, seed, dF), fmi2OK);
+        if (!isfinite(dF[0])) return 12;
+        EXPECT(fmi2GetDirectionalDerivative(c, &f_ref, 1, xv, 0, seed, dF), fmi2OK);
+        EXPECT(fmi2GetDirectionalDerivative(c, &f_ref, 0, xv, 2, seed, dF), fmi2OK);
+        EXPECT(fmi2GetDirectionalDerivative(c, &bad_ref, 1, xv, 2, seed, dF), fmi2Error);
+        EXPECT(fmi2GetDirectionalDerivative(c, &f_ref, 1, &bad_ref, 1, seed, dF), fmi2Error);
+        EXPECT(fmi2GetDirectionalDerivative(c, xv, 1, xv, 2, seed, dF), fmi2Error);     /* x is no unknown */
+        EXPECT(fmi2GetDirectionalDerivative(c, &f_ref, 1, xv, 2, NULL, dF), fmi2Error);
+        EXPECT(fmi2GetDirectionalDerivative(NULL, &f_ref, 1, xv, 2, seed, dF), fmi2Error);
+        EXPECT(fmi2SetReal(c, &x_ref, 1, &nan_value), fmi2OK);
+        EXPECT(fmi2GetDirectionalDerivative(c, &f_ref, 1, xv, 2, seed, dF), fmi2Error);
+        inputs[0] = 2.0;            /* a jump of 2 m from the committed state */
+        EXPECT(fmi2SetReal(c, xv, 2, inputs), fmi2OK);
+        if (fmi2GetDirectionalDerivative(c, &f_ref, 1, xv, 2, seed, dF) == fmi2OK && !isfinite(dF[0])) return 13;
         EXPECT(fmi2FreeFMUstate(c, &saved), fmi2OK);
         EXPECT(fmi2FreeFMUstate(c, &restored), fmi2OK);
         fmi2FreeInstance(c);
