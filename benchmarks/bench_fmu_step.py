@@ -1,6 +1,7 @@
 """Cost of one 1 ms co-simulation step of the bushing FMU, against a trivial pythonfmu FMU.
 
     python benchmarks/bench_fmu_step.py [--steps N] [--repeats R]
+    python benchmarks/bench_fmu_step.py --native-against REV [--repeats R]
 
 Both FMUs are driven the same way through fmpy's FMI 2.0 API: set x and v, doStep(1 ms),
 get F, on the paper's identification sine (2 mm, 10 Hz). The trivial FMU computes F = 2*x.
@@ -19,6 +20,10 @@ the same ports built from the same C layer (the stateless Kelvin-Voigt model, F 
 against the pythonfmu bushing FMU, side by side; and in a plain C master
 (``c_master_timing.c``, 100 times the steps per run), where no Python is in the loop; and the
 native FMUs of the filled-rubber models (berg, fractional) with their default sets, the same way.
+
+``--native-against REV``: only the C master, each model's native FMU built from this tree and from
+the commit REV (a git worktree of it, built by its own build_fmu.py), the two timed alternately
+in the same run: whether a change to the native FMU changed its step's cost.
 """
 from __future__ import annotations
 
@@ -253,12 +258,57 @@ def _c_master(master: Path, fmu: Path, folder: Path, steps: int, repeats: int) -
     return [float(line) * 1e-9 for line in run.stdout.split()]
 
 
+def measure_native_against(revision: str, steps: int, repeats: int) -> dict:
+    """{model: (this tree's, ``revision``'s seconds per step)} in the C master, the two FMUs of a
+    model timed alternately (each repeat one run of each)."""
+    import build_fmu
+    from fmu_src.native.build import fmi_header_directory
+
+    models = ("proposed", *FILLED_RUBBER)
+    with tempfile.TemporaryDirectory() as work:
+        work = Path(work)
+        tree = work / "baseline"
+        subprocess.run(["git", "-C", str(REPO), "worktree", "add", "--detach", str(tree), revision], check=True,
+                       capture_output=True)
+        try:
+            build = ("import sys, build_fmu\nfor model in sys.argv[2:]:\n"
+                     "    print(build_fmu.build_native_fmu(out_dir=sys.argv[1] + '/' + model, model=model).path)")
+            baseline = subprocess.run([sys.executable, "-c", build, str(work / "old"), *models], cwd=tree,
+                                      env=dict(os.environ, PYTHONPATH=str(tree)), capture_output=True, text=True,
+                                      check=True).stdout.split()
+        finally:
+            subprocess.run(["git", "-C", str(REPO), "worktree", "remove", "--force", str(tree)], check=True)
+        current = [build_fmu.build_native_fmu(out_dir=work / "new" / model, model=model).path for model in models]
+        master = work / "c_master_timing"
+        subprocess.run(["cc", "-O2", "-std=c99", "-I", str(fmi_header_directory()), "-o", str(master),
+                        str(Path(__file__).with_name("c_master_timing.c")), "-ldl", "-lm"], check=True)
+        result = {}
+        for model, new, old in zip(models, current, baseline):
+            times = {"new": [], "old": []}
+            for k in range(repeats):
+                for key, fmu in (("new", new), ("old", old)):
+                    times[key] += _c_master(master, Path(fmu), work / f"{key}_{model}_{k}", 100 * steps, 1)
+            result[model] = (statistics.median(times["new"]), statistics.median(times["old"]),
+                             statistics.median(a / b for a, b in zip(times["new"], times["old"])))
+    return result
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--steps", type=int, default=2000, help="steps per run (default 2000 = 2 s)")
     parser.add_argument("--repeats", type=int, default=15)
+    parser.add_argument("--native-against", metavar="REV", help="only the C master: this tree's native FMUs "
+                        "against those of the commit REV, side by side")
     parser.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
+    if args.native_against:
+        result = measure_native_against(args.native_against, args.steps, args.repeats)
+        print(f"machine: {platform.machine()}, Python {platform.python_version()}; C master, {100 * args.steps} "
+              f"steps a run, {args.repeats} runs each, alternating; us/step, median")
+        print(f"{'model':12s} {'this tree':>10s} {args.native_against[:12]:>12s} {'ratio':>6s}")
+        for model, (new, old, ratio) in result.items():
+            print(f"{model:12s} {new * 1e6:10.3f} {old * 1e6:12.3f} {ratio:6.3f}")
+        return
     if args.child:
         print(json.dumps(measure(args.steps, args.repeats)))
         return
