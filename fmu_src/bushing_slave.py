@@ -363,7 +363,7 @@ class BushingSlave(Fmi2Slave):
         self.log(f"{axis.label}the displacement input {axis.displacement} jumps in {count} of the last "
                  f"{JUMP_WINDOW} steps (at t = {current_time:.6g} s by {mismatch / a.to_kernel:.3g} {unit} per "
                  f"step against |{axis.velocity}|*h = {travel / a.to_kernel:.3g} {unit}): {axis.velocity} is "
-                 f"probably not d{axis.displacement}/dt of the sampled displacement, and the dashpots carry "
+                 f"probably not the time derivative of the sampled {axis.displacement}, and the dashpots carry "
                  f"every jump; build the input with identification.fmu_input (a continuous path, "
                  f"{axis.velocity} = the secant velocity of {axis.displacement}) or set {axis.velocity} = "
                  f"({axis.displacement}(t + h) - {axis.displacement}(t))/h",

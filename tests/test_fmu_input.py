@@ -26,7 +26,7 @@ SLICE = 4000
 FORCE_TOLERANCE = 1e-10
 """max |FMU - forward model| / max |forward model| on the same path (measured 1.1e-13 for both FMUs,
 2026-12: the same kernels, differing by the m <-> mm conversions of the ports only)."""
-JUMP_FRAGMENT = "is probably not dx/dt of the sampled displacement"
+JUMP_FRAGMENT = "is probably not the time derivative of the sampled x"
 
 
 @pytest.fixture(scope="module")

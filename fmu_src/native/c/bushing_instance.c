@@ -465,8 +465,8 @@ static void bw_count_jump(bw_instance *inst, int a, double current_time, double 
         const char *unit = spec->rotational ? "rad" : "m";
         inst->jump_warned = 1;
         bw_log(inst, BW_WARNING, "logStatusWarning", "%sthe displacement input %s jumps in %d of the last %d steps "
-               "(at t = %.6g s by %.3g %s per step against |%s|*h = %.3g %s): %s is probably not d%s/dt of the "
-               "sampled displacement, and the dashpots carry every jump; build the input with "
+               "(at t = %.6g s by %.3g %s per step against |%s|*h = %.3g %s): %s is probably not the time derivative "
+               "of the sampled %s, and the dashpots carry every jump; build the input with "
                "identification.fmu_input (a continuous path, %s = the secant velocity of %s) or set %s = "
                "(%s(t + h) - %s(t))/h", spec->label, spec->displacement, count, BW_JUMP_WINDOW, current_time,
                mismatch / spec->to_kernel, unit, spec->velocity, travel / spec->to_kernel, unit, spec->velocity,
