@@ -1,4 +1,4 @@
-"""Model exchange with the FMU's Jacobian against a difference Jacobian (issue 35's target).
+"""Model exchange with the FMU's Jacobian against a difference Jacobian: the same accuracy with fewer right-hand sides?
 
     python benchmarks/bench_model_exchange_jacobian.py [--models proposed,berg,fractional] [--duration 1.0]
 
