@@ -187,42 +187,89 @@ def is_velocity(variable) -> bool:
     return (variable.unit or "").endswith("/s")
 
 
-def run_sine(opened: Opened, steps: int, h: float = 1e-3) -> None:
-    """``steps`` communication steps more of a 5 Hz sine of twice the nominal travel on every axis."""
+def run_sine(opened: Opened, steps: int, h: float = 1e-3) -> np.ndarray:
+    """``steps`` communication steps more of a 5 Hz sine of twice the nominal travel on every axis;
+    returns the inputs of the last step."""
     for _ in range(steps):
         phase = 10.0 * np.pi * opened.time
-        opened.set_inputs([2.0 * 10.0 * np.pi * nominal(v) / (2.0 * np.pi) * np.cos(phase) if is_velocity(v)
+        inputs = np.array([2.0 * 10.0 * np.pi * nominal(v) / (2.0 * np.pi) * np.cos(phase) if is_velocity(v)
                            else 2.0 * nominal(v) * np.sin(phase) for v in opened.inputs])
+        opened.set_inputs(inputs)
         opened.step(h)
+    return inputs
+
+
+def step_end(opened: Opened, inputs: np.ndarray, h: float = 1e-3) -> np.ndarray:
+    """``inputs`` with each displacement moved to where a step of ``h`` from them ended, x + v*h (the
+    inputs are each axis's displacement, then its velocity)."""
+    ended = inputs.copy()
+    for j, v in enumerate(opened.inputs):
+        if not is_velocity(v):
+            ended[j] = inputs[j] + h * inputs[j + 1]
+    return ended
 
 
 @pytest.mark.parametrize("version", VERSIONS)
 @pytest.mark.parametrize("name", FMUS)
 def test_co_simulation_dF_dx_dF_dv_are_those_of_the_output_the_fmu_returns(fmus, name, version):
     """In co-simulation, dF/d(x, v) at the communication point, where the output is the committed
-    state taken through the displacement jump to the x set: against central differences of the
-    output itself (x set at +-h), at no jump (x where the step ended) and at jumps of a few
-    hundredths of a millimetre."""
+    state taken through the displacement jump to the x set: against differences of the output itself
+    (x set at +-h). At jumps of a few hundredths of a millimetre central differences; at no jump (x
+    where the step ended, up to rounding) the output is not differentiable in x where the motion
+    could reverse, and dF/dx is the one-sided derivative in the direction of the velocity set
+    (second-order one-sided differences that way)."""
     opened = Opened(fmus[version][name], "cs")
     rng = np.random.default_rng(3)
     scales = np.array([nominal(v) for v in opened.inputs])
     for point in range(POINTS):
-        run_sine(opened, 7)
-        at_end = opened.get(opened.inputs)      # x where the step ended (the state's), v as set
+        at_end = step_end(opened, run_sine(opened, 7))
+        no_jump = point % 2 == 0
         inputs = np.array([value + rng.uniform(-0.5, 0.5) * nominal(v) if is_velocity(v) else
-                           value if point % 3 == 0 else value + 0.02 * nominal(v) * rng.uniform(-1.0, 1.0)
+                           value if no_jump else value + 0.02 * nominal(v) * rng.uniform(-1.0, 1.0)
                            for value, v in zip(at_end, opened.inputs)])
         opened.set_inputs(inputs)
         jacobian = opened.jacobian(opened.outputs, opened.inputs)
         difference = np.zeros_like(jacobian)
-        for j in range(len(inputs)):
+
+        def output(j, step):
+            opened.set_inputs(inputs + step * np.eye(len(inputs))[j])
+            return opened.get(opened.outputs)
+        for j, v in enumerate(opened.inputs):
             h = 1e-6 * scales[j]
-            opened.set_inputs(inputs + h * np.eye(len(inputs))[j])
-            up = opened.get(opened.outputs)
-            opened.set_inputs(inputs - h * np.eye(len(inputs))[j])
-            difference[:, j] = (up - opened.get(opened.outputs)) / (2.0 * h)
+            if no_jump and not is_velocity(v):
+                h *= 1.0 if inputs[j + 1] >= 0.0 else -1.0
+                difference[:, j] = (-3.0 * output(j, 0.0) + 4.0 * output(j, h) - output(j, 2.0 * h)) / (2.0 * h)
+            else:
+                difference[:, j] = (output(j, h) - output(j, -h)) / (2.0 * h)
         opened.set_inputs(inputs)
         assert_rows_agree(jacobian, difference, scales, f"{name} FMI {version} co-simulation point {point}")
+    opened.free()
+
+
+def test_at_no_jump_the_derivative_is_the_one_sided_one_of_the_motion(fmus):
+    """Where x is where the last step ended, the proposed model's dF/dx differs by side (moving on,
+    or reversing, which the dashpots' jump would start): the FMU gives the side of the velocity set,
+    whatever the rounding of x (exactly there, or 1e-16 m either side)."""
+    opened = Opened(fmus[2]["proposed"], "cs")
+    at_end = step_end(opened, run_sine(opened, 20))
+    x = opened.inputs[0]
+    h = 1e-9
+    for velocity in (at_end[1], -at_end[1]):
+        side = 1.0 if velocity > 0.0 else -1.0
+        given = []
+        for rounding in (0.0, 1e-16, -1e-16):
+            inputs = np.array([at_end[0] + rounding, velocity])
+            opened.set_inputs(inputs)
+            given.append(opened.jacobian(opened.outputs, [x])[0, 0])
+        forces = []
+        for step in (0.0, side * h, 2.0 * side * h, -side * h, -2.0 * side * h):
+            opened.set_inputs([at_end[0] + step, velocity])
+            forces.append(opened.get(opened.outputs)[0])
+        onward = (-3.0 * forces[0] + 4.0 * forces[1] - forces[2]) / (2.0 * side * h)
+        back = (-3.0 * forces[0] + 4.0 * forces[3] - forces[4]) / (-2.0 * side * h)
+        assert abs(onward - back) > 1e-3 * abs(onward)          # the two sides differ here
+        for value in given:
+            assert abs(value - onward) <= 1e-5 * abs(onward), (velocity, given, onward, back)
     opened.free()
 
 
@@ -281,7 +328,7 @@ def test_never_a_non_finite_derivative_over_10000_points_switches_included(fmus,
         assert np.all(np.isfinite(result)), (inputs, result)
         if k % 2:
             cs.step(1e-3)
-            inputs[~moving] = cs.get([v for v, m in zip(cs.inputs, moving) if not m])
+            inputs = step_end(cs, inputs)      # the next point jumps from where this step ended, or not
     cs.free()
 
 
@@ -357,3 +404,35 @@ def test_fmi3_seed_and_sensitivity_counts_are_checked(fmus):
             function(me.fmu.component, unknowns, 1, knowns, 2, seed, 1, sensitivity, 1)
     assert sum("nSeed = 1 and nSensitivity = 1 must be" in message for message in me.messages) == 2
     me.free()
+
+
+@pytest.mark.parametrize("version", VERSIONS)
+def test_in_initialization_mode_the_derivatives_are_refused_with_a_reason(fmus, version):
+    """The state is set at the exit of initialization mode; before it there is nothing to differentiate."""
+    path = fmus[version]["proposed"]
+    description = read_model_description(str(path))
+    kind = FMU3Slave if version == 3 else FMU2Slave
+    messages = []
+    fmu = kind(guid=description.guid, unzipDirectory=extract(str(path)),
+               modelIdentifier=description.coSimulation.modelIdentifier, instanceName="init")
+    if version == 3:
+        fmu.instantiate(loggingOn=True, logMessage=lambda env, status, category, message:
+                        messages.append(message.decode()))
+        fmu.enterInitializationMode(startTime=0.0)
+    else:
+        callbacks = fmi2CallbackFunctions()
+        callbacks.logger = fmi2CallbackLoggerTYPE(lambda c, name, status, category, message:
+                                                   messages.append(message.decode()))
+        callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+        callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+        fmu.instantiate(callbacks=callbacks, loggingOn=True)
+        fmu.setupExperiment(startTime=0.0)
+        fmu.enterInitializationMode()
+    refs = {v.name: v.valueReference for v in description.modelVariables}
+    with pytest.raises(FMICallException):
+        fmu.getDirectionalDerivative([refs["F"]], [refs["x"]], [1.0])
+    assert any("available after the exit of initialization mode" in message for message in messages)
+    fmu.exitInitializationMode()
+    assert np.isfinite(fmu.getDirectionalDerivative([refs["F"]], [refs["x"]], [1.0])[0])
+    fmu.terminate()
+    fmu.freeInstance()

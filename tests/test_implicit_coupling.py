@@ -19,21 +19,21 @@ def fmu(native_fmu_path):
 
 @pytest.mark.parametrize("mass_kg", [0.3, 1.0])
 def test_linearly_implicit_coupling_stays_bounded_where_explicit_coupling_diverges(fmu, mass_kg):
-    reference = coupling.couple(fmu, mass_kg, 1e-5, implicit=False)
+    reference = coupling.couple(fmu, mass_kg, 1e-5, "explicit")
     assert reference.refused_at is None
-    explicit = coupling.couple(fmu, mass_kg, 1e-3, implicit=False)
+    explicit = coupling.couple(fmu, mass_kg, 1e-3, "explicit")
     assert explicit.refused_at is not None and explicit.refused_at < 0.05
-    implicit = coupling.couple(fmu, mass_kg, 1e-3, implicit=True)
+    implicit = coupling.couple(fmu, mass_kg, 1e-3, "implicit")
     assert implicit.refused_at is None
     assert coupling.deviation(implicit, reference) <= 0.2
 
 
 def test_the_reference_is_converged(fmu):
-    fine = coupling.couple(fmu, 1.0, 1e-5, implicit=False)
-    coarse = coupling.couple(fmu, 1.0, 2e-5, implicit=False)
+    fine = coupling.couple(fmu, 1.0, 1e-5, "explicit")
+    coarse = coupling.couple(fmu, 1.0, 2e-5, "explicit")
     assert coupling.deviation(coarse, fine) <= 0.01
 
 
 def test_bad_arguments_are_refused(fmu):
     with pytest.raises(ValueError, match="mass -1.0 kg"):
-        coupling.couple(fmu, -1.0, 1e-3, implicit=True)
+        coupling.couple(fmu, -1.0, 1e-3, "implicit")

@@ -300,5 +300,6 @@ def model_source(axis_models, identifier: str) -> GeneratedModel:
         f"#define BW_JUMP_RELATIVE {integration.JUMP_RELATIVE!r}\n"
         f"#define BW_JUMP_FLOOR {integration.JUMP_FLOOR!r}\n"
         f"#define BW_JUMP_WINDOW {integration.JUMP_WINDOW}\n"
-        f"#define BW_JUMP_COUNT {integration.JUMP_COUNT}\n\n")
+        f"#define BW_JUMP_COUNT {integration.JUMP_COUNT}\n"
+        f"#define BW_ROUNDING_JUMP {integration.ROUNDING_JUMP_MM!r}\n\n")
     return GeneratedModel(header + body, token, indicators)

@@ -693,7 +693,14 @@ static void bw_nominals(double *values, size_t count) {
    axes are independent, so the Jacobian is block diagonal: one tangent per axis and direction.
    In co-simulation the output is the one bw_output returns, the committed state taken through
    the displacement jump to x (which the dashpots carry): dF/dx includes the jump's derivative,
-   also where x equals the committed state's displacement (a jump of 0). */
+   also where x equals the committed state's displacement. There (a jump of 0, or of rounding
+   size: BW_ROUNDING_JUMP, integration.ROUNDING_JUMP_MM) F is not differentiable where the
+   motion could reverse (a Bouc-Wen walk's sgn, a friction element's turn), and the derivative
+   is the one-sided one in the direction of the velocity set, the branch the motion continues
+   on, taken at a jump of twice the rounding size that way (the kernels' own choice at exactly 0
+   is the reversal's for some and the continuation's for others, and rounding of the host's x
+   would pick between them at random). Available from the exit of initialization mode (the
+   state is set there). */
 
 typedef struct {
     double d_state[BW_MAX_STATES];   /* kernel units */
@@ -721,6 +728,11 @@ static bw_status bw_check_derivative_variables(bw_instance *inst, const char *fu
     const char *known_rule = inst->model_exchange ? "the knowns are inputs and continuous states"
                                                   : "in co-simulation the knowns are the inputs";
     size_t i;
+    if (!inst->initialized) {
+        bw_log(inst, BW_ERROR, "logStatusError", "%s: the derivatives are available after the exit of initialization "
+               "mode, where the state is set", function);
+        return BW_ERROR;
+    }
     for (i = 0; i < n_unknowns; i++) {
         unsigned int r = unknowns[i];
         if (r >= BW_VARIABLES || !(bw_variables[r].kind == BW_OUTPUT ||
@@ -772,8 +784,9 @@ static bw_status bw_axis_tangent(bw_instance *inst, const char *function, int a,
         return BW_ERROR;
     }
     if (!inst->model_exchange) {
-        double d_jump[BW_MAX_STATES];
-        if (model->jump_tangent(&axis->constants, state, axis->x_now - axis->state_x, d_jump) != BW_KERNEL_OK) {
+        double d_jump[BW_MAX_STATES], jump = axis->x_now - axis->state_x;
+        if (fabs(jump) <= BW_ROUNDING_JUMP && v != 0.0) jump = copysign(2.0 * BW_ROUNDING_JUMP, v);
+        if (model->jump_tangent(&axis->constants, state, jump, d_jump) != BW_KERNEL_OK) {
             bw_log(inst, BW_ERROR, "logStatusError", "%s: %sthe output cannot be differentiated: the displacement jump "
                    "of %g mm from the committed state cannot be taken (check the units of %s: metres)", function,
                    spec->label, axis->x_now - axis->state_x, spec->displacement);
