@@ -637,11 +637,16 @@ def _neg(a):
 class Generator:
     """Generates and compiles tangents; one version per (kernel, argument activities)."""
 
+    _serials = itertools.count()
+
     def __init__(self):
         self.specs: dict = {}
         self.compiled: dict = {}
         self.namespaces: dict = {}
         self.sources: dict = {}
+        # Generators name their tangents alike (one kernel, other activities): the line cache's
+        # filename keeps each generator's source apart, for inspect.getsource (numba, the C).
+        self.serial = next(Generator._serials)
 
     def spec(self, function, activities, name=None) -> _Spec:
         function = getattr(function, "py_func", function)
@@ -668,7 +673,7 @@ class Generator:
         spec = self.spec(function, activities)
         if spec.name not in self.compiled:
             source = spec.generate()
-            filename = f"<tangent {spec.where} {spec.name}>"
+            filename = f"<tangent {spec.where} {spec.name} #{self.serial}>"
             linecache.cache[filename] = (len(source), None, source.splitlines(True), filename)
             namespace = self.namespace(spec.function)
             exec(compile(source, filename, "exec"), namespace)
