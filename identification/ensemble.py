@@ -24,7 +24,9 @@ Members, all within the threshold by their true misfit:
     1 Hz sines and the random test; with the energy probe, on none).
     The region's valleys curve: for Table 5 the truth sat at delta chi^2 = 13 (inside 24.9) while
     the straight line to it rose to 42, so no sample around the best fit and no straight push
-    reaches it, but a least-squares path along the valley does;
+    reaches it, but a least-squares path along the valley does. With the fit's exact Jacobian
+    (``multistart.Problem.jacobian``) its least squares take the exact Jacobian of the fit's
+    residuals and the probe's exact gradient (:class:`ProbeMeasure`), else scipy's differences;
 (3) MEMBERS posterior draws (emcee, WALKERS walkers from a tiny ball around the best fit, STEPS
     steps of which the first BURN_IN are discarded, differential-evolution and snooker moves as
     emcee recommends for curved posteriors; posterior exp(-chi^2/(2 s^2)), flat over the box),
@@ -200,6 +202,49 @@ def profile_extremes(problem, best: np.ndarray, best_misfit: float, ident: Ident
     return np.array([theta for theta, _ in found]), np.array([misfit for _, misfit in found])
 
 
+class ProbeMeasure:
+    """A probe's measure (PROBES: the rms force [N] of a sine or step, or the energy [N*mm] a sine
+    dissipates) as a function of the coordinates, and its exact gradient."""
+
+    def __init__(self, space, kind: str, amplitude: float, rate: float, duration: float, measure: str):
+        from identification.forward_model import prepare_input
+        from identification.protocols import Sine, Step, sample_times
+        self.space, self.measure = space, measure
+        protocol = Sine(amplitude, rate, duration) if kind == "sine" else Step(amplitude, rate, duration)
+        t = sample_times(duration, 1000.0)
+        self.driven = prepare_input(t, *protocol.signals(t), decimate_holds=True)
+        self.weights = np.diff(np.append(self.driven.sample_index, t.size))
+        self.displacement = self.driven.displacement_mm[self.driven.output_index]
+
+    def of_forces(self, forces: np.ndarray) -> np.ndarray:
+        """The measure of (P, samples) forces, (P,)."""
+        if self.measure == "energy":   # trapezoidal integral of F dx over the samples
+            return np.sum(0.5 * (forces[:, 1:] + forces[:, :-1]) * np.diff(self.displacement), axis=1)
+        return np.sqrt(np.average(forces ** 2, axis=1, weights=self.weights))
+
+    def values(self, thetas: np.ndarray) -> np.ndarray:
+        """The measure at each row of (P, d) coordinates, (P,)."""
+        from identification.simulate import simulate_driven
+        space = self.space
+        return self.of_forces(simulate_driven(space.to_parameters(np.atleast_2d(thetas)), self.driven,
+                                              model=space.bushing))
+
+    def gradient(self, theta: np.ndarray) -> tuple[float, np.ndarray]:
+        """The measure at one point (d,) and its gradient (d,): the forces' sensitivities
+        (``fit_jacobian``) through the measure (linear for the energy; d rms = average(w F dF)/rms)."""
+        from identification.fit_jacobian import population_sensitivities
+        driven = self.driven
+        matrix, seeds = self.space.to_parameters_and_seeds(np.asarray(theta, dtype=float)[None, :])
+        forces, sensitivities = population_sensitivities(matrix, seeds, driven.time_s, driven.displacement_mm,
+                                                         driven.velocity_mm_s, driven.output_index,
+                                                         driven.output_velocity_mm_s, model=self.space.bushing)
+        value = float(self.of_forces(forces)[0])
+        if self.measure == "energy":
+            step = np.diff(self.displacement)[:, None]
+            return value, np.sum(0.5 * (sensitivities[0, 1:] + sensitivities[0, :-1]) * step, axis=0)
+        return value, np.average(forces[0][:, None] * sensitivities[0], axis=0, weights=self.weights) / value
+
+
 def _profile_task(shared: ProfileProblem, item):
     """Maximise sign*g, g = the probe's measure relative to the best fit's, keeping chi^2 near
     the region's edge: bounded least squares on the residuals [r*sqrt(n), c - (w/c)*sign*g],
@@ -207,32 +252,28 @@ def _profile_task(shared: ProfileProblem, item):
     optimum at PROFILE_TARGET x delta_chi2 and is corrected by the chi^2 each solve reaches; the
     farthest solution inside the region is kept (None if none is)."""
     from scipy.optimize import least_squares
-    from identification.forward_model import prepare_input
-    from identification.protocols import Sine, Step, sample_times
-    from identification.simulate import simulate_driven
 
     (kind, amplitude, rate, duration, measure), sign = item
     problem, best, ident = shared.problem, shared.best, shared.ident
     space, n = problem.space, problem.objective.size
-    protocol = Sine(amplitude, rate, duration) if kind == "sine" else Step(amplitude, rate, duration)
-    t = sample_times(duration, 1000.0)
-    driven = prepare_input(t, *protocol.signals(t), decimate_holds=True)
-    weights = np.diff(np.append(driven.sample_index, t.size))
-    displacement = driven.displacement_mm[driven.output_index]
-
-    def probe_measure(thetas):
-        forces = simulate_driven(space.to_parameters(np.atleast_2d(thetas)), driven, model=space.bushing)
-        if measure == "energy":   # trapezoidal integral of F dx over the samples
-            return np.sum(0.5 * (forces[:, 1:] + forces[:, :-1]) * np.diff(displacement), axis=1)
-        return np.sqrt(np.average(forces ** 2, axis=1, weights=weights))
+    probe = ProbeMeasure(space, kind, amplitude, rate, duration, measure)
+    probe_measure, probe_gradient = probe.values, probe.gradient
 
     bounds = space.bounds()
-    steps = 1e-6 * np.maximum(1.0, np.abs(best))
-    steps = np.where(best + steps > bounds[:, 1], -steps, steps)
-    values = probe_measure(np.vstack([best, best + np.diag(steps)]))
-    if not np.all(np.isfinite(values)) or values[0] <= 0:
-        return None
-    gradient = (values[1:] - values[0]) / steps / values[0]             # of g = rms/rms_best - 1
+    exact = problem.jacobian == "exact"
+    if exact:
+        value, gradient = probe_gradient(best)
+        values = np.array([value])
+        if not (np.isfinite(value) and value > 0 and np.all(np.isfinite(gradient))):
+            return None
+        gradient = gradient / value                                      # of g = rms/rms_best - 1
+    else:
+        steps = 1e-6 * np.maximum(1.0, np.abs(best))
+        steps = np.where(best + steps > bounds[:, 1], -steps, steps)
+        values = probe_measure(np.vstack([best, best + np.diag(steps)]))
+        if not np.all(np.isfinite(values)) or values[0] <= 0:
+            return None
+        gradient = (values[1:] - values[0]) / steps / values[0]         # of g = rms/rms_best - 1
     smallest = 1e-12 * ident.singular_values[0]
     whitened = (ident.directions @ gradient) / np.maximum(ident.singular_values, smallest)
     target = PROFILE_TARGET * ident.threshold_chi2
@@ -245,10 +286,19 @@ def _profile_task(shared: ProfileProblem, item):
         reward = c - (weight / c) * sign * g if np.isfinite(g) else c + 1e3
         return np.append(problem.residuals(theta[None, :])[0] * math.sqrt(n), reward)
 
+    def jacobian(theta):
+        """The exact Jacobian of ``residuals`` (the fit's, then the reward's row)."""
+        _, fit_rows = problem.residuals_and_jacobian(theta)
+        value, gradient = probe_gradient(theta)
+        finite = np.isfinite(value) and np.all(np.isfinite(gradient))   # else the reward is the constant c + 1e3
+        reward = -(weight / c) * sign * gradient / values[0] if finite else np.zeros_like(gradient)
+        return np.vstack([fit_rows * math.sqrt(n), reward[None, :]])
+
     theta, kept = best.copy(), None
     for _ in range(PROFILE_ROUNDS):
         with np.errstate(over="ignore", invalid="ignore"):
-            result = least_squares(residuals, theta, bounds=(bounds[:, 0], bounds[:, 1]), method="trf",
+            result = least_squares(residuals, theta, jac=jacobian if exact else "2-point",
+                                   bounds=(bounds[:, 0], bounds[:, 1]), method="trf",
                                    x_scale="jac", max_nfev=PROFILE_EVALUATIONS)
         misfit = float(problem.misfit(result.x[None, :])[0])
         reached = (misfit - shared.best_misfit) * n

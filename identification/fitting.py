@@ -46,7 +46,8 @@ from identification.fit_result import (FLOOR_FACTOR, MIN_AGREEING, FitNotConverg
 from identification.kdyn_table import KdynTable, load_kdyn_table
 from identification.loop_start import LOOP_STARTS, anchored_coordinates, slow_loop_start
 from identification.measurements import Measurement
-from identification.multistart import Problem, StartRecord, first_records, jacobian, run_stages, screen
+from identification.multistart import (JACOBIANS, Problem, StartRecord, first_records, jacobian, run_stages, screen,
+                                       simulations_per_jacobian)
 from identification.noise import NoiseEstimate, estimate_noise
 from identification.objectives import Objective, nrmse
 from identification.presets import PAPER_GA, PRESETS, SearchSettings
@@ -83,7 +84,7 @@ def as_tests(measurements) -> list[RigTest]:
 
 def fit(measurements, model: str | BushingModel = "proposed", preset: str = "default", seed: int = 0,
         workers: int | None = None, scheduler=None, engine=None, progress: bool = True, screening: int | None = None,
-        starts: int | None = None, kdyn=None, ensemble: bool = True) -> FitResult:
+        starts: int | None = None, kdyn=None, ensemble: bool = True, jacobian: str = "exact") -> FitResult:
     """Identify a model's parameters from rig tests, and say how sure the fit is.
 
     Parameters
@@ -116,6 +117,10 @@ def fit(measurements, model: str | BushingModel = "proposed", preset: str = "def
     ensemble : bool
         False skips the profiles and the posterior sampling (a third to half of the time): no
         band then, and ``FitResult.save(ensemble=...)`` refuses.
+    jacobian : str
+        How the least squares and the identifiability get the residuals' Jacobian: ``exact``
+        (default: the forces' sensitivities, computed with them; ``identification.fit_jacobian``)
+        or ``difference`` (forward differences, one simulation per coordinate).
 
     Returns
     -------
@@ -150,6 +155,8 @@ def fit(measurements, model: str | BushingModel = "proposed", preset: str = "def
     bushing = resolve_model(model)
     if seed < 0:
         raise IdentificationError(f"seed = {seed}: give an integer >= 0")
+    if jacobian not in JACOBIANS:
+        raise IdentificationError(f"jacobian = {jacobian!r}: choose one of {', '.join(JACOBIANS)}")
     noise = [_noise_of(t) for t in tests]
     # One BLAS thread here as in every task: a multi-threaded BLAS may sum in another order,
     # and the scales and the Jacobian's SVD computed here must not depend on the engine.
@@ -166,7 +173,7 @@ def fit(measurements, model: str | BushingModel = "proposed", preset: str = "def
             # (Ctrl-C, SIGTERM): see identification.engine
             with engine if owned else contextlib.nullcontext():
                 result = _search(tests, noise, bushing, preset, settings, seed, engine, progress, started, table,
-                                 ensemble)
+                                 ensemble, jacobian)
     if not result.converged:
         warnings.warn(result.warning, FitNotConvergedWarning, stacklevel=2)
     return result
@@ -193,11 +200,17 @@ def _settings(base: SearchSettings, screening: int | None, starts: int | None) -
 
 
 def _search(tests, noise, model, preset, settings, seed, engine, progress, started, table=None,
-            sample_ensemble=True) -> FitResult:
+            sample_ensemble=True, jacobian_kind="exact") -> FitResult:
     measurements = [t.measurement for t in tests]
     space = SearchSpace.from_measurements(measurements, model, steps=[t.kind == "step" for t in tests], table=table)
     # with a table, the screening and the early stages run its coarser loop (kdyn_table)
-    problem = Problem(Objective(tests, noise, model=space.bushing, table=table, search=table is not None), space)
+    problem = Problem(Objective(tests, noise, model=space.bushing, table=table, search=table is not None), space,
+                      jacobian_kind)
+    if jacobian_kind == "exact" and tests:
+        # compiled (or loaded) here first, so that the workers load it from the disk cache
+        # instead of each compiling it at once
+        from identification.fit_jacobian import sensitivity_module
+        sensitivity_module(space.bushing, len(space.names))
     ga_evaluations = PAPER_GA["population"] * PAPER_GA["generations"]
     notes = []
     loop = slow_loop_start(tests, space) if preset != "paper" else None
@@ -220,7 +233,7 @@ def _search(tests, noise, model, preset, settings, seed, engine, progress, start
     # runs once more, and a third check only reports (identification.refinement). A lone best
     # start gets company before the check at the best fit (_extend_if_alone).
     refinement = _check_steps(problem, tests, records, n, d)
-    problem = Problem(refinement.objective.with_fit_loop(tests), space)
+    problem = Problem(refinement.objective.with_fit_loop(tests), space, jacobian_kind)
     records = run_stages(problem, engine, records, [last], bars.stage, first_stage=len(early))
     records, added, agreeing = _extend_if_alone(problem, engine, records, last, len(early), n, d, bars)
     final_count = last[0] + added
@@ -230,7 +243,7 @@ def _search(tests, noise, model, preset, settings, seed, engine, progress, start
     refinement_at_best = _check_steps(problem, tests, records, n, d)
     evaluations += refinement.evaluations + refinement_at_best.evaluations
     if refinement_at_best.changed:
-        problem = Problem(refinement_at_best.objective, space)
+        problem = Problem(refinement_at_best.objective, space, jacobian_kind)
         records = run_stages(problem, engine, records, [(final_count, last[1])],
                              lambda s, k: bars.stage(s, k, again=True, total=final_count), first_stage=len(early))
         final_check = _check_steps(problem, tests, records, n, d)
@@ -248,7 +261,7 @@ def _search(tests, noise, model, preset, settings, seed, engine, progress, start
     threshold = misfit_threshold(best.misfit, n, d)
     scaled_jacobian, _ = jacobian(problem, best.theta)
     ident = identifiability(scaled_jacobian * np.sqrt(n), space.names, threshold * n)
-    evaluations += d + 1
+    evaluations += simulations_per_jacobian(problem, d, known=False)
     limit = best.misfit + threshold
     sampler = None
     members = [best.theta]
@@ -257,8 +270,9 @@ def _search(tests, noise, model, preset, settings, seed, engine, progress, start
         # here, not on a worker: the compiled kernel runs the walkers on every core of this process
         draws, _, sampler = posterior_samples(problem, best.theta, seed, threshold_scale(best.misfit, n, d))
         pushed, pushed_misfits = push_to_boundary(problem, best.theta, draws, limit)
+        per_jacobian = simulations_per_jacobian(problem, d, known=False)
         evaluations += WALKERS * STEPS + len(draws) * len(PUSH) \
-            + len(PROBES) * 2 * (d + 1) * (1 + PROFILE_ROUNDS * PROFILE_EVALUATIONS)
+            + len(PROBES) * 2 * per_jacobian * (1 + PROFILE_ROUNDS * PROFILE_EVALUATIONS)
         members = select_members(best.theta, [(r.theta, r.misfit) for r in final],
                                  np.vstack([extremes, pushed]), np.concatenate([extreme_misfits, pushed_misfits]),
                                  limit, space.bounds())

@@ -17,8 +17,10 @@ evaluations there; trust-region least squares uses the residuals' structure and 
 noise floor from a few screened starts. ``benchmarks/bench_fit_reliability.py`` measures it
 against CMA-ES with restarts and the previous default.
 
-The Jacobian is a forward difference computed in one population call of the compiled
-kernel (the point's residuals are reused from the last evaluation). Each start is one task
+The Jacobian is exact by default: the forces' sensitivities to the coordinates, computed with
+the forces in one simulation (``identification.fit_jacobian``); ``Problem(jacobian="difference")``
+takes forward differences instead, in one population call of the compiled kernel (the point's
+residuals reused from the last evaluation). Each start is one task
 of the engine (``identification.engine``): everything is decided by the seed, so any engine
 gives the same bits.
 """
@@ -45,14 +47,43 @@ last stage took 4107 simulations instead of 8392 (the fit 63 s instead of 107 s)
 the final starts crawled along flat valleys."""
 
 
+JACOBIANS = ("exact", "difference")
+"""How the least squares and the identifiability get the residuals' Jacobian: ``exact``, the
+forces' sensitivities computed with them (``identification.fit_jacobian``; a dynamic-stiffness
+table's rows by differences), or ``difference``, forward differences of DIFFERENCE_STEP."""
+
+
 @dataclass(frozen=True)
 class Problem:
-    """What a worker needs: the objective and the box (picklable)."""
+    """What a worker needs: the objective, the box (picklable) and how the Jacobian is taken
+    (``jacobian``, one of JACOBIANS)."""
     objective: Objective
     space: SearchSpace
+    jacobian: str = "exact"
+
+    def __post_init__(self):
+        if self.jacobian not in JACOBIANS:
+            raise ValueError(f"jacobian = {self.jacobian!r}: choose one of {', '.join(JACOBIANS)}")
 
     def residuals(self, theta: np.ndarray) -> np.ndarray:
         return self.objective.residual_matrix(self.space.to_parameters(theta))
+
+    def residuals_and_jacobian(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The residuals (n,) at one point ``theta`` (d,), the same bits as :meth:`residuals`, and
+        their exact Jacobian (n, d) with respect to the coordinates: the parameters' derivatives
+        (``SearchSpace.to_parameters_and_seeds``) carried through the simulation. A table's rows
+        by forward differences (one table simulation per coordinate)."""
+        theta = np.asarray(theta, dtype=float)
+        matrix, seeds = self.space.to_parameters_and_seeds(theta[None, :])
+        residual, derivative = self.objective.residual_jacobian(matrix, seeds)
+        residual, derivative = residual[0], derivative[0]
+        if self.objective.table is not None:
+            rows = slice(residual.size - self.objective.table.size, residual.size)
+            steps = _difference_steps(self.space, theta)
+            shifted = self.objective.table_residuals(self.space.to_parameters(theta + np.diag(steps)))
+            difference = ((shifted - residual[rows]) / steps[:, None]).T
+            derivative[rows] = np.where(np.isnan(derivative[rows]), difference, derivative[rows])
+        return residual, derivative
 
     def misfit(self, theta: np.ndarray) -> np.ndarray:
         with np.errstate(over="ignore"):   # failed candidates: huge by design
@@ -147,12 +178,40 @@ def run_stages(problem: Problem, engine, records: list[StartRecord], stages, pro
     return records
 
 
+def _difference_steps(space: SearchSpace, theta: np.ndarray) -> np.ndarray:
+    """Forward-difference steps of each coordinate, inwards at the upper bounds."""
+    high = space.bounds()[:, 1]
+    steps = DIFFERENCE_STEP * np.maximum(1.0, np.abs(theta))
+    return np.where(theta + steps > high, -steps, steps)
+
+
 def jacobian(problem: Problem, theta: np.ndarray, at: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The Jacobian of the residuals (n, d) at ``theta`` and the residuals there: exact
+    (:meth:`Problem.residuals_and_jacobian`) or, with ``problem.jacobian == "difference"``, by
+    forward differences, stepping inwards at the upper bounds (with the residuals ``at`` if
+    already known). A problem without ``jacobian`` (a stand-in that gives residuals only) takes
+    differences."""
+    if _kind(problem) == "exact":
+        residual, derivative = problem.residuals_and_jacobian(theta)
+        return derivative, residual
+    return difference_jacobian(problem, theta, at)
+
+
+def _kind(problem) -> str:
+    return getattr(problem, "jacobian", "difference")
+
+
+def simulations_per_jacobian(problem: Problem, coordinates: int, known: bool) -> int:
+    """Simulations one :func:`jacobian` runs: one with sensitivities (exact), or one per
+    coordinate, and one more where the residuals at the point are not ``known`` (difference)."""
+    return 1 if _kind(problem) == "exact" else coordinates + (not known)
+
+
+def difference_jacobian(problem: Problem, theta: np.ndarray,
+                        at: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Forward-difference Jacobian of the residuals (n, d) at ``theta``, stepping inwards at
     the upper bounds, and the residuals there (``at`` if already known)."""
-    high = problem.space.bounds()[:, 1]
-    steps = DIFFERENCE_STEP * np.maximum(1.0, np.abs(theta))
-    steps = np.where(theta + steps > high, -steps, steps)
+    steps = _difference_steps(problem.space, theta)
     if at is None:
         rows = problem.residuals(np.vstack([theta[None, :], theta + np.diag(steps)]))
         at, shifted = rows[0], rows[1:]
@@ -183,7 +242,7 @@ def _least_squares_task(problem: Problem, item) -> tuple[np.ndarray, float, int,
     def jac(theta):
         nonlocal used
         known = last["residuals"] if np.array_equal(last.get("theta"), theta) else None
-        used += len(theta) + (known is None)
+        used += simulations_per_jacobian(problem, len(theta), known is not None)
         return jacobian(problem, theta, known)[0]
 
     try:

@@ -168,6 +168,45 @@ class Objective:
         residual = np.concatenate(parts, axis=1)
         return np.where(np.isfinite(residual), residual, FAILED_RESIDUAL * scale)
 
+    def residual_jacobian(self, matrix: np.ndarray, seeds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Residuals of P candidates (P, n), the same bits as :meth:`residual_matrix`, and their
+        derivatives (P, n, K) along K directions ``seeds`` (P, m, K: each direction's derivative
+        of the m parameters), computed with them (``identification.fit_jacobian``). A failed
+        candidate's residuals are the constant FAILED_RESIDUAL from where it fails: derivative 0
+        there, and so is a derivative that overflows where the force does not. A table's rows get
+        NaN derivatives: the caller takes those by differences (:meth:`table_residuals`), the
+        table's steady-state loop has no sensitivities."""
+        from identification.fit_jacobian import population_sensitivities
+        scale = 1.0 / math.sqrt(self.size)
+        parts, derivatives = [], []
+        for test in self.tests:
+            d = test.driven
+            predicted, sensitivity = population_sensitivities(matrix, seeds, d.time_s, d.displacement_mm,
+                                                              d.velocity_mm_s, d.output_index, d.output_velocity_mm_s,
+                                                              FIT_MAX_SUBSTEPS, self.bushing)
+            parts.append((predicted - test.measured_N) * (scale / test.sigma_N))
+            derivatives.append(sensitivity * (scale / test.sigma_N))
+        if self.table is not None:
+            parts.append(self.table.residuals(matrix, self.bushing) * scale)
+            derivatives.append(np.full((matrix.shape[0], self.table.size, seeds.shape[2]), np.nan))
+        residual = np.concatenate(parts, axis=1)
+        failed = ~np.isfinite(residual)
+        # a failed residual is a constant (derivative 0); a derivative that overflows where the
+        # force does not (a candidate far out in the box) is taken as 0 too, so that a least-squares
+        # step from there stays finite
+        derivative = np.concatenate(derivatives, axis=1)
+        derivative = np.where(failed[:, :, None] | ~np.isfinite(derivative), 0.0, derivative)
+        if self.table is not None:
+            rows = slice(residual.shape[1] - self.table.size, residual.shape[1])
+            derivative[:, rows] = np.where(failed[:, rows, None], 0.0, np.nan)
+        return np.where(failed, FAILED_RESIDUAL * scale, residual), derivative
+
+    def table_residuals(self, matrix: np.ndarray) -> np.ndarray:
+        """The table's rows of :meth:`residual_matrix` alone, shape (P, table rows x 2)."""
+        scale = 1.0 / math.sqrt(self.size)      # as residual_matrix scales them: the same bits
+        residual = self.table.residuals(matrix, self.bushing) * scale
+        return np.where(np.isfinite(residual), residual, FAILED_RESIDUAL * scale)
+
     def __call__(self, matrix: np.ndarray) -> np.ndarray:
         """Misfit of each of P candidates, shape (P,)."""
         return np.sum(self.residual_matrix(np.atleast_2d(matrix)) ** 2, axis=1)

@@ -51,6 +51,9 @@ from fmu_src.model_definition import SearchCoordinate
 from identification.errors import IdentificationError
 from identification.measurements import Measurement
 
+COMPLEX_STEP = 1e-30
+"""The imaginary step of :meth:`SearchSpace.to_parameters_and_seeds` (no cancellation: any tiny
+step is exact to rounding)."""
 TIME_CONSTANT_FLOOR = 0.01
 """The smallest time constant searched, as a fraction of the (shortest) sample interval."""
 
@@ -202,8 +205,10 @@ class SearchSpace:
         return np.array(rows)
 
     def to_model_parameters(self, coordinates: np.ndarray) -> np.ndarray:
-        """(P, d) coordinates -> (P, m) parameters of the model, in its parameter order."""
-        theta = np.atleast_2d(np.asarray(coordinates, dtype=float))
+        """(P, d) coordinates -> (P, m) parameters of the model, in its parameter order. Complex
+        coordinates give complex parameters (the same map: how :meth:`to_parameters_and_seeds`
+        differentiates it by complex step)."""
+        theta = np.atleast_2d(np.asarray(coordinates, dtype=complex if np.iscomplexobj(coordinates) else float))
         names = self.bushing.parameter_names
         value = {name: np.zeros(theta.shape[0]) for name in names}   # fixed parameters (x0) stay 0
         for name in self.bushing.search.unit_weights:
@@ -242,6 +247,20 @@ class SearchSpace:
         """(P, d) coordinates -> (P, m) parameters of the model, what its compiled kernels take
         (``compiled_core.parameter_matrix``; for the proposed model alpha1 = alpha2 = 1)."""
         return np.ascontiguousarray(self.to_model_parameters(coordinates))
+
+    def to_parameters_and_seeds(self, coordinates: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(P, d) coordinates -> the (P, m) parameters (:meth:`to_parameters`, the same bits) and
+        their derivatives (P, m, d) along each coordinate: column j of row i is dp/dtheta_j at
+        theta_i, in the parameters' units per coordinate unit. By complex step of the map itself
+        (its parameters at theta + i*COMPLEX_STEP*e_j, imaginary part over the step): exact to
+        rounding, as the map is analytic in theta except at the gains' clamp A >= 1 N/mm (0 below
+        it, the derivative of the clamp's constant)."""
+        theta = np.atleast_2d(np.asarray(coordinates, dtype=float))
+        count, d = theta.shape
+        shifted = theta[:, None, :] + 1j * COMPLEX_STEP * np.eye(d)[None, :, :]     # (P, d, d)
+        with np.errstate(invalid="ignore", over="ignore"):
+            values = self.to_model_parameters(shifted.reshape(count * d, d)).reshape(count, d, -1)
+        return self.to_parameters(theta), np.ascontiguousarray(np.transpose(values.imag, (0, 2, 1)) / COMPLEX_STEP)
 
     def to_coordinates(self, params: Mapping[str, float]) -> np.ndarray:
         """The inverse of :meth:`to_model_parameters` (after rescaling every alpha to 1)."""

@@ -1,0 +1,267 @@
+"""The fit's exact Jacobian: the forces' sensitivities to the search coordinates, computed with the forces.
+
+For a parameter set p (a row of the fit's candidates) and K seed directions dp/dtheta_j (the
+derivatives of the search space's map theta -> p, ``SearchSpace.to_parameters_and_seeds``), one
+simulation gives the forces F_k at the output samples and their derivatives dF_k/dtheta_j for all
+K directions: forward-mode sensitivities propagated through the model's own kernels,
+
+    m = prepare(p), state = initial_state(m, x_0), ms = prepare_step(m, h),
+    state = step_prepared(m, ms, state, state_x, x_k, v_k, h, max_substeps)   (jump + integrate),
+    F_k = force(m, state, x_k, v_out_k),
+
+with p, m, ms and the state active and the input (x, v, h) constant. No derivative is typed here:
+``fmu_src.tangents`` generates each kernel's tangent from its source (the kernels' own
+statements, so the forces are bit for bit those of ``compiled_core``'s population loop: tested),
+``identification.vector_tangents`` makes them carry the K directions at once (the value, the
+expensive part of a step, is computed once), and this module writes them, with the loop below,
+into a generated module that numba compiles and caches on disk like the plain kernels
+(``fmu_src.compiled_kernels``; the first process compiles, later ones load).
+
+What the derivative is where the forward model is not differentiable: the derivative of the
+branch the kernels take (a Bouc-Wen block's sgn switches, the substep count of a step, which is
+piecewise constant in p); ``tangents``' module docstring states each one-sided value. Away from
+those it is the exact derivative of the computed forces (``tests/test_fit_jacobian.py`` checks it
+against central differences of the plain forward model).
+
+Units as in the models: mm, mm/s, N, s; the derivatives in N per unit of each search coordinate.
+"""
+from __future__ import annotations
+
+import ast
+import builtins
+import hashlib
+import inspect
+import os
+import sys
+import types
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from fmu_src import compiled_kernels as _kernels, integration, tangents
+from fmu_src.bushing_models import BushingModel, resolve_model
+from fmu_src.jit import numba
+from identification.vector_tangents import vectorize
+from identification.compiled_core import _input_arrays, _step_sizes, parameter_matrix
+
+_MAX_SUBSTEPS = integration.DEFAULT_MAX_SUBSTEPS
+
+
+def _population_sensitivities(matrix, seeds, t, x, v, out_index, out_velocity, max_substeps, step_sizes,
+                              step_size_index):
+    """Forces (P, outputs) and their derivatives (P, outputs, K) in the K directions ``seeds``
+    (P, m, K: dp/dtheta of each row), as ``compiled_core._population_forces`` computes the forces
+    (the same protocol and statements). A candidate that fails gets NaN from there on, both.
+
+    Written here, never called here: its source is compiled in the model's generated module
+    (:func:`_appendix`), where ``_PREPARE_T`` ... ``_FORCE_T`` are the vector tangents of that
+    model's kernels, ``_VALUES(row)`` the row as ``prepare``'s tuple, ``_SEEDS(seeds, i)`` row i's
+    seeds in the same layout with a K-tuple per value and ``_STORE(out, i, j, d)`` a K-tuple's store."""
+    count, samples, outputs = matrix.shape[0], t.size, out_index.size
+    forces = np.full((count, outputs), np.nan)
+    sensitivities = np.full((count, outputs, seeds.shape[2]), np.nan)
+    cached = step_sizes.size > 0
+    for i in range(count):
+        m, d_m = _PREPARE_T(_VALUES(matrix[i]), _SEEDS(seeds, i))
+        prepared = [_PREPARE_STEP_T(m, step_sizes[u] if cached else t[1] - t[0], d_m)
+                    for u in range(max(step_sizes.size, 1))]
+        state_x = x[0]
+        state, d_state = _INITIAL_T(m, state_x, d_m)
+        j = 0
+        if out_index[0] == 0:
+            f, d_f = _FORCE_T(m, state, state_x, out_velocity[0], d_m, d_state)
+            forces[i, 0] = f
+            _STORE(sensitivities, i, 0, d_f)
+            j = 1
+        for k in range(samples - 1):
+            if j == outputs:
+                break
+            h = t[k + 1] - t[k]
+            if cached:
+                ms, d_ms = prepared[step_size_index[k]]
+            else:
+                ms, d_ms = _PREPARE_STEP_T(m, h, d_m)
+            result, d_result = _STEP_T(m, ms, state, state_x, x[k], v[k], h, max_substeps, d_m, d_ms, d_state)
+            state, used, status = result
+            d_state = d_result[0]
+            if status != _OK:
+                break  # this candidate failed: NaN from here on
+            state_x = x[k] + v[k] * h
+            if out_index[j] == k + 1:
+                f, d_f = _FORCE_T(m, state, state_x, out_velocity[j], d_m, d_state)
+                forces[i, j] = f
+                _STORE(sensitivities, i, j, d_f)
+                j += 1
+    return forces, sensitivities
+
+
+def _tangent_names(model: BushingModel, generator: tangents.Generator) -> dict[str, str]:
+    """The generated tangents of the kernels the population loop calls, by the loop's names."""
+    namespace = model.step.__globals__     # the step protocol bound to the model's kernels
+    return {
+        "_PREPARE_T": generator.emit(model.prepare, (True,)),
+        "_INITIAL_T": generator.emit(model.initial_state, (True, False)),
+        "_PREPARE_STEP_T": generator.emit(namespace["prepare_step"], (True, False)),
+        "_STEP_T": generator.emit(namespace["step_prepared"], (True, True, True, False, False, False, False, False)),
+        "_FORCE_T": generator.emit(model.force, (True, True, False, False)),
+    }
+
+
+def _machinery_imports(model: BushingModel, source: str, machinery: str) -> str:
+    """The imports from the compiled machinery of the globals the tangents read that the model's
+    module does not have (the tangents of ``integration``'s functions read its globals)."""
+    module = sys.modules[model.kernel_module]
+    tree = ast.parse(source)
+    defined = {node.name for node in tree.body if isinstance(node, ast.FunctionDef)}
+    assigned = {n.id for n in ast.walk(tree) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Store)}
+    assigned |= {a.arg for n in ast.walk(tree) if isinstance(n, ast.FunctionDef) for a in n.args.args}
+    names = sorted({n.id for n in ast.walk(tree) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)}
+                   - defined - assigned - set(tangents.HELPERS))
+    needed = []
+    for name in names:
+        if name in module.__dict__:
+            if name in integration.__dict__ and module.__dict__[name] is not integration.__dict__[name]:
+                raise ValueError(f"{module.__name__} defines {name!r}, which the tangents of integration's "
+                                 "functions also read as integration's: rename it")
+            continue
+        if name in integration.__dict__:
+            needed.append(name)
+        elif name != "math" and not hasattr(builtins, name):
+            raise ValueError(f"the tangents of the {model.name} model read {name!r}, found in neither its module "
+                             "nor integration")
+    return f"from {machinery} import {', '.join(needed)}\n" if needed else ""
+
+
+def _tuple_of_lanes(values: int, lanes: int) -> str:
+    """``_SEEDS(seeds, i)``: row i of a (P, values, lanes) array as a tuple of K-tuples."""
+    rows = ", ".join("(" + "".join(f"seeds[i, {a}, {k}], " for k in range(lanes)) + ")" for a in range(values))
+    return f"@numba.njit(cache=True)\ndef _SEEDS(seeds, i):\n    return ({rows},)\n\n\n"
+
+
+def _appendix(model: BushingModel, lanes: int, machinery: str) -> str:
+    """The vector tangents of ``model``'s kernels for ``lanes`` directions, their helpers and the
+    population loop (:func:`_population_sensitivities`), as source for its generated module."""
+    generator = tangents.Generator()
+    loop_names = _tangent_names(model, generator)
+    source = vectorize("\n\n".join(generator.sources.values()), lanes)
+    helpers = "\n\n".join(inspect.getsource(helper) for helper in tangents.HELPERS.values())
+    functions = [*generator.sources, *tangents.HELPERS]
+    values = ", ".join(f"row[{i}]" for i in range(len(model.specs)))
+    stores = "".join(f"    out[i, j, {k}] = d[{k}]\n" for k in range(lanes))
+    return ("\n\nimport math\nimport numpy as np\nfrom " + machinery + " import OK as _OK\n"
+            + _machinery_imports(model, source, machinery)
+            + f"\nSLOPE_CAP = {tangents.SLOPE_CAP!r}\n\n\n" + helpers + "\n\n\n" + source + "\n\n\n"
+            + "".join(f"{name} = numba.njit(error_model='numpy', cache=True)({name})\n" for name in functions)
+            + "".join(f"{alias} = {name}\n" for alias, name in loop_names.items())
+            + f"\n\n@numba.njit(cache=True)\ndef _VALUES(row):\n    return ({values},)\n\n\n"
+            + _tuple_of_lanes(len(model.specs), lanes)
+            + f"@numba.njit(cache=True)\ndef _STORE(out, i, j, d):\n{stores}\n\n"
+            + inspect.getsource(_population_sensitivities)
+            # not parallel: the fit asks for one point's Jacobian at a time, and numba's parallel
+            # loop over these tuple types costs a third of the module's compile time
+            + "\n\n_simulate_sensitivities = numba.njit(error_model='numpy', cache=True)(_population_sensitivities)\n")
+
+
+_compiled: dict[tuple[str, int], types.ModuleType] = {}
+
+
+def _inputs_key(model: BushingModel, lanes: int) -> str:
+    """A hash of everything the generated module's source is made from: the model's kernel module
+    and its package's other modules (the machinery, the tangent generator, the unrolling, the
+    compiled modules' contract), the vector rewrite and this module, and the lane count."""
+    files = sorted({Path(sys.modules[model.kernel_module].__file__), *Path(integration.__file__).parent.glob("*.py"),
+                    Path(__file__), Path(sys.modules[vectorize.__module__].__file__)})
+    digest = hashlib.sha256(f"{model.name} {lanes}".encode())
+    for path in files:
+        digest.update(path.read_bytes())
+    return digest.hexdigest()[:16]
+
+
+def _generated_module(model: BushingModel, lanes: int) -> types.ModuleType:
+    """The generated module's source written and loaded (``compiled_kernels``). Generating it (the
+    tangents, their vector rewrite: over a second for the proposed model) is done once per machine:
+    an index file in the cache folder, named after a hash of its inputs (:func:`_inputs_key`),
+    holds the module's name, and every later process loads that module's file as it is."""
+    index = _kernels.cache_directory() / f"bushing_jacobian{lanes}_{model.name}_{_inputs_key(model, lanes)}.name"
+    machinery = _kernels.integration_module()      # loaded first: the module imports it by name
+    try:
+        name = index.read_text().strip()
+        path = _kernels.cache_directory() / f"{name}.py"
+        return _kernels.load_generated(name, path.read_text())
+    except OSError:     # not generated yet on this machine (or the index cannot be read)
+        pass
+    source = _kernels.model_source(model, machinery, _appendix(model, lanes, machinery))
+    name = _kernels.module_name(f"bushing_jacobian{lanes}_{model.name}", source)
+    module = _kernels.load_generated(name, source)
+    try:
+        partial = index.with_suffix(f".{os.getpid()}.tmp")
+        partial.write_text(name)
+        os.replace(partial, index)     # whole or not at all: workers start at once
+    except OSError:
+        pass
+    return module
+
+
+def sensitivity_module(model: str | BushingModel, lanes: int) -> types.ModuleType:
+    """The generated module of ``model`` with the forces' sensitivities in ``lanes`` directions,
+    its population loop compiled (or loaded from numba's disk cache) by a first call on a
+    two-sample input: once per process. The first process on a machine compiles (about 90 s for
+    the proposed model's 14 directions: every tangent statement is written 14 times); later ones
+    load the machine code (about half a second)."""
+    bushing = resolve_model(model)
+    key = (bushing.name, lanes)
+    if key not in _compiled:
+        module = _generated_module(bushing, lanes)
+        values = np.array([bushing.values({spec.name: 1.0 for spec in bushing.specs})])
+        two = np.array([0.0, 1e-3])
+        module._simulate_sensitivities(values, np.zeros(values.shape + (lanes,)), two, two, two,
+                                       np.arange(2, dtype=np.int64), two, 10, *_step_sizes(two))
+        _compiled[key] = module
+    return _compiled[key]
+
+
+def python_sensitivities(model: str | BushingModel, lanes: int) -> Callable:
+    """The population loop (:func:`_population_sensitivities`, same arguments) with the vector
+    tangents of ``model``'s kernels as plain Python, uncompiled: the very source the compiled
+    module holds, for tests that check every model without compiling each (interpreted, some 100
+    times slower; plain Python raises where numba gives inf or NaN)."""
+    bushing = resolve_model(model)
+    generator = tangents.Generator()
+    loop_names = _tangent_names(bushing, generator)
+    source = vectorize("\n\n".join(generator.sources.values()), lanes)
+    namespace: dict = {}
+    # integration's globals under the model's own (_machinery_imports refuses a name both have)
+    for function in (integration.block_gain, bushing.prepare):
+        namespace.update(generator.namespace(function))
+    namespace.update(numba=numba, np=np, _OK=integration.OK)
+    exec(compile(source, f"<vector tangents of {bushing.name}>", "exec"), namespace)
+    namespace.update({alias: namespace[name] for alias, name in loop_names.items()})
+    namespace["_VALUES"] = tuple
+    namespace["_SEEDS"] = lambda seeds, i: tuple(tuple(float(s) for s in row) for row in seeds[i])
+
+    def store(out, i, j, d):
+        out[i, j, :] = d
+    namespace["_STORE"] = store
+    return types.FunctionType(_population_sensitivities.__code__, namespace, "_population_sensitivities")
+
+
+def population_sensitivities(parameter_sets, seeds, time_s, displacement_mm, velocity_mm_s, output_index,
+                             output_velocity_mm_s, max_substeps: int = _MAX_SUBSTEPS,
+                             model: str | BushingModel = "proposed") -> tuple[np.ndarray, np.ndarray]:
+    """Forces [N], shape (P, outputs), as ``compiled_core.simulate_population_at`` gives them (the
+    same bits), and their derivatives, shape (P, outputs, K), in the K directions ``seeds`` (P, m,
+    K): the derivatives of each row's m parameters (in the model's order) along each direction.
+    NaN (both) from where a candidate fails."""
+    t, x, v = _input_arrays(time_s, displacement_mm, velocity_mm_s)
+    out_index = np.ascontiguousarray(output_index, dtype=np.int64)
+    out_velocity = np.ascontiguousarray(output_velocity_mm_s, dtype=float)
+    bushing = resolve_model(model)
+    matrix = parameter_matrix(parameter_sets, bushing)
+    seeds = np.ascontiguousarray(seeds, dtype=float)
+    if seeds.ndim != 3 or seeds.shape[:2] != matrix.shape:
+        raise ValueError(f"seeds must have shape (P, m, K) = ({matrix.shape[0]}, {matrix.shape[1]}, K), "
+                         f"got {seeds.shape}")
+    module = sensitivity_module(bushing, seeds.shape[2])
+    return module._simulate_sensitivities(matrix, seeds, t, x, v, out_index, out_velocity, max_substeps,
+                                          *_step_sizes(t))
