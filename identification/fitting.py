@@ -25,6 +25,9 @@ optimum is exact, so only the floor is checked).
 from __future__ import annotations
 
 import contextlib
+import os
+import sys
+import threading
 import time
 import warnings
 from dataclasses import replace
@@ -33,6 +36,7 @@ from pathlib import Path
 import numpy as np
 
 from fmu_src.bushing_models import BushingModel, resolve_model
+from fmu_src.compiled_kernels import cache_directory
 from fmu_src.parameter_files import ParameterSet
 from identification.compiled_core import parameter_matrix
 from identification.engine import make_engine
@@ -199,20 +203,54 @@ def _settings(base: SearchSettings, screening: int | None, starts: int | None) -
     return SearchSettings(base.screening, base.stages)   # validates
 
 
+def _exact_jacobian_or_why_not(tests, space: SearchSpace, progress: bool) -> tuple[str, str | None]:
+    """("exact", None) with the sensitivity module compiled (or loaded) here first, so that the
+    workers load it from the disk cache instead of each compiling it at once; or ("difference",
+    a note saying why) where the exact Jacobian would not pay: a fit to a dynamic-stiffness table
+    alone (its rows are differences either way), or a cache folder that cannot be written (every
+    process, every worker would compile the module again, a minute or more each)."""
+    from identification.fit_jacobian import sensitivity_module
+    if not tests:
+        return "difference", None
+    folder = cache_directory()
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        writable = os.access(folder, os.W_OK)
+    except OSError:
+        writable = False
+    if not writable:
+        return "difference", (f"note: the compiled models' cache {folder} cannot be written, so the fit takes "
+                              "forward differences for its Jacobian (the exact one would be compiled again in every "
+                              "process); set BUSHING_CACHE_DIR to a writable folder")
+    # The first fit of a model on a machine compiles the module for a minute or more: say so
+    # if it takes longer than a moment (a load from the cache takes under a second).
+    message = threading.Timer(3.0, lambda: print(
+        f"compiling the fit's exact Jacobian for the {space.bushing.name} model (once per machine: a minute or two; "
+        f"cached in {folder})", file=sys.stderr, flush=True)) if progress else None
+    if message:
+        message.daemon = True
+        message.start()
+    try:
+        sensitivity_module(space.bushing, len(space.names))
+    finally:
+        if message:
+            message.cancel()
+    return "exact", None
+
+
 def _search(tests, noise, model, preset, settings, seed, engine, progress, started, table=None,
             sample_ensemble=True, jacobian_kind="exact") -> FitResult:
     measurements = [t.measurement for t in tests]
     space = SearchSpace.from_measurements(measurements, model, steps=[t.kind == "step" for t in tests], table=table)
     # with a table, the screening and the early stages run its coarser loop (kdyn_table)
+    notes = []
+    if jacobian_kind == "exact":
+        jacobian_kind, note = _exact_jacobian_or_why_not(tests, space, progress)
+        if note:
+            notes.append(note)
     problem = Problem(Objective(tests, noise, model=space.bushing, table=table, search=table is not None), space,
                       jacobian_kind)
-    if jacobian_kind == "exact" and tests:
-        # compiled (or loaded) here first, so that the workers load it from the disk cache
-        # instead of each compiling it at once
-        from identification.fit_jacobian import sensitivity_module
-        sensitivity_module(space.bushing, len(space.names))
     ga_evaluations = PAPER_GA["population"] * PAPER_GA["generations"]
-    notes = []
     loop = slow_loop_start(tests, space) if preset != "paper" else None
     if loop is not None:
         notes.append(f"note: {LOOP_STARTS} of the screened starts take the {loop.describe()}")

@@ -278,3 +278,20 @@ def test_a_later_process_loads_the_generated_module_by_its_index():
                                                   f"{fit_jacobian._inputs_key(model, 14)}.name")
     assert index.read_text().strip() == module.__name__
     assert fit_jacobian._generated_module(model, 14) is module     # by the index, the same module
+
+
+def test_the_fit_takes_differences_where_the_exact_jacobian_would_not_pay(table2_problem, monkeypatch, tmp_path):
+    """A fit to a dynamic-stiffness table alone (its rows are differences either way), and a cache
+    folder that cannot be written (every process would compile the module again): forward
+    differences, the second with a note that names the folder and the way out."""
+    from identification import fitting
+    space = table2_problem.space
+    assert fitting._exact_jacobian_or_why_not([], space, False) == ("difference", None)
+    blocked = tmp_path / "file_not_folder"
+    blocked.write_text("")
+    monkeypatch.setattr(fitting, "cache_directory", lambda: blocked / "cache")
+    kind, note = fitting._exact_jacobian_or_why_not(table2_problem.objective.tests, space, False)
+    assert kind == "difference"
+    assert str(blocked / "cache") in note and "BUSHING_CACHE_DIR" in note
+    monkeypatch.undo()
+    assert fitting._exact_jacobian_or_why_not(table2_problem.objective.tests, space, False) == ("exact", None)
