@@ -35,8 +35,7 @@ class AxisDependencies:
 
 def _activities(states: int, known) -> tuple:
     """The activities (m, state, x, v) with one known active."""
-    state = tuple(known == i for i in range(states)) if states else ()
-    return (False, state, known == X, known == V)
+    return (False, tuple(known == i for i in range(states)), known == X, known == V)
 
 
 def _elements(activity, count: int) -> list[bool]:
@@ -60,7 +59,7 @@ def axis_dependencies(model: BushingModel) -> AxisDependencies:
                                                  states)):
                 if active:
                     rates[i].add(known)
-    jumped = generator.spec(model.jump, (False, (False,) * states if states else (), True)).return_activity
+    jumped = generator.spec(model.jump, (False, (False,) * states, True)).return_activity
     moved = _elements(jumped[0] if isinstance(jumped, tuple) else jumped, states)
     cosimulation = {known for known in (X, V) if known in output}
     if any(moved[i] and i in output for i in range(states)):

@@ -53,10 +53,11 @@ def _common_attributes(identifier: str, token_name: str, token: str, axis_models
             "variableNamingConvention": "structured"}
 
 
-def _dependencies(variables: list[FmuVariable], axis_models) -> dict[int, list[FmuVariable]]:
-    """{value reference of an output or a state's derivative: the knowns it depends on} in model
-    exchange (states and inputs), and for each output, under the key -(value reference) - 1, in
-    co-simulation (inputs only), from ``dependencies.axis_dependencies`` of the axis's model."""
+def _dependencies(variables: list[FmuVariable], axis_models, interfaces) -> dict[int, list[FmuVariable]]:
+    """{value reference of an output or a state's derivative: the knowns it depends on} for an FMU
+    with ``interfaces`` (``dependencies.axis_dependencies`` of the axis's model): an output's
+    states and inputs in model exchange, its inputs in co-simulation (x through the jump too), the
+    union where the FMU has both; a state derivative's states and inputs."""
     found = {}
     by_model = {}
     for v in variables:
@@ -66,17 +67,14 @@ def _dependencies(variables: list[FmuVariable], axis_models) -> dict[int, list[F
         if model.name not in by_model:
             by_model[model.name] = axis_dependencies(model)
         dependencies = by_model[model.name]
-
-        def knowns(wanted):
-            return [k for k in variables if k.axis == v.axis and (
-                (k.kind == "state" and k.index in wanted) or (k.kind == "displacement" and X in wanted)
-                or (k.kind == "velocity" and V in wanted))]
         if v.kind == "output":
-            found[v.value_reference] = knowns(dependencies.output)
-            found[-v.value_reference - 1] = knowns(dependencies.cosimulation_output)
+            wanted = (dependencies.output if "me" in interfaces else frozenset()) | \
+                (dependencies.cosimulation_output if "cs" in interfaces else frozenset())
         else:
-            state = next(s for s in variables if s.value_reference == v.state)
-            found[v.value_reference] = knowns(dependencies.rates[state.index])
+            wanted = dependencies.rates[next(s for s in variables if s.value_reference == v.state).index]
+        found[v.value_reference] = [k for k in variables if k.axis == v.axis and (
+            (k.kind == "state" and k.index in wanted) or (k.kind == "displacement" and X in wanted)
+            or (k.kind == "velocity" and V in wanted))]
     return found
 
 
@@ -123,16 +121,13 @@ def fmi2(axis_models, identifier: str, token: str, interfaces=INTERFACES, event_
         ET.SubElement(element, "Real", real)
     structure = ET.SubElement(root, "ModelStructure")
     outputs = ET.SubElement(structure, "Outputs")
-    dependencies = _dependencies(variables, axis_models)
+    dependencies = _dependencies(variables, axis_models, interfaces)
 
     def position(k):
         return index[k.value_reference]
     for v in variables:
         if v.kind == "output":
-            knowns = dependencies[v.value_reference] if "me" in interfaces else dependencies[-v.value_reference - 1]
-            if "me" in interfaces and "cs" in interfaces:     # the inputs the co-simulation output depends on too
-                knowns = [k for k in variables if k in knowns or k in dependencies[-v.value_reference - 1]]
-            _unknown(outputs, "Unknown", "index", str(position(v)), knowns, position)
+            _unknown(outputs, "Unknown", "index", str(position(v)), dependencies[v.value_reference], position)
     if "me" in interfaces and any(v.kind == "derivative" for v in variables):
         derivatives = ET.SubElement(structure, "Derivatives")
         for v in variables:
@@ -171,15 +166,14 @@ def fmi3(axis_models, identifier: str, token: str) -> bytes:
             attributes["nominal"] = c_double(nominal(v))
         ET.SubElement(model_variables, "Float64", attributes)
     structure = ET.SubElement(root, "ModelStructure")
-    dependencies = _dependencies(variables, axis_models)
+    dependencies = _dependencies(variables, axis_models, INTERFACES)
 
     def reference(k):
         return k.value_reference
     for v in variables:
-        if v.kind == "output":     # model exchange's states and inputs, and the co-simulation output's inputs
-            knowns = [k for k in variables if k in dependencies[v.value_reference]
-                      or k in dependencies[-v.value_reference - 1]]
-            _unknown(structure, "Output", "valueReference", str(v.value_reference), knowns, reference)
+        if v.kind == "output":
+            _unknown(structure, "Output", "valueReference", str(v.value_reference), dependencies[v.value_reference],
+                     reference)
     for v in variables:
         if v.kind == "derivative":
             _unknown(structure, "ContinuousStateDerivative", "valueReference", str(v.value_reference),

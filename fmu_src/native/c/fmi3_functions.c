@@ -377,9 +377,10 @@ static int bw3_derivative_arguments(fmi3Instance instance, const char *function,
     return 1;
 }
 
-/* fmi3GetAdjointDerivative (FMI 3 only, so here rather than in bushing_instance.c): sensitivity = J^T * seed, one tangent per known (the column of J
-   that the known's entry of J^T * seed needs), so it equals the transposed Jacobian of
-   bw_directional_derivative to rounding. */
+/* fmi3GetAdjointDerivative (FMI 3 only, so here rather than in bushing_instance.c):
+   sensitivity = J^T * seed, one tangent per known (the column of J that the known's entry of
+   J^T * seed needs), so it equals the transposed Jacobian of bw_directional_derivative to
+   rounding. */
 static bw_status bw_adjoint_derivative(bw_instance *inst, const char *function, const unsigned int unknowns[],
                                        size_t n_unknowns, const unsigned int knowns[], size_t n_knowns,
                                        const double seed[], double sensitivity[]) {
