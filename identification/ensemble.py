@@ -253,6 +253,8 @@ def _profile_task(shared: ProfileProblem, item):
     farthest solution inside the region is kept (None if none is)."""
     from scipy.optimize import least_squares
 
+    from identification.multistart import difference_steps
+
     (kind, amplitude, rate, duration, measure), sign = item
     problem, best, ident = shared.problem, shared.best, shared.ident
     space, n = problem.space, problem.objective.size
@@ -268,8 +270,7 @@ def _profile_task(shared: ProfileProblem, item):
             return None
         gradient = gradient / value                                      # of g = rms/rms_best - 1
     else:
-        steps = 1e-6 * np.maximum(1.0, np.abs(best))
-        steps = np.where(best + steps > bounds[:, 1], -steps, steps)
+        steps = difference_steps(space, best)
         values = probe_measure(np.vstack([best, best + np.diag(steps)]))
         if not np.all(np.isfinite(values)) or values[0] <= 0:
             return None

@@ -79,7 +79,7 @@ class Problem:
         residual, derivative = residual[0], derivative[0]
         if self.objective.table is not None:
             rows = slice(residual.size - self.objective.table.size, residual.size)
-            steps = _difference_steps(self.space, theta)
+            steps = difference_steps(self.space, theta)
             shifted = self.objective.table_residuals(self.space.to_parameters(theta + np.diag(steps)))
             difference = ((shifted - residual[rows]) / steps[:, None]).T
             derivative[rows] = np.where(np.isnan(derivative[rows]), difference, derivative[rows])
@@ -178,7 +178,7 @@ def run_stages(problem: Problem, engine, records: list[StartRecord], stages, pro
     return records
 
 
-def _difference_steps(space: SearchSpace, theta: np.ndarray) -> np.ndarray:
+def difference_steps(space: SearchSpace, theta: np.ndarray) -> np.ndarray:
     """Forward-difference steps of each coordinate, inwards at the upper bounds."""
     high = space.bounds()[:, 1]
     steps = DIFFERENCE_STEP * np.maximum(1.0, np.abs(theta))
@@ -211,7 +211,7 @@ def difference_jacobian(problem: Problem, theta: np.ndarray,
                         at: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Forward-difference Jacobian of the residuals (n, d) at ``theta``, stepping inwards at
     the upper bounds, and the residuals there (``at`` if already known)."""
-    steps = _difference_steps(problem.space, theta)
+    steps = difference_steps(problem.space, theta)
     if at is None:
         rows = problem.residuals(np.vstack([theta[None, :], theta + np.diag(steps)]))
         at, shifted = rows[0], rows[1:]
