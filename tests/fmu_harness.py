@@ -16,6 +16,17 @@ from fmpy.fmi2 import calloc, free
 STATUS_NAMES = ["ok", "warning", "discard", "error", "fatal", "pending"]
 
 
+def logging_callbacks(log) -> fmi2CallbackFunctions:
+    """FMI 2 callbacks that pass each message to ``log(status name, category, message)`` (keep the
+    returned object alive while the instance lives)."""
+    callbacks = fmi2CallbackFunctions()
+    callbacks.logger = fmi2CallbackLoggerTYPE(lambda component, instance_name, status, category, message:
+                                              log(STATUS_NAMES[status], category.decode(), message.decode()))
+    callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+    callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+    return callbacks
+
+
 class BushingFmu:
     """One FMU instance, initialised and ready to step."""
 
@@ -27,10 +38,7 @@ class BushingFmu:
         self.description = read_model_description(fmu_path)
         self.refs = {v.name: v.valueReference for v in self.description.modelVariables}
         self.messages: list[tuple[str, str, str]] = []  # (status, category, message)
-        self._callbacks = fmi2CallbackFunctions()
-        self._callbacks.logger = fmi2CallbackLoggerTYPE(self._log)
-        self._callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
-        self._callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+        self._callbacks = logging_callbacks(lambda *message: self.messages.append(message))
         self.unzip_dir = extract(fmu_path)
         self.fmu = FMU2Slave(guid=self.description.guid, unzipDirectory=self.unzip_dir,
                              modelIdentifier=self.description.coSimulation.modelIdentifier,
@@ -45,9 +53,6 @@ class BushingFmu:
         if exit_initialization:
             self.fmu.exitInitializationMode()
         self.time = 0.0
-
-    def _log(self, component, instance_name, status, category, message):
-        self.messages.append((STATUS_NAMES[status], category.decode(), message.decode()))
 
     def set(self, name: str, value: float) -> None:
         self.fmu.setReal([self.refs[name]], [value])

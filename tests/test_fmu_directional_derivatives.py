@@ -16,10 +16,10 @@ import numpy as np
 import pytest
 from fmpy import extract, read_model_description
 from fmpy.fmi1 import FMICallException
-from fmpy.fmi2 import (FMU2Model, FMU2Slave, calloc, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
-                       fmi2CallbackFunctions, fmi2CallbackLoggerTYPE, free)
+from fmpy.fmi2 import FMU2Model, FMU2Slave
 from fmpy.fmi3 import FMU3Model, FMU3Slave
 
+from fmu_harness import logging_callbacks
 from fmu_src.bushing_models import MODELS
 
 FMUS = (*MODELS, "six_axis")
@@ -38,7 +38,7 @@ class Opened:
     """One initialised instance of a native FMU through fmpy's low-level API, model exchange
     ("me", in continuous-time mode) or co-simulation ("cs"), that keeps its log messages."""
 
-    def __init__(self, path, interface: str):
+    def __init__(self, path, interface: str, exit_initialization: bool = True):
         self.description = d = read_model_description(str(path))
         self.fmi3 = d.fmiVersion == "3.0"
         self.interface = interface
@@ -52,17 +52,14 @@ class Opened:
                                  self.messages.append(message.decode()))
             self.fmu.enterInitializationMode(startTime=0.0)
         else:
-            self._callbacks = fmi2CallbackFunctions()
-            self._callbacks.logger = fmi2CallbackLoggerTYPE(lambda c, name, status, category, message:
-                                                            self.messages.append(message.decode()))
-            self._callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
-            self._callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+            self._callbacks = logging_callbacks(lambda status, category, message: self.messages.append(message))
             self.fmu.instantiate(callbacks=self._callbacks, loggingOn=True)
             self.fmu.setupExperiment(startTime=0.0)
             self.fmu.enterInitializationMode()
-        self.fmu.exitInitializationMode()
-        if interface == "me":
-            self.fmu.enterContinuousTimeMode()
+        if exit_initialization:
+            self.fmu.exitInitializationMode()
+            if interface == "me":
+                self.fmu.enterContinuousTimeMode()
         self.derivatives = [v for v in d.modelVariables if v.derivative is not None]
         self.states = [v.derivative for v in self.derivatives]
         self.inputs = [v for v in d.modelVariables if v.causality == "input"]
@@ -409,30 +406,10 @@ def test_fmi3_seed_and_sensitivity_counts_are_checked(fmus):
 @pytest.mark.parametrize("version", VERSIONS)
 def test_in_initialization_mode_the_derivatives_are_refused_with_a_reason(fmus, version):
     """The state is set at the exit of initialization mode; before it there is nothing to differentiate."""
-    path = fmus[version]["proposed"]
-    description = read_model_description(str(path))
-    kind = FMU3Slave if version == 3 else FMU2Slave
-    messages = []
-    fmu = kind(guid=description.guid, unzipDirectory=extract(str(path)),
-               modelIdentifier=description.coSimulation.modelIdentifier, instanceName="init")
-    if version == 3:
-        fmu.instantiate(loggingOn=True, logMessage=lambda env, status, category, message:
-                        messages.append(message.decode()))
-        fmu.enterInitializationMode(startTime=0.0)
-    else:
-        callbacks = fmi2CallbackFunctions()
-        callbacks.logger = fmi2CallbackLoggerTYPE(lambda c, name, status, category, message:
-                                                   messages.append(message.decode()))
-        callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
-        callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
-        fmu.instantiate(callbacks=callbacks, loggingOn=True)
-        fmu.setupExperiment(startTime=0.0)
-        fmu.enterInitializationMode()
-    refs = {v.name: v.valueReference for v in description.modelVariables}
+    opened = Opened(fmus[version]["proposed"], "cs", exit_initialization=False)
     with pytest.raises(FMICallException):
-        fmu.getDirectionalDerivative([refs["F"]], [refs["x"]], [1.0])
-    assert any("available after the exit of initialization mode" in message for message in messages)
-    fmu.exitInitializationMode()
-    assert np.isfinite(fmu.getDirectionalDerivative([refs["F"]], [refs["x"]], [1.0])[0])
-    fmu.terminate()
-    fmu.freeInstance()
+        opened.directional(opened.outputs, opened.inputs[:1], [1.0])
+    assert any("available after the exit of initialization mode" in message for message in opened.messages)
+    opened.fmu.exitInitializationMode()
+    assert np.isfinite(opened.directional(opened.outputs, opened.inputs[:1], [1.0])[0])
+    opened.free()
