@@ -11,10 +11,13 @@ Each model is fitted (``fitting.fit``) and assessed on:
   rms in units of the table's uncertainty, ``kdyn_table``).
 
 The recommendation (:func:`recommend`) is the simplest model that reaches the noise floor and
-predicts best: among the models at the floor (all models, if none is), those whose held-out
-errors are within ``PREDICTION_TOLERANCE`` of the best on each kind of held-out data (all of
-them, if none is held out); of those the one with the fewest free parameters, then the lowest
-BIC.
+predicts best: among the models at the floor, those whose held-out errors are within
+``PREDICTION_TOLERANCE`` of the best on each kind of held-out data (all of them, if none is held
+out); of those the one with the fewest free parameters, then the lowest BIC. Where no model
+reaches the floor, the fewest parameters says nothing (a linear bushing that misses the data by
+140x its noise is not simpler than one that misses by 70x, it is worse): the models that predict
+within the tolerance of the best (all, without held-out data), and of those the lowest BIC, with
+a note that no model describes the data to their noise and by how much the chosen one misses.
 
 Writes into the output directory: ``params_<model>.json`` per model (with provenance),
 ``comparison.csv`` (one row per model: everything above and whether it is the recommendation),
@@ -92,15 +95,44 @@ class Assessment:
 class Recommendation:
     model: str
     reason: str
+    caveat: str = ""
+    """Where no model reaches the noise floor: that none describes the data to their noise, the
+    recommended model's miss (its worst training test against its noise level); else empty."""
 
 
 def recommend(assessments: Sequence[Assessment], tolerance: float = PREDICTION_TOLERANCE) -> Recommendation:
-    """The simplest model that reaches the floor and predicts best (module docstring), and why."""
+    """The model to use (module docstring), why, and a caveat where none reaches the floor.
+
+    Where some models reach the noise floor: of those, the ones that predict every kind of held-out
+    data (files, then the table) within ``tolerance`` of the best; of those the one with the fewest
+    free parameters, then the lowest BIC. Where none does, parsimony says nothing (every model misses
+    the data): the ones that predict within ``tolerance`` of the best, where held-out data are given,
+    and of those (of all, without) the lowest BIC, which weighs the fit itself against its
+    parameters."""
     pool = [a for a in assessments if a.at_floor]
     why = [f"{len(pool)} of {len(assessments)} at the noise floor"]
     if not pool:
         pool = list(assessments)
-        why = ["no model reaches the noise floor"]
+        why = [f"no model reaches the noise floor (none of the {len(pool)} describes the data to their noise)"]
+    held_out = _predicting_best(pool, tolerance, why)
+    filtered = len(held_out) < len(pool) or len(why) > 1
+    if why[0].startswith("no model"):
+        chosen = min(held_out, key=lambda a: (a.information_criterion, a.free_parameters))
+        why.append(f"{chosen.model} has the lowest BIC{' of those' if filtered else ''}")
+        caveat = (f"no model describes these data to their noise level; the best, {chosen.model}, misses its worst "
+                  f"training test by {chosen.training_ratio:.3g}x the noise (the floor is {FLOOR_FACTOR}x): treat "
+                  "its predictions as approximate")
+        return Recommendation(chosen.model, "; ".join(why), caveat)
+    chosen = min(held_out, key=lambda a: (a.free_parameters, a.information_criterion))
+    simplest = [a.model for a in held_out if a.free_parameters == chosen.free_parameters]
+    why.append(f"{chosen.model} has the fewest free parameters of those ({chosen.free_parameters})"
+               + (f" and the lowest BIC among {', '.join(simplest)}" if len(simplest) > 1 else ""))
+    return Recommendation(chosen.model, "; ".join(why))
+
+
+def _predicting_best(pool: list[Assessment], tolerance: float, why: list[str]) -> list[Assessment]:
+    """Those of ``pool`` that predict each kind of held-out data they were assessed on (files, then
+    the table) within ``tolerance`` of the best, saying so in ``why``; ``pool`` where none was held out."""
     for name, error in (("held-out files", lambda a: a.validation_error), ("table", lambda a: a.table_error)):
         known = [a for a in pool if error(a) is not None and math.isfinite(error(a))]
         if not known:
@@ -109,11 +141,7 @@ def recommend(assessments: Sequence[Assessment], tolerance: float = PREDICTION_T
         close = [a for a in known if error(a) <= (1.0 + tolerance) * best]
         why.append(f"{len(close)} predict the {name} within {tolerance:.0%} of the best")
         pool = close
-    chosen = min(pool, key=lambda a: (a.free_parameters, a.information_criterion))
-    simplest = [a.model for a in pool if a.free_parameters == chosen.free_parameters]
-    why.append(f"{chosen.model} has the fewest free parameters of those ({chosen.free_parameters})"
-               + (f" and the lowest BIC among {', '.join(simplest)}" if len(simplest) > 1 else ""))
-    return Recommendation(chosen.model, "; ".join(why))
+    return pool
 
 
 def compare_models(models: Sequence[str | BushingModel], tests: Sequence[RigTest], validation_files: Sequence[Path],
@@ -172,6 +200,8 @@ def compare_models(models: Sequence[str | BushingModel], tests: Sequence[RigTest
     _write_csvs(out_dir, assessments, recommendation, errors, table)
     print(f"wrote {out_dir}/comparison.csv, validation.csv{', kdyn_errors.csv' if table is not None else ''}, "
           "params_<model>.json and compare_*.png", file=sys.stderr)
+    if recommendation.caveat:
+        print(f"note: {recommendation.caveat}")
     print(f"why: {recommendation.reason}")
     print(f"recommended: {recommendation.model}")
     return {"parameters": parameters, "errors": errors, "assessments": assessments, "recommendation": recommendation}

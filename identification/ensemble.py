@@ -144,7 +144,10 @@ def posterior_samples(problem, best: np.ndarray, seed: int, scale: float = 1.0):
         inside = problem.space.inside(thetas)
         out = np.full(len(thetas), -np.inf)
         if inside.any():
-            out[inside] = -0.5 * n * problem.misfit(thetas[inside]) / scale
+            misfits = problem.misfit(thetas[inside])
+            # a misfit that is not finite is a draw the posterior gives no weight (never NaN,
+            # which emcee refuses)
+            out[inside] = np.where(np.isfinite(misfits), -0.5 * n * misfits / scale, -np.inf)
         return out
 
     rng = np.random.default_rng(np.random.SeedSequence(seed).spawn(2)[1])
@@ -190,16 +193,19 @@ class ProfileProblem:
 
 
 def profile_extremes(problem, best: np.ndarray, best_misfit: float, ident: Identifiability, limit: float,
-                     engine) -> tuple[np.ndarray, np.ndarray]:
+                     engine) -> tuple[np.ndarray, np.ndarray, int]:
     """For each probe and both signs, the member within the region whose probe measure is
     largest or smallest (a prediction profile's end, Kreutz et al.
-    2012), one task each; returns their coordinates and misfits (those found)."""
+    2012), one task each; returns their coordinates and misfits (those found), and how many
+    profiles failed (residuals, Jacobian or probe not finite: skipped, what they had found kept)."""
     shared = ProfileProblem(problem, best, best_misfit, limit, ident)
     items = [(probe, sign) for probe in PROBES for sign in (1.0, -1.0)]
-    found = [r for r in engine.map(_profile_task, items, shared, chunk_size=1) if r is not None]
+    results = engine.map(_profile_task, items, shared, chunk_size=1)
+    failed = sum(failure for _, failure in results)
+    found = [kept for kept, _ in results if kept is not None]
     if not found:
-        return np.empty((0, len(best))), np.empty(0)
-    return np.array([theta for theta, _ in found]), np.array([misfit for _, misfit in found])
+        return np.empty((0, len(best))), np.empty(0), failed
+    return np.array([theta for theta, _ in found]), np.array([misfit for _, misfit in found]), failed
 
 
 class ProbeMeasure:
@@ -246,14 +252,29 @@ class ProbeMeasure:
 
 
 def _profile_task(shared: ProfileProblem, item):
+    """(the profile's end, whether it failed): :func:`_profile`, with residuals, a Jacobian or a
+    probe measure that are not finite (a solve pushed where the model blows up) a failed
+    profile, counted and skipped, never an exception; what it kept before stays."""
+    from identification.multistart import SEARCH_FAILURES
+    found = []
+    try:
+        return _profile(shared, item, found), False
+    except SEARCH_FAILURES:
+        return (found[-1] if found else None), True
+
+
+def _profile(shared: ProfileProblem, item, found: list):
     """Maximise sign*g, g = the probe's measure relative to the best fit's, keeping chi^2 near
     the region's edge: bounded least squares on the residuals [r*sqrt(n), c - (w/c)*sign*g],
     whose cost is chi^2/2 - w*sign*g + const (c large). w starts where the linearisation puts the
     optimum at PROFILE_TARGET x delta_chi2 and is corrected by the chi^2 each solve reaches; the
-    farthest solution inside the region is kept (None if none is)."""
+    farthest solution inside the region is kept (None if none is; each one kept is appended to
+    ``found`` as well). Raises NotFiniteError where the probe's measure or gradient at the best
+    fit, or a Jacobian, is not finite."""
     from scipy.optimize import least_squares
 
-    from identification.multistart import difference_steps
+    from identification.multistart import NotFiniteError, difference_steps, finite_or_raise
+    from identification.multistart import jacobian as residual_jacobian
 
     (kind, amplitude, rate, duration, measure), sign = item
     problem, best, ident = shared.problem, shared.best, shared.ident
@@ -266,13 +287,15 @@ def _profile_task(shared: ProfileProblem, item):
     if exact:
         value, gradient = probe_gradient(best)
         values = np.array([value])
-        if not (np.isfinite(value) and value > 0 and np.all(np.isfinite(gradient))):
+        if not (np.isfinite(value) and np.all(np.isfinite(gradient))):
+            raise NotFiniteError("the probe's measure or its gradient at the best fit is not finite")
+        if value <= 0:
             return None
         gradient = gradient / value                                      # of g = rms/rms_best - 1
     else:
         steps = difference_steps(space, best)
-        values = probe_measure(np.vstack([best, best + np.diag(steps)]))
-        if not np.all(np.isfinite(values)) or values[0] <= 0:
+        values = finite_or_raise(probe_measure(np.vstack([best, best + np.diag(steps)])), "probe's measures")
+        if values[0] <= 0:
             return None
         gradient = (values[1:] - values[0]) / steps / values[0]         # of g = rms/rms_best - 1
     smallest = 1e-12 * ident.singular_values[0]
@@ -289,14 +312,16 @@ def _profile_task(shared: ProfileProblem, item):
 
     def jacobian(theta):
         """The exact Jacobian of ``residuals`` (the fit's, then the reward's row)."""
-        _, fit_rows = problem.residuals_and_jacobian(theta)
+        fit_rows, _ = residual_jacobian(problem, theta)      # exact, or differences where it diverges
         value, gradient = probe_gradient(theta)
         finite = np.isfinite(value) and np.all(np.isfinite(gradient))   # else the reward is the constant c + 1e3
         reward = -(weight / c) * sign * gradient / values[0] if finite else np.zeros_like(gradient)
-        return np.vstack([fit_rows * math.sqrt(n), reward[None, :]])
+        return finite_or_raise(np.vstack([fit_rows * math.sqrt(n), reward[None, :]]), "profile's Jacobian entries")
 
     theta, kept = best.copy(), None
     for _ in range(PROFILE_ROUNDS):
+        if not math.isfinite(weight):   # a solve that barely moved chi^2 asks for an infinite push
+            break
         with np.errstate(over="ignore", invalid="ignore"):
             result = least_squares(residuals, theta, jac=jacobian if exact else "2-point",
                                    bounds=(bounds[:, 0], bounds[:, 1]), method="trf",
@@ -305,6 +330,7 @@ def _profile_task(shared: ProfileProblem, item):
         reached = (misfit - shared.best_misfit) * n
         if misfit <= shared.limit:
             kept, theta = (result.x, misfit), result.x
+            found.append(kept)
         if not np.isfinite(reached) or reached <= 0:
             break
         weight *= math.sqrt(target / reached)    # delta chi^2 grows with w^2 (linearised)

@@ -157,6 +157,7 @@ class FitResult:
     agreed_before_added: int | None = None  # the agreement count when the last stage ended, before any added start
     ensemble_sampled: bool = True          # False: fit(ensemble=False), the ensemble is the best fit alone
     residuals: int = 0                     # n, the residuals chi^2/n is over (0: not recorded)
+    failed_starts: int = 0                 # starts and profiles whose residuals or Jacobian were not finite
 
     @property
     def free_parameters(self) -> int:
@@ -238,6 +239,7 @@ class FitResult:
             out.update({"starts_agreeing": self.agreeing, "final_starts": self.final_starts,
                         "starts_added_for_agreement": self.added_starts,
                         "starts_agreeing_before_added": self.agreed_before_added,
+                        "failed_starts": self.failed_starts,
                         "agreement_threshold_misfit": round_for_file(self.threshold),
                         "ensemble_members": len(self.ensemble), "ensemble_sampled": self.ensemble_sampled,
                         "steps_per_sample": list(self.steps_per_sample),
@@ -284,6 +286,9 @@ class FitResult:
                          f"{self.threshold:.2e} of the best: delta chi^2 at 95 % for {len(self.space.names)} parameters); "
                          + (f"ensemble: {len(self.ensemble)} parameter sets" if self.ensemble_sampled
                             else "ensemble: not sampled (ensemble=False, --no-ensemble), the best fit alone"))
+            if self.failed_starts:
+                lines.append(f"failed starts: {self.failed_starts} (their residuals or Jacobian were not finite: "
+                             "skipped, each kept at its last finite point)")
         if self.steps_per_sample:
             lines.append("forward model: " + ", ".join(f"{m} step{'s' if m > 1 else ''} per sample on {t.name}"
                                                        for m, t in zip(self.steps_per_sample, self.tests)))
@@ -343,9 +348,9 @@ class FitResult:
 
 
 def agreeing_starts(records: list[StartRecord], stage: int, best_misfit: float, threshold: float) -> int:
-    """Starts that ran ``stage`` and reached ``best_misfit`` within ``threshold``: the agreement
-    count, the convergence evidence."""
-    return int(sum(r.misfit <= best_misfit + threshold for r in records if r.stage == stage))
+    """Starts that ran ``stage`` and reached ``best_misfit`` within ``threshold`` (a failed start
+    never agrees): the agreement count, the convergence evidence."""
+    return int(sum(r.misfit <= best_misfit + threshold for r in records if r.stage == stage and not r.failed))
 
 
 def round_for_file(value):

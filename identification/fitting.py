@@ -50,8 +50,8 @@ from identification.fit_result import (FLOOR_FACTOR, MIN_AGREEING, FitNotConverg
 from identification.kdyn_table import KdynTable, load_kdyn_table
 from identification.loop_start import LOOP_STARTS, anchored_coordinates, slow_loop_start
 from identification.measurements import Measurement
-from identification.multistart import (JACOBIANS, Problem, StartRecord, first_records, jacobian, run_stages, screen,
-                                       simulations_per_jacobian)
+from identification.multistart import (JACOBIANS, Problem, StartRecord, failed_starts, first_records, jacobian,
+                                       run_stages, screen, simulations_per_jacobian)
 from identification.noise import NoiseEstimate, estimate_noise
 from identification.objectives import Objective, nrmse
 from identification.presets import PAPER_GA, PRESETS, SearchSettings
@@ -294,17 +294,24 @@ def _search(tests, noise, model, preset, settings, seed, engine, progress, start
     bars.close()
     evaluations += sum(r.evaluations - 1 for r in records)
 
-    final = [r for r in records if r.stage == len(early)]     # scored by the objective used from here on
-    best = min(final, key=lambda r: (r.misfit, r.start))
+    # scored by the objective used from here on; a failed start is skipped (failed_starts)
+    final = [r for r in records if r.stage == len(early) and not r.failed]
+    best = _best_record(final or records)
+    failed = failed_starts(records)
+    if not final:
+        notes.append(f"note: every start of the last stage failed (residuals or Jacobian not finite); the result is "
+                     f"the best finite point the search found (stage {best.stage + 1 if best.stage >= 0 else 0})")
     threshold = misfit_threshold(best.misfit, n, d)
-    scaled_jacobian, _ = jacobian(problem, best.theta)
+    scaled_jacobian = _identifiability_jacobian(problem, best.theta, notes)
     ident = identifiability(scaled_jacobian * np.sqrt(n), space.names, threshold * n)
     evaluations += simulations_per_jacobian(problem, d, known=False)
     limit = best.misfit + threshold
     sampler = None
     members = [best.theta]
     if sample_ensemble:
-        extremes, extreme_misfits = profile_extremes(problem, best.theta, best.misfit, ident, limit, engine)
+        extremes, extreme_misfits, failed_profiles = profile_extremes(problem, best.theta, best.misfit, ident, limit,
+                                                                      engine)
+        failed += failed_profiles
         # here, not on a worker: the compiled kernel runs the walkers on every core of this process
         draws, _, sampler = posterior_samples(problem, best.theta, seed, threshold_scale(best.misfit, n, d))
         pushed, pushed_misfits = push_to_boundary(problem, best.theta, draws, limit)
@@ -323,9 +330,28 @@ def _search(tests, noise, model, preset, settings, seed, engine, progress, start
                        ensemble, ident, preset, seed, evaluations, time.perf_counter() - started, engine.description,
                        space, final_starts=len(final), sampler=sampler, notes=notes, steps_per_sample=steps,
                        table=table_fit(table, parameters), added_starts=added, agreed_before_added=agreeing,
-                       ensemble_sampled=sample_ensemble, residuals=n)
+                       ensemble_sampled=sample_ensemble, residuals=n, failed_starts=failed)
     result.parameters.provenance = result.provenance()
     return result
+
+
+def _best_record(records: list[StartRecord]) -> StartRecord:
+    """The record of the lowest misfit (then the best-screened start) among ``records``; a failed
+    start counts with the last point where it was finite (screened points always are)."""
+    finite = [r for r in records if np.isfinite(r.misfit)] or records
+    return min(finite, key=lambda r: (r.misfit, r.start))
+
+
+def _identifiability_jacobian(problem: Problem, theta: np.ndarray, notes: list[str]) -> np.ndarray:
+    """The residuals' Jacobian at the best fit for the identifiability; entries that are not finite
+    (a difference across a blow-up) are taken as 0, with a note."""
+    scaled_jacobian, _ = jacobian(problem, theta)
+    finite = np.isfinite(scaled_jacobian)
+    if not finite.all():
+        notes.append(f"note: {int(np.count_nonzero(~finite))} entries of the Jacobian at the best fit are not finite "
+                     "and were taken as 0 for the identifiability")
+        scaled_jacobian = np.where(finite, scaled_jacobian, 0.0)
+    return scaled_jacobian
 
 
 def _fit_kelvin_voigt(bushing: BushingModel, tests, noise, started, table=None) -> FitResult:
@@ -366,9 +392,10 @@ def _extend_if_alone(problem: Problem, engine, records: list[StartRecord], last:
     gets its chance to be confirmed, or a better optimum is found, before the fit says it is
     not converged. Returns the records (sorted as ``run_stages`` sorts them), how many starts
     were added and how many agreed before."""
-    best = min(r.misfit for r in records if r.stage == stage)
-    agreeing = agreeing_starts(records, stage, best, misfit_threshold(best, n, d))
-    waiting = sorted((r for r in records if r.stage < stage), key=lambda r: (-r.stage, r.misfit, r.start))[:last[0]]
+    best = min((r.misfit for r in records if r.stage == stage and not r.failed), default=np.inf)
+    agreeing = agreeing_starts(records, stage, best, misfit_threshold(best, n, d)) if np.isfinite(best) else 0
+    waiting = sorted((r for r in records if r.stage < stage and not r.failed),
+                     key=lambda r: (-r.stage, r.misfit, r.start))[:last[0]]
     if agreeing >= MIN_AGREEING or not waiting:
         return records, 0, agreeing
     run_stages(problem, engine, waiting, [(len(waiting), last[1])],
@@ -380,7 +407,7 @@ def _extend_if_alone(problem: Problem, engine, records: list[StartRecord], last:
 def _check_steps(problem: Problem, tests, records, n: int, d: int):
     """``refinement.refine_steps`` at the best start of the latest stage (its misfit sets the
     region's delta chi^2)."""
-    best = min((r for r in records if r.stage == records[0].stage), key=lambda r: (r.misfit, r.start))
+    best = _best_record([r for r in records if r.stage == records[0].stage and not r.failed] or records)
     return refine_steps(problem.objective, tests, problem.space.to_parameters(best.theta[None, :]),
                         misfit_threshold(best.misfit, n, d) * n)
 

@@ -26,6 +26,7 @@ gives the same bits.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -100,6 +101,9 @@ class StartRecord:
     evaluations: int           # model simulations it used (Jacobians included)
     message: str = ""
     history: list[float] = field(default_factory=list)   # misfit at the end of each stage
+    failed: bool = False
+    """Its residuals or Jacobian were not finite (or scipy gave up on them): the start is skipped
+    from then on, counted (``failed_starts``), and keeps the last point where it was finite."""
 
 
 def screen(problem: Problem, engine, count: int, seed: int, progress=None,
@@ -165,17 +169,29 @@ def run_stages(problem: Problem, engine, records: list[StartRecord], stages, pro
     first, each group sorted by misfit."""
     records = list(records)
     for stage, (starts, evaluations) in enumerate(stages, start=first_stage):
-        # a stage run again (after the objective was refined) continues the starts that ran it
-        records.sort(key=lambda r: (-(r.stage >= stage), r.misfit, r.start))
-        running = records[:starts]
+        # a stage run again (after the objective was refined) continues the starts that ran it;
+        # a failed start runs no more
+        records.sort(key=lambda r: (r.failed, -(r.stage >= stage), r.misfit, r.start))
+        running = [r for r in records[:starts] if not r.failed]
         results = engine.map(_least_squares_task, [(r.theta, evaluations) for r in running], problem,
                              progress=progress and (lambda n, s=stage: progress(s, n)))
-        for record, (theta_end, misfit, used, message) in zip(running, results):
-            record.theta, record.misfit, record.stage, record.message = theta_end, misfit, stage, message
+        for record, (theta_end, misfit, used, message, failed) in zip(running, results):
             record.evaluations += used
+            record.message = message
+            if failed:      # skipped from here on, at the best finite point it reached
+                record.failed = True
+                if misfit < record.misfit:
+                    record.theta, record.misfit = theta_end, misfit
+                continue
+            record.theta, record.misfit, record.stage = theta_end, misfit, stage
             record.history.append(misfit)
-    records.sort(key=lambda r: (-r.stage, r.misfit, r.start))
+    records.sort(key=lambda r: (r.failed, -r.stage, r.misfit, r.start))
     return records
+
+
+def failed_starts(records: list[StartRecord]) -> int:
+    """How many starts failed (their residuals or Jacobian not finite): skipped, not raised."""
+    return sum(r.failed for r in records)
 
 
 def difference_steps(space: SearchSpace, theta: np.ndarray) -> np.ndarray:
@@ -193,8 +209,24 @@ def jacobian(problem: Problem, theta: np.ndarray, at: np.ndarray | None = None) 
     differences."""
     if _kind(problem) == "exact":
         residual, derivative = problem.residuals_and_jacobian(theta)
-        return derivative, residual
+        if exact_usable(derivative):
+            return derivative, residual
+        return difference_jacobian(problem, theta, residual)
     return difference_jacobian(problem, theta, at)
+
+
+EXACT_JACOBIAN_LIMIT = 1e100
+"""An exact Jacobian with an entry beyond this (residuals in noise units per coordinate; a fit's
+are of order 1 to 1e4) is replaced by forward differences at that point: where a Bouc-Wen block's
+z crosses 0 with n < 1 the gain's derivative n*|z|^(n-1) is infinite, and a sensitivity carried
+through it reached 2e303 (proposed model, Table 2 tests, seed 8, 2026-11-26), finite but too large
+for the least squares' scaling and SVD, which then fail on infs. Differences take the secant."""
+
+
+def exact_usable(derivative: np.ndarray) -> bool:
+    """Whether an exact Jacobian's entries are all finite and within EXACT_JACOBIAN_LIMIT."""
+    with np.errstate(invalid="ignore"):
+        return bool(np.all(np.abs(derivative) <= EXACT_JACOBIAN_LIMIT))
 
 
 def _kind(problem) -> str:
@@ -224,32 +256,64 @@ def _misfit_task(problem: Problem, block: np.ndarray) -> np.ndarray:
     return problem.misfit(block)
 
 
-def _least_squares_task(problem: Problem, item) -> tuple[np.ndarray, float, int, str]:
+class NotFiniteError(ArithmeticError):
+    """Residuals or a Jacobian that are not finite: the start (or profile) that met them fails."""
+
+
+def finite_or_raise(values: np.ndarray, what: str) -> np.ndarray:
+    """``values`` if every entry is finite, else NotFiniteError naming ``what``."""
+    if not np.all(np.isfinite(values)):
+        raise NotFiniteError(f"the {what} are not finite")
+    return values
+
+
+SEARCH_FAILURES = (ValueError, ArithmeticError, np.linalg.LinAlgError)
+"""What a least-squares solve raises where the residuals or the Jacobian are not finite (scipy's
+ValueError "Residuals are not finite in the initial point", an SVD that does not converge, our
+NotFiniteError): a failed start, an ordinary event of a search, never the user's error."""
+
+
+def _least_squares_task(problem: Problem, item) -> tuple[np.ndarray, float, int, str, bool]:
     """Bounded trust-region least squares from ``theta`` for at most ``evaluations`` residual
-    evaluations; returns (theta, misfit, simulations used, scipy's message). A start that
-    fails is a record with an infinite misfit, not an exception."""
+    evaluations; returns (theta, misfit, simulations used, scipy's message, failed). A start
+    whose residuals or Jacobian are not finite fails (``failed`` True, theta and misfit those
+    it started from), not an exception."""
     theta0, evaluations = item
     bounds = problem.space.bounds()
     used = 0
     last: dict = {}
+    best = {"theta": np.asarray(theta0, dtype=float), "misfit": math.inf}
 
     def fun(theta):
         nonlocal used
         used += 1
-        last["theta"], last["residuals"] = theta.copy(), problem.residuals(theta[None, :])[0]
-        return last["residuals"]
+        residuals = problem.residuals(theta[None, :])[0]
+        last["theta"], last["residuals"] = theta.copy(), residuals
+        with np.errstate(over="ignore"):
+            misfit = float(np.sum(residuals ** 2))
+        if misfit < best["misfit"]:
+            best["theta"], best["misfit"] = theta.copy(), misfit
+        return residuals
 
     def jac(theta):
         nonlocal used
         known = last["residuals"] if np.array_equal(last.get("theta"), theta) else None
+        before = used
         used += simulations_per_jacobian(problem, len(theta), known is not None)
-        return jacobian(problem, theta, known)[0]
+        derivative, _ = jacobian(problem, theta, known)
+        if _kind(problem) == "exact" and not exact_usable(derivative):
+            used = before + 1 + len(theta)   # the exact one, then differences from its residuals
+        return finite_or_raise(derivative, "Jacobian's entries")
 
     try:
         with np.errstate(over="ignore", invalid="ignore"):   # failed candidates: huge residuals by design
             result = least_squares(fun, np.clip(theta0, bounds[:, 0], bounds[:, 1]), jac=jac,
                                    bounds=(bounds[:, 0], bounds[:, 1]), method="trf", x_scale="jac",
                                    ftol=COST_TOLERANCE, max_nfev=evaluations)
-    except (ValueError, np.linalg.LinAlgError) as exc:
-        return np.asarray(theta0, dtype=float), float("inf"), used, f"failed: {exc}"
-    return result.x, float(2.0 * result.cost), used, result.message
+    except SEARCH_FAILURES as exc:
+        # the start fails; the best finite point it evaluated (if any) is what it found
+        return best["theta"], best["misfit"], used, f"failed: {exc}", True
+    misfit = float(2.0 * result.cost)
+    if not math.isfinite(misfit):
+        return best["theta"], best["misfit"], used, "failed: the misfit is not finite", True
+    return result.x, misfit, used, result.message, False

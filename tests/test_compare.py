@@ -48,6 +48,34 @@ def test_without_a_model_at_the_floor_the_best_predictor_is_recommended_and_the_
     assert choice.model == "b" and choice.reason.startswith("no model reaches the noise floor")
 
 
+def test_without_a_model_at_the_floor_or_held_out_data_the_lowest_bic_is_recommended_not_the_fewest_parameters():
+    # the issue's friction-damper sine: every model misses (70, 74 and 142 times the noise), and the
+    # linear bushing, the simplest, misses most; chi^2 = n*misfit decides, the parameters' ln(n) hardly
+    n = 5000
+    proposed = assessment("proposed", 14, 70.0, misfit=70.0 ** 2, residuals=n)
+    bouc_wen = assessment("single_bouc_wen", 6, 74.0, misfit=74.0 ** 2, residuals=n)
+    linear = assessment("kelvin_voigt", 2, 142.0, misfit=142.0 ** 2, residuals=n)
+    choice = recommend([linear, bouc_wen, proposed])
+    assert choice.model == "proposed"
+    assert choice.reason.startswith("no model reaches the noise floor") and "lowest BIC" in choice.reason
+    assert "no model describes these data to their noise level" in choice.caveat
+    assert "proposed" in choice.caveat and "70x the noise" in choice.caveat
+
+
+def test_without_a_model_at_the_floor_a_close_predictor_with_the_lower_bic_is_recommended():
+    # within 10 % of the best held-out error, the information criterion decides, not the parameters
+    choice = recommend([assessment("few", 2, 40.0, held_out=0.100, misfit=1600.0),
+                        assessment("many", 14, 20.0, held_out=0.105, misfit=400.0),
+                        assessment("off", 8, 10.0, held_out=0.300, misfit=100.0)])
+    assert choice.model == "many" and "2 predict the held-out files within 10% of the best" in choice.reason
+    assert choice.caveat
+
+
+def test_models_at_the_floor_carry_no_caveat():
+    choice = recommend([assessment("a", 6, 1.0), assessment("b", 2, 30.0, misfit=900.0)])
+    assert choice.model == "a" and choice.caveat == ""
+
+
 def test_without_held_out_data_equal_counts_are_decided_by_the_information_criterion():
     # BIC = n*misfit + d*ln(n): the same d, the lower chi^2 wins
     a, b = assessment("a", 8, 1.1, misfit=1.02), assessment("b", 8, 1.0, misfit=1.01)
