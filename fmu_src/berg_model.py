@@ -28,8 +28,9 @@ from __future__ import annotations
 import math
 
 from .bushing_params import SPRING, ParameterSpec
-from .integration import NOT_FINITE, OK, friction_force, friction_jump_turn, friction_turn, maxwell_decay, maxwell_step
-from .model_definition import BushingModel, SearchBox, SearchCoordinate, StateSpec
+from .integration import (NOT_FINITE, OK, friction_force, friction_jump_turn, friction_turn, maxwell_decay, maxwell_step,
+                          vector_dot, vector_friction_force, vector_friction_jump_turn, vector_friction_turn)
+from .model_definition import BushingModel, CoupledKernels, SearchBox, SearchCoordinate, StateSpec
 
 FRICTION_LIMIT = dict(minimum=0.0, why="a friction force limit is a magnitude", bound_powers=(0, 0))
 HALF_TRAVEL = dict(minimum=0.0, exclusive=True, why="it divides the friction law: the travel to half the limit")
@@ -114,6 +115,83 @@ def switches(m, state, x, v):
     return (v,)
 
 
+# ---------------------------------------------------------------------------- coupled kernels
+# On a displacement vector (3-vectors): the progressive spring is radial, (k0 + k3*|x|^2)*x; the
+# friction is integration.vector_friction_force, Berg's law along a line; the Maxwell elements act
+# on each component. The state is (travel d, F_s, f1, f2), 3-vectors: a reversal needs no direction
+# of its own (where d = 0 the force is F_s whichever way the motion goes).
+def initial_state_coupled(m, x0):
+    """At rest at x0: no travel since a reversal, no friction or Maxwell force."""
+    return tuple(0.0 for i in range(12))
+
+
+def elastic_force_coupled(k0, k3, x):
+    """The radial progressive spring (k0 + k3*|x|^2)*x [N], a 3-vector."""
+    r2 = vector_dot(x, x)
+    return tuple(k0 * x[i] + k3 * r2 * x[i] for i in range(3))
+
+
+def force_coupled(m, state, x, v):
+    """F = (k0 + k3*|x|^2)*x + F_f + f1 + f2 [N], a 3-vector."""
+    k0, k3, limit, half_travel, k1, rate1, k2, rate2 = m
+    elastic = elastic_force_coupled(k0, k3, x)
+    friction = vector_friction_force(limit, half_travel, (state[0], state[1], state[2]), (state[3], state[4], state[5]))
+    return tuple(elastic[i] + friction[i] + state[6 + i] + state[9 + i] for i in range(3))
+
+
+def update_coupled(m, state, x, v):
+    """At an event (d.v changed sign): the friction reverses where v shortens the travel."""
+    k0, k3, limit, half_travel, k1, rate1, k2, rate2 = m
+    travel, reversal = vector_friction_turn(limit, half_travel, (state[0], state[1], state[2]),
+                                            (state[3], state[4], state[5]), v)
+    return (*travel, *reversal, *tuple(state[6 + i] for i in range(6)))
+
+
+def jump_coupled(m, state, jump):
+    """A displacement jump (a 3-vector): a reversal first where it shortens the travel (and is more
+    than rounding), then the friction travels it and the Maxwell springs take it."""
+    k0, k3, limit, half_travel, k1, rate1, k2, rate2 = m
+    travel, reversal = vector_friction_jump_turn(limit, half_travel, (state[0], state[1], state[2]),
+                                                 (state[3], state[4], state[5]), jump)
+    return (*tuple(travel[i] + jump[i] for i in range(3)), *reversal,
+            *tuple(state[6 + i] + k1 * jump[i] for i in range(3)),
+            *tuple(state[9 + i] + k2 * jump[i] for i in range(3))), OK
+
+
+def integrate_coupled(m, state, x, v, h, max_substeps):
+    """Over the step x + v*t: a reversal at its start where v shortens the travel, then the travel
+    grows by v*h and the Maxwell forces follow exactly; returns (state, 1, status)."""
+    k0, k3, limit, half_travel, k1, rate1, k2, rate2 = m
+    travel, reversal = vector_friction_turn(limit, half_travel, (state[0], state[1], state[2]),
+                                            (state[3], state[4], state[5]), v)
+    decay1, decay2 = maxwell_decay(rate1, h), maxwell_decay(rate2, h)
+    new = (*tuple(travel[i] + v[i] * h for i in range(3)), *reversal,
+           *tuple(maxwell_step(state[6 + i], k1, decay1, v[i], h) for i in range(3)),
+           *tuple(maxwell_step(state[9 + i], k2, decay2, v[i], h) for i in range(3)))
+    if not math.isfinite(sum(new[i] for i in range(12))):
+        return new, 1, NOT_FINITE
+    return new, 1, OK
+
+
+def derivatives_coupled(m, state, x, v):
+    """(dd/dt, 0, df1/dt, df2/dt), 3-vectors each (model exchange): the reversal force changes only
+    at events (``update_coupled``)."""
+    k0, k3, limit, half_travel, k1, rate1, k2, rate2 = m
+    return (v[0], v[1], v[2], 0.0, 0.0, 0.0, *tuple(k1 * v[i] - rate1 * state[6 + i] for i in range(3)),
+            *tuple(k2 * v[i] - rate2 * state[9 + i] for i in range(3)))
+
+
+def switches_coupled(m, state, x, v):
+    """d.v [mm^2/s]: where it turns negative the friction reverses."""
+    return (vector_dot((state[0], state[1], state[2]), v),)
+
+
+COUPLED_STATES = (StateSpec("travel", 0, "m", "travel since the friction's last reversal, x - x_s"),
+                  StateSpec("F_s", 1, "N", "friction force at the last reversal"))
+"""The coupled friction's states (the first two vectors of the coupled state), which the
+fractional model shares."""
+
+
 SEARCH = SearchBox(
     (SearchCoordinate("k0", "stiffness", -3.0, 1.0), SearchCoordinate("k3", "cubic", 0.0, 2.0),
      SearchCoordinate("Ff_max", "force", -3.0, 0.5), SearchCoordinate("x2", "travel", -4.0, 0.5),
@@ -139,4 +217,9 @@ MODEL = BushingModel(
     "params_berg_filled_rubber.json", prepare, initial_state, jump, integrate, force,
     derivatives, switches, update=update,
     switch_specs=(StateSpec("v", 0, "m/s", "the velocity input: where it changes sign the friction reverses"),),
-    search=SEARCH, plot_style=("C4", "-"), rank=30)
+    search=SEARCH, plot_style=("C4", "-"), rank=30,
+    coupled=CoupledKernels(
+        COUPLED_STATES + (StateSpec("f1", 2, "N", "force of the first Maxwell element"),
+                          StateSpec("f2", 3, "N", "force of the second Maxwell element")),
+        initial_state_coupled, jump_coupled, integrate_coupled, force_coupled, derivatives_coupled, switches_coupled,
+        (StateSpec("dv", 0, "m2/s", "d.v: where it turns negative the friction reverses"),), update=update_coupled))

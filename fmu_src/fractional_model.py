@@ -33,10 +33,11 @@ from __future__ import annotations
 
 import math
 
-from .berg_model import CUBIC, FRICTION_LIMIT, HALF_TRAVEL
+from .berg_model import COUPLED_STATES, CUBIC, FRICTION_LIMIT, HALF_TRAVEL
 from .bushing_params import SPRING, ParameterSpec
-from .integration import NOT_FINITE, OK, friction_force, friction_jump_turn, friction_turn, maxwell_decay, maxwell_step
-from .model_definition import BushingModel, SearchBox, SearchCoordinate, StateSpec
+from .integration import (NOT_FINITE, OK, friction_force, friction_jump_turn, friction_turn, maxwell_decay, maxwell_step,
+                          vector_dot, vector_friction_force, vector_friction_jump_turn, vector_friction_turn)
+from .model_definition import BushingModel, CoupledKernels, SearchBox, SearchCoordinate, StateSpec
 
 MODES = 19
 """Maxwell elements on the grid of rates, 10^-4 ... 10^5 1/s, two per decade."""
@@ -143,6 +144,74 @@ def switches(m, state, x, v):
     return (v,)
 
 
+# ---------------------------------------------------------------------------- coupled kernels
+# On a displacement vector (3-vectors), as Berg's coupled model (berg_model): the radial progressive
+# spring, the vector friction, and each Maxwell element of the spectrum and the upper tail's dashpot
+# on each component. The state is (travel d, F_s, f_0, ..., f_MODES), 3-vectors: element j's
+# component c at 6 + 3*j + c.
+COUPLED_SIZE = 6 + 3 * ELEMENTS
+
+
+def initial_state_coupled(m, x0):
+    """At rest at x0: no travel since a reversal, no friction or relaxation force."""
+    return tuple(0.0 for i in range(COUPLED_SIZE))
+
+
+def force_coupled(m, state, x, v):
+    """F = (k0 + k3*|x|^2)*x + F_f + (the Maxwell forces) + (upper tail)*v [N], a 3-vector."""
+    k0, k3, limit, half_travel, stiffness, rates, dashpot = m
+    r2 = vector_dot(x, x)
+    friction = vector_friction_force(limit, half_travel, (state[0], state[1], state[2]), (state[3], state[4], state[5]))
+    return tuple(k0 * x[c] + k3 * r2 * x[c] + friction[c] + sum(state[6 + 3 * i + c] for i in range(ELEMENTS))
+                 + dashpot * v[c] for c in range(3))
+
+
+def update_coupled(m, state, x, v):
+    """At an event (d.v changed sign): the friction reverses where v shortens the travel."""
+    k0, k3, limit, half_travel, stiffness, rates, dashpot = m
+    travel, reversal = vector_friction_turn(limit, half_travel, (state[0], state[1], state[2]),
+                                            (state[3], state[4], state[5]), v)
+    return (*travel, *reversal, *tuple(state[6 + i] for i in range(3 * ELEMENTS)))
+
+
+def jump_coupled(m, state, jump):
+    """A displacement jump (a 3-vector): a reversal first where it shortens the travel (and is more
+    than rounding), then the friction travels it and the Maxwell springs take it."""
+    k0, k3, limit, half_travel, stiffness, rates, dashpot = m
+    travel, reversal = vector_friction_jump_turn(limit, half_travel, (state[0], state[1], state[2]),
+                                                 (state[3], state[4], state[5]), jump)
+    return (*tuple(travel[c] + jump[c] for c in range(3)), *reversal,
+            *tuple(state[6 + i] + stiffness[i // 3] * jump[i % 3] for i in range(3 * ELEMENTS))), OK
+
+
+def integrate_coupled(ms, state, x, v, h, max_substeps):
+    """Over the step x + v*t (``ms`` = ``prepare_step(m, h)``): a reversal at its start where v
+    shortens the travel, the travel grows by v*h and every Maxwell force follows exactly; returns
+    (state, 1, status)."""
+    m, decays = ms
+    k0, k3, limit, half_travel, stiffness, rates, dashpot = m
+    travel, reversal = vector_friction_turn(limit, half_travel, (state[0], state[1], state[2]),
+                                            (state[3], state[4], state[5]), v)
+    new = (*tuple(travel[c] + v[c] * h for c in range(3)), *reversal,
+           *tuple(maxwell_step(state[6 + i], stiffness[i // 3], decays[i // 3], v[i % 3], h)
+                  for i in range(3 * ELEMENTS)))
+    if not math.isfinite(sum(new[i] for i in range(COUPLED_SIZE))):
+        return new, 1, NOT_FINITE
+    return new, 1, OK
+
+
+def derivatives_coupled(m, state, x, v):
+    """(dd/dt, 0, df_j/dt ...), 3-vectors each (model exchange)."""
+    k0, k3, limit, half_travel, stiffness, rates, dashpot = m
+    return (v[0], v[1], v[2], 0.0, 0.0, 0.0,
+            *tuple(stiffness[i // 3] * v[i % 3] - rates[i // 3] * state[6 + i] for i in range(3 * ELEMENTS)))
+
+
+def switches_coupled(m, state, x, v):
+    """d.v [mm^2/s]: where it turns negative the friction reverses."""
+    return (vector_dot((state[0], state[1], state[2]), v),)
+
+
 SEARCH = SearchBox(
     (SearchCoordinate("k0", "stiffness", -3.0, 1.0), SearchCoordinate("k3", "cubic", 0.0, 2.0),
      SearchCoordinate("Ff_max", "force", -3.0, 0.5), SearchCoordinate("x2", "travel", -4.0, 0.5),
@@ -170,4 +239,8 @@ MODEL = BushingModel(
     "params_fractional_filled_rubber.json", prepare, initial_state, jump, integrate, force,
     derivatives, switches, update=update,
     switch_specs=(StateSpec("v", 0, "m/s", "the velocity input: where it changes sign the friction reverses"),),
-    search=SEARCH, plot_style=("C5", "-"), rank=40)
+    search=SEARCH, plot_style=("C5", "-"), rank=40,
+    coupled=CoupledKernels(
+        COUPLED_STATES + tuple(StateSpec(spec.name, 2 + i, "N", spec.meaning) for i, spec in enumerate(_mode_states())),
+        initial_state_coupled, jump_coupled, integrate_coupled, force_coupled, derivatives_coupled, switches_coupled,
+        (StateSpec("dv", 0, "m2/s", "d.v: where it turns negative the friction reverses"),), update=update_coupled))

@@ -247,6 +247,221 @@ def walk_along_xi(z, xi_total, A, beta, gamma, n, heun_limit, theta, max_pieces)
     return z, OK
 
 
+# ---------------------------------------------------------------------------- coupled (vector) Bouc-Wen blocks
+# A Bouc-Wen element acting on a displacement vector (the plane, or 3-space; the kernels take
+# 3-vectors, a plane path has a zero third component) has the isotropic evolution
+#
+#     dz/dt = A*u - |z|^(n-2)*(gamma*(z.u) + beta*|z.u|)*z
+#
+# which is eq. 1 along any line (z parallel to u). Its linearisation in u is
+# M = A*I - (gamma + beta*sgn(z.u))*|z|^(n-2)*z z^T: the scalar bracket g = A - (...)*|z|^n along z,
+# A across it. A step works in the frame of z: the component along its direction e (signed s) is
+# the scalar block of the section above, whose every decision (branch, split where its velocity
+# changes sign, substeps) it reuses, so a path along a line steps as the one-axis model does; the
+# part across e is linear (rate (K + alpha*A)/c for a block, exact exponentials) and feeds z across
+# at A*u, while the nonlinear term shrinks (or, unloading, grows) that part at the rate
+# psi = (gamma + beta*sgn)*|z|^(n-2)*(z.u), whose integral over the step the parallel solve gives:
+# integral(psi*s dt) = A*xi_parallel - (s1 - s0). Then the same step again in the frame of the
+# mean of the start and the predicted end of z (the midpoint rule: second order in the frame's
+# turn). Substeps also bound that turn, weighted by the nonlinear share of the gain
+# (THETA_ROTATION). Measured against scipy's Radau on circles, ellipses and random plane paths:
+# tests/test_coupled_models.py.
+
+THETA_ROTATION = 0.1
+"""Largest turn of z's direction [rad] per substep, weighted by the nonlinear share
+|A - g|/|A| of the gain (the turn matters only through the nonlinear term)."""
+
+
+def vector_dot(a, b):
+    """a.b of two 3-vectors."""
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def vector_axpy(s, a, b):
+    """s*a + b (3-vectors)."""
+    return (s * a[0] + b[0], s * a[1] + b[1], s * a[2] + b[2])
+
+
+def vector_scale(s, a):
+    """s*a (a 3-vector)."""
+    return (s * a[0], s * a[1], s * a[2])
+
+
+def vector_norm(a):
+    """|a| of a 3-vector."""
+    return math.sqrt(vector_dot(a, a))
+
+
+def vector_direction(a, fallback):
+    """a/|a|, or ``fallback`` where a = 0."""
+    r = vector_norm(a)
+    if r > 0.0:
+        return (a[0] / r, a[1] / r, a[2] / r)
+    return fallback
+
+
+def block_frame(z, u, a):
+    """The frame's direction of a coupled block: along z; where z = 0, along its relative velocity
+    u; where that is 0 too, along the drive a; else x."""
+    return vector_direction(z, vector_direction(u, vector_direction(a, (1.0, 0.0, 0.0))))
+
+
+def vector_gain(z, u, A, beta, gamma, n):
+    """The coupled block's rate dz/dt = A*u - |z|^(n-2)*(gamma*(z.u) + beta*|z.u|)*z [N/s] at
+    hysteretic force z [N] and relative velocity u [mm/s] (3-vectors); finite at z = 0 for n > 0."""
+    zu = vector_dot(z, u)
+    r2 = vector_dot(z, z)
+    if r2 > 0.0:
+        f = r2 ** (0.5 * n - 1.0) * (gamma * zu + beta * abs(zu))
+        return (A * u[0] - f * z[0], A * u[1] - f * z[1], A * u[2] - f * z[2])
+    return (A * u[0], A * u[1], A * u[2])
+
+
+def across_decay(s0, s1, xi_parallel, A):
+    """The integral of psi over a step, from its parallel solve: (A*xi - (s1 - s0))/mean(s); 0 where s
+    passes through 0 (the part across is then of rounding size, and psi's mean is not defined)."""
+    if s0 * s1 > 0.0:
+        return (A * xi_parallel - (s1 - s0)) / (0.5 * (s0 + s1))
+    return 0.0
+
+
+def rotation_pieces(s0, s_end, across, A, beta, gamma, n, sigma, limit):
+    """Pieces so that z's direction turns by at most THETA_ROTATION per piece, weighted by the
+    nonlinear share of the gain: from the parallel force s0 [N] towards about s_end, with
+    ``across`` the norm of A times the travel across z [N]; at most ``limit`` + 1 (the caller's
+    limit of substeps, so that more is refused, not computed)."""
+    if across == 0.0 or A == 0.0:
+        return 1
+    reference = max(abs(s0), abs(s_end))
+    if reference == 0.0:
+        return 1
+    share = abs(gamma + beta * sigma) * reference ** n / abs(A)
+    turn = across / reference * share
+    if turn <= THETA_ROTATION:
+        return 1
+    if turn > THETA_ROTATION * limit:
+        return limit + 1
+    return int(math.ceil(turn / THETA_ROTATION))
+
+
+def vector_walk_frame(z, travel, e, A, beta, gamma, n, heun_limit, theta, max_pieces):
+    """z after the straight relative displacement ``travel`` of a coupled element, stepped in the
+    frame ``e`` (see the section's comment); returns (z, status)."""
+    s0 = vector_dot(z, e)
+    across0 = vector_axpy(-s0, e, z)
+    along = vector_dot(travel, e)
+    across = vector_axpy(-along, e, travel)
+    s1, status = walk_along_xi(s0, along, A, beta, gamma, n, heun_limit, theta, max_pieces)
+    E, phi1, _ = decay_factors(across_decay(s0, s1, along, A))
+    return vector_axpy(s1, e, vector_axpy(E, across0, vector_scale(A * phi1, across))), status
+
+
+def vector_walk(z, travel, A, beta, gamma, n, heun_limit, theta, max_pieces):
+    """z (a 3-vector, N) after the straight relative displacement ``travel`` [mm] of a coupled
+    Bouc-Wen element (``walk_along_xi`` across space: a displacement jump, or a step of an element
+    driven by the displacement itself); returns (z, status). Pieces bound the turn of z's
+    direction (THETA_ROTATION), each stepped in the frame of z and again in the frame of the mean
+    of its start and predicted end."""
+    remaining = travel
+    used = 0
+    while True:
+        e = block_frame(z, remaining, (0.0, 0.0, 0.0))
+        s0 = vector_dot(z, e)
+        along = vector_dot(remaining, e)
+        sigma = 1.0 if along * s0 >= 0.0 else -1.0
+        g0 = A - (gamma + beta * sigma) * abs(s0) ** n
+        across = A * vector_norm(vector_axpy(-along, e, remaining))
+        count = rotation_pieces(s0, s0 + g0 * along, across, A, beta, gamma, n, sigma, max_pieces)
+        if used + 1 > max_pieces or count > max_pieces:
+            return z, TOO_MANY_SUBSTEPS
+        piece = remaining if count == 1 else vector_scale(1.0 / count, remaining)
+        predicted, status = vector_walk_frame(z, piece, e, A, beta, gamma, n, heun_limit, theta, max_pieces)
+        if status != OK:
+            return z, status
+        middle = vector_direction(vector_axpy(1.0, z, predicted), e)
+        if middle[0] != e[0] or middle[1] != e[1] or middle[2] != e[2]:
+            predicted, status = vector_walk_frame(z, piece, middle, A, beta, gamma, n, heun_limit, theta,
+                                                  max_pieces)
+            if status != OK:
+                return z, status
+        z = predicted
+        used += 1
+        if count == 1:
+            return z, OK
+        remaining = vector_axpy(-1.0, piece, remaining)
+
+
+def vector_block_frame(u, z, h, a, blk, e):
+    """A coupled block (``blk`` as the scalar block's) advanced by h in the frame ``e``; returns
+    (u, z, xi) as 3-vectors. Along e the scalar :func:`block_step`; across it u decays at
+    (K + alpha*A)/c and drives z at A, which the nonlinear term decays at psi (see the comment)."""
+    K, alpha, c, A, beta, gamma, n = blk
+    s0 = vector_dot(z, e)
+    z_across = vector_axpy(-s0, e, z)
+    u_along = vector_dot(u, e)
+    u_across = vector_axpy(-u_along, e, u)
+    a_along = vector_dot(a, e)
+    a_across = vector_axpy(-a_along, e, a)
+    u1, s1, xi_along = block_step(u_along, s0, abs(s0) ** n, h, a_along, blk)
+    lam = (K + alpha * A) / c
+    E, phi1, phi2 = decay_factors(lam * h)
+    decay = across_decay(s0, s1, xi_along, A)
+    Em, phim1, phim2 = decay_factors(decay)
+    # integrals over the step of exp(-psi*(h - t)) times exp(-lam*t) and times t*phi1(lam*t):
+    # the drive of z across by u_across(t) = u_across*exp(-lam*t) + a_across*t*phi1(lam*t)
+    # written so that phi1's argument is >= 0 (no overflow): h*exp(-y)*phi1(x - y), y the smaller of
+    # lam*h and psi*h
+    if decay < lam * h:
+        from_u = h * Em * decay_factors(lam * h - decay)[1]
+    else:
+        from_u = h * E * decay_factors(decay - lam * h)[1]
+    if abs(lam * h) > 1e-5:   # the difference loses about 1e-16/(lam*h) of its value
+        from_a = (h * phim1 - from_u) / lam
+    else:   # the limit lam -> 0, h^2*phi2(psi*h), to a relative O(lam*h)
+        from_a = h * h * phim2
+    z_across = vector_axpy(Em, z_across, vector_axpy(A * from_u, u_across, vector_scale(A * from_a, a_across)))
+    return (vector_axpy(u1, e, vector_axpy(E, u_across, vector_scale(h * phi1, a_across))),
+            vector_axpy(s1, e, z_across),
+            vector_axpy(xi_along, e, vector_axpy(h * phi1, u_across, vector_scale(h * h * phi2, a_across))))
+
+
+def vector_block_step(u, z, h, a, blk):
+    """A coupled block (3-vectors u [mm/s], z [N], drive a [mm/s^2]) advanced by h [s]: in the
+    frame of z, then again in the frame of the mean of z's start and predicted end; returns
+    (u, z, xi), xi the relative displacement over the step."""
+    e = block_frame(z, u, a)
+    u1, z1, xi = vector_block_frame(u, z, h, a, blk, e)
+    middle = vector_direction(vector_axpy(1.0, z, z1), e)
+    if middle[0] != e[0] or middle[1] != e[1] or middle[2] != e[2]:
+        return vector_block_frame(u, z, h, a, blk, middle)
+    return u1, z1, xi
+
+
+def vector_substeps_needed(u, z, T, a, blk, limit):
+    """Substeps of a coupled block over the remaining interval T [s]: those of its part along z
+    (:func:`substeps_needed`) and those that bound the turn of z's direction
+    (:func:`rotation_pieces`, at most ``limit`` + 1)."""
+    K, alpha, c, A, beta, gamma, n = blk
+    e = block_frame(z, u, a)
+    s0 = vector_dot(z, e)
+    u_along = vector_dot(u, e)
+    a_along = vector_dot(a, e)
+    count = substeps_needed(u_along, s0, abs(s0) ** n, T, a_along, blk)
+    u_across = vector_axpy(-u_along, e, u)
+    a_across = vector_axpy(-a_along, e, a)
+    E, phi1, phi2 = decay_factors((K + alpha * A) / c * T)
+    across = A * vector_norm(vector_axpy(T * phi1, u_across, vector_scale(T * T * phi2, a_across)))
+    if across == 0.0:
+        return count
+    moving = u_along if u_along != 0.0 else a_along
+    sigma = 1.0 if moving * s0 >= 0.0 else -1.0
+    g0 = A - (gamma + beta * sigma) * abs(s0) ** n
+    E, phi1, phi2 = decay_factors((K + alpha * g0) / c * T)
+    s_end = s0 + g0 * (T * (u_along * phi1 + a_along * T * phi2))
+    turn = rotation_pieces(s0, s_end, across, A, beta, gamma, n, sigma, limit)
+    return turn if turn > count else count
+
+
 # ---------------------------------------------------------------------------- friction and Maxwell elements
 def friction_force(limit, half_travel, travel, reversal_force, direction):
     """Berg's smooth rate-independent friction force [N] (Berg, Vehicle System Dynamics 30, 1998).
@@ -303,6 +518,45 @@ def friction_turn(limit, half_travel, travel, reversal_force, direction, motion)
     return 0.0, friction_force(limit, half_travel, travel, reversal_force, direction), heading
 
 
+def vector_friction_force(limit, half_travel, travel, reversal_force):
+    """Berg's friction on a displacement vector [N, a 3-vector]: from the last reversal, with the
+    travel d = x - x_s (a 3-vector) and the force F_s there,
+
+        F = F_s + R*|d|*F_max/(x2*|R| + |d|*F_max),   R = F_max*d/|d| - F_s,
+
+    the force heads from F_s towards F_max in the direction of the travel, with Berg's law in the
+    travel's length. Along a line it is Berg's law (R = +-F_max - F_s, |R| = F_max -+ F_s: the
+    denominator x2*F_max*(1 -+ beta) + |d|*F_max of :func:`friction_force`); it depends on
+    positions only (rate-independent) and turns with them (rotation invariant); F = F_s at d = 0,
+    and F_max*x/(x2 + |x|) from rest (F_s = 0). Derivation: docs/models.md."""
+    r = vector_norm(travel)
+    if r == 0.0:
+        return reversal_force
+    room = vector_axpy(limit / r, travel, vector_scale(-1.0, reversal_force))
+    denominator = half_travel * vector_norm(room) + r * limit
+    if denominator > 0.0:
+        return vector_axpy(r * limit / denominator, room, reversal_force)
+    return reversal_force
+
+
+def vector_friction_turn(limit, half_travel, travel, reversal_force, motion):
+    """(travel, reversal force) once the displacement moves along ``motion`` (a velocity or a jump,
+    3-vectors): a reversal (travel 0, the reversal force the force here) where the motion shortens
+    the travel (d.motion < 0: the displacement turns back towards the last reversal), which along a
+    line is a motion against the direction (:func:`friction_turn`); else as they are."""
+    if vector_dot(travel, motion) < 0.0:
+        return (0.0, 0.0, 0.0), vector_friction_force(limit, half_travel, travel, reversal_force)
+    return travel, reversal_force
+
+
+def vector_friction_jump_turn(limit, half_travel, travel, reversal_force, jump):
+    """:func:`vector_friction_turn` for a displacement jump: one of rounding size
+    (ROUNDING_JUMP_MM) never reverses the friction."""
+    if vector_norm(jump) > ROUNDING_JUMP_MM:
+        return vector_friction_turn(limit, half_travel, travel, reversal_force, jump)
+    return travel, reversal_force
+
+
 def maxwell_decay(rate, h):
     """(E, phi1) of a Maxwell element of ``rate`` = stiffness/damping [1/s] over h [s]:
     exp(-rate*h) and (1 - E)/(rate*h) (``decay_factors``), what :func:`maxwell_step` takes; a
@@ -348,6 +602,21 @@ def step_prepared(m, ms, state, state_x, x, v, h, max_substeps):
         state, status = jump(m, state, x - state_x)  # noqa: F821 (the model's, where bound)
     if status == OK:
         state, used, status = integrate(ms, state, x, v, h, max_substeps)  # noqa: F821
+    return state, used, status
+
+
+def step_coupled(m, state, state_x, x, v, h, max_substeps):
+    """:func:`step` of a model's coupled form (``model_definition.CoupledKernels``): x, v and
+    state_x are 3-vectors [mm, mm/s], and where x differs from state_x the difference is first a
+    displacement jump. Bound to the coupled kernels ``jump_coupled`` and ``integrate_coupled``;
+    never called in this module."""
+    status = OK
+    used = 0
+    if x[0] != state_x[0] or x[1] != state_x[1] or x[2] != state_x[2]:
+        state, status = jump_coupled(m, state, (x[0] - state_x[0], x[1] - state_x[1],  # noqa: F821
+                                                x[2] - state_x[2]))
+    if status == OK:
+        state, used, status = integrate_coupled(prepare_step(m, h), state, x, v, h, max_substeps)  # noqa: F821
     return state, used, status
 
 

@@ -134,6 +134,54 @@ class SearchBox:
 
 
 @dataclass(frozen=True)
+class CoupledKernels:
+    """A model's coupled form: the same parameters acting on a displacement vector (a group of
+    axes: the plane of a radial bushing, or 3-space), with isotropic hysteresis that is the
+    one-axis model along any line (``integration``'s coupled blocks).
+
+    Its kernels mirror the one-axis ones with 3-vectors (tuples) for x, v, a jump and the force:
+
+        initial_state(constants, x0) -> state       x0 [mm], a 3-vector
+        jump(constants, state, jump) -> (state, status)
+        integrate(step constants, state, x, v, h, max_substeps) -> (state, substeps, status)
+        force(constants, state, x, v) -> F, a 3-vector [N]
+        derivatives(constants, state, x, v) -> d(state)/dt
+        switches(constants, state, x, v) -> the quantities whose sign selects a branch
+        update(constants, state, x, v) -> state     (optional) the state after an event
+
+    taking the one-axis model's ``prepare`` (and ``prepare_step``) constants. A plane path has a
+    zero third component, and its state's third components stay 0. The state is flat: component
+    c of the vector state ``states[i]`` is entry 3*i + c (``StateSpec.index`` is i).
+    ``zero_parameters``: parameters that have no direction in the plane (Spencer's x0), which a
+    coupled group requires to be 0."""
+    states: tuple[StateSpec, ...]
+    initial_state: Callable
+    jump: Callable
+    integrate: Callable
+    force: Callable
+    derivatives: Callable
+    switches: Callable
+    switch_specs: tuple[StateSpec, ...] = ()
+    update: Callable | None = None
+    zero_parameters: tuple[str, ...] = ()
+    step: Callable = field(init=False, repr=False, compare=False)
+    """step(constants, state, state_x, x, v, h, max_substeps) -> (state, substeps, status): the
+    step protocol ``integration.step_coupled`` bound to these kernels."""
+
+    def __post_init__(self):
+        namespace = dict(sys.modules[self.integrate.__module__].__dict__)
+        namespace.setdefault("prepare_step", integration.unprepared_step)
+        namespace["jump_coupled"], namespace["integrate_coupled"] = self.jump, self.integrate
+        object.__setattr__(self, "step", types.FunctionType(integration.step_coupled.__code__, namespace,
+                                                            "step_coupled"))
+
+    @property
+    def size(self) -> int:
+        """Floats in the flat state."""
+        return 3 * len(self.states)
+
+
+@dataclass(frozen=True)
 class BushingModel:
     """One bushing model: its names, parameters (paper units, N-mm-s), FMU states and the
     kernels that every path runs (the pythonfmu FMU, numba, the native FMU's C). Each model
@@ -170,6 +218,9 @@ class BushingModel:
     """(matplotlib colour, line style) of the model in comparison plots."""
     rank: int = 100
     """Position in listings (the command line's choices, ``compare``'s columns): lower first."""
+    coupled: CoupledKernels | None = None
+    """The model on a displacement vector (a coupled group of axes); None: it has none (it acts
+    on each axis alone: Kelvin-Voigt, whose linear elements couple nothing)."""
     step: Callable = field(init=False, repr=False, compare=False)
     """step(constants, state, state_x, x, v, h, max_substeps) -> (state, substeps, status): the
     step protocol of ``integration.step`` bound to this model's ``jump`` and ``integrate``."""

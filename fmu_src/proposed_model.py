@@ -28,8 +28,9 @@ import math
 
 from .bushing_params import DAMPING, EXPONENT, GAIN, SPRING, WEIGHT, Constraint, ParameterSpec
 from .integration import (DEFAULT_MAX_SUBSTEPS, HEUN_JUMP_LIMIT, NOT_FINITE, OK, THETA_JUMP, TOO_MANY_SUBSTEPS,
-                          block_gain, block_power, block_step, substeps_needed, walk_along_xi)
-from .model_definition import BushingModel, SearchBox, SearchCoordinate, StateSpec
+                          block_gain, block_power, block_step, substeps_needed, vector_block_step, vector_dot,
+                          vector_gain, vector_substeps_needed, vector_walk, walk_along_xi)
+from .model_definition import BushingModel, CoupledKernels, SearchBox, SearchCoordinate, StateSpec
 
 IDENTIFIER = "BoucWenBushing"
 
@@ -165,6 +166,97 @@ def switches(m, state, x, v):
     return (v - dy, state[1], v - dw, state[3])
 
 
+# ---------------------------------------------------------------------------- coupled kernels
+# Eqs. 1-5 on a displacement vector (3-vectors x, v, y, w, z1, z2; a plane path has a zero third
+# component): the plates y and w are vectors, every spring and dashpot acts on each component, and
+# each Bouc-Wen block is the isotropic vector block (integration's coupled blocks), eq. 1 along any
+# line. The state is (y, z1, w, z2), 12 floats.
+def initial_state_coupled(m, x0):
+    """Relaxed static equilibrium at the displacement x0 (a 3-vector) with virgin hysteresis."""
+    k1, K1 = m[1], m[7]
+    if K1 > 0.0:
+        return (k1 * x0[0] / K1, k1 * x0[1] / K1, k1 * x0[2] / K1, 0.0, 0.0, 0.0, x0[0], x0[1], x0[2], 0.0, 0.0, 0.0)
+    return (x0[0], x0[1], x0[2], 0.0, 0.0, 0.0, x0[0], x0[1], x0[2], 0.0, 0.0, 0.0)
+
+
+def force_coupled(m, state, x, v):
+    """Eq. 5 with eq. 4 on each component: F = k0*y + c0*dw/dt [N], a 3-vector."""
+    k0, k1, k2, c0, c1, c2, C, K1, alpha1, alpha2, blk1, blk2 = m
+    return tuple(k0 * state[i] + c0 * ((c2 * v[i] + k2 * (x[i] - state[6 + i]) + alpha2 * state[9 + i]) / C)
+                 for i in range(3))
+
+
+def jump_coupled(m, state, jump):
+    """A displacement jump (a 3-vector): y takes it, w its share c2/(c0 + c2), and z2 walks along
+    the rest, c0/(c0 + c2)*jump."""
+    k0, k1, k2, c0, c1, c2, C, K1, alpha1, alpha2, blk1, blk2 = m
+    z2, status = vector_walk((state[9], state[10], state[11]), tuple(c0 / C * jump[i] for i in range(3)), blk2[3],
+                             blk2[4], blk2[5], blk2[6], HEUN_JUMP_LIMIT, THETA_JUMP, DEFAULT_MAX_SUBSTEPS)
+    if status != OK:
+        return state, status
+    return (state[0] + jump[0], state[1] + jump[1], state[2] + jump[2], state[3], state[4], state[5],
+            *tuple(state[6 + i] + (C - c0) / C * jump[i] for i in range(3)), z2[0], z2[1], z2[2]), OK
+
+
+def integrate_coupled(m, state, x, v, h, max_substeps):
+    """Both vector blocks over the step; returns (state, substeps used, status)."""
+    k0, k1, k2, c0, c1, c2, C, K1, alpha1, alpha2, blk1, blk2 = m
+    y = (state[0], state[1], state[2])
+    z1 = (state[3], state[4], state[5])
+    w = (state[6], state[7], state[8])
+    z2 = (state[9], state[10], state[11])
+    a1 = tuple(k0 * v[i] / c1 for i in range(3))
+    elapsed = 0.0
+    used = 0
+    while True:
+        remaining = h - elapsed
+        x_now = tuple(x[i] + v[i] * elapsed for i in range(3))
+        u1 = tuple(-(k1 * (x_now[i] - y[i]) - k0 * y[i] + alpha1 * z1[i]) / c1 for i in range(3))
+        u2 = tuple((c0 * v[i] - k2 * (x_now[i] - w[i]) - alpha2 * z2[i]) / C for i in range(3))
+        count = max(vector_substeps_needed(u1, z1, remaining, a1, blk1, max_substeps),
+                    vector_substeps_needed(u2, z2, remaining, (0.0, 0.0, 0.0), blk2, max_substeps))
+        if used + 1 > max_substeps or count > max_substeps:
+            return (y[0], y[1], y[2], z1[0], z1[1], z1[2], w[0], w[1], w[2], z2[0], z2[1], z2[2]), used, \
+                TOO_MANY_SUBSTEPS
+        sub = remaining if count == 1 else remaining / count
+        u1, z1, xi1 = vector_block_step(u1, z1, sub, a1, blk1)
+        u2, z2, xi2 = vector_block_step(u2, z2, sub, (0.0, 0.0, 0.0), blk2)
+        elapsed = h if count == 1 else elapsed + sub
+        x_now = tuple(x[i] + v[i] * elapsed for i in range(3))
+        # as the one-axis step: the invariant keeps y consistent with u1
+        if K1 > 0.0:
+            y = tuple((k1 * x_now[i] + alpha1 * z1[i] + c1 * u1[i]) / K1 for i in range(3))
+        else:
+            y = tuple(y[i] + v[i] * sub - xi1[i] for i in range(3))
+        w = tuple(w[i] + v[i] * sub - xi2[i] for i in range(3))
+        used += 1
+        if count == 1:
+            break
+    new = (y[0], y[1], y[2], z1[0], z1[1], z1[2], w[0], w[1], w[2], z2[0], z2[1], z2[2])
+    if not math.isfinite(sum(new[i] for i in range(12))):
+        return new, used, NOT_FINITE
+    return new, used, OK
+
+
+def derivatives_coupled(m, state, x, v):
+    """Eqs. 1-4 on each component: (dy/dt, dz1/dt, dw/dt, dz2/dt), 3-vectors each [mm/s, N/s]."""
+    k0, k1, k2, c0, c1, c2, C, K1, alpha1, alpha2, blk1, blk2 = m
+    dy = tuple((c1 * v[i] + k1 * (x[i] - state[i]) - k0 * state[i] + alpha1 * state[3 + i]) / c1 for i in range(3))
+    dw = tuple((c2 * v[i] + k2 * (x[i] - state[6 + i]) + alpha2 * state[9 + i]) / C for i in range(3))
+    dz1 = vector_gain((state[3], state[4], state[5]), tuple(v[i] - dy[i] for i in range(3)), blk1[3], blk1[4],
+                      blk1[5], blk1[6])
+    dz2 = vector_gain((state[9], state[10], state[11]), tuple(v[i] - dw[i] for i in range(3)), blk2[3], blk2[4],
+                      blk2[5], blk2[6])
+    return (dy[0], dy[1], dy[2], dz1[0], dz1[1], dz1[2], dw[0], dw[1], dw[2], dz2[0], dz2[1], dz2[2])
+
+
+def switches_coupled(m, state, x, v):
+    """z1.u1 and z2.u2 [N.mm/s]: where either changes sign its block's law switches branch."""
+    rates = derivatives_coupled(m, state, x, v)
+    return (vector_dot((state[3], state[4], state[5]), tuple(v[i] - rates[i] for i in range(3))),
+            vector_dot((state[9], state[10], state[11]), tuple(v[i] - rates[6 + i] for i in range(3))))
+
+
 SEARCH = SearchBox(
     (SearchCoordinate("k0", "stiffness", -3.0, 1.0), SearchCoordinate("k1", "stiffness", -3.0, 1.0),
      SearchCoordinate("k2", "stiffness", -5.0, 0.0),
@@ -193,4 +285,11 @@ MODEL = BushingModel(
                   StateSpec("z1", 1, "N", "hysteretic force of block 1"),
                   StateSpec("u2", 2, "m/s", "relative velocity of block 2, v - dw/dt"),
                   StateSpec("z2", 3, "N", "hysteretic force of block 2")),
-    constraints=CONSTRAINTS, search=SEARCH, plot_style=("C0", "-"), rank=0)
+    constraints=CONSTRAINTS, search=SEARCH, plot_style=("C0", "-"), rank=0,
+    coupled=CoupledKernels(
+        (StateSpec("y", 0, "m", "displacement of the left plate (eq. 3)"),
+         StateSpec("z1", 1, "N", "hysteretic force of the left block (eq. 1)"),
+         StateSpec("w", 2, "m", "displacement of the right plate (eq. 4)"),
+         StateSpec("z2", 3, "N", "hysteretic force of the right block (eq. 2)")),
+        initial_state_coupled, jump_coupled, integrate_coupled, force_coupled, derivatives_coupled, switches_coupled,
+        (StateSpec("z1u1", 0, "N.m/s", "z1.u1: block 1's branch"), StateSpec("z2u2", 1, "N.m/s", "z2.u2: block 2's branch"))))

@@ -15,8 +15,8 @@ import math
 
 from .bushing_params import DAMPING, EXPONENT, GAIN, SPRING, WEIGHT, ParameterSpec
 from .integration import (DEFAULT_MAX_SUBSTEPS, HEUN_JUMP_LIMIT, NOT_FINITE, OK, THETA, THETA_JUMP, block_gain,
-                          walk_along_xi)
-from .model_definition import BushingModel, SearchBox, SearchCoordinate, StateSpec
+                          vector_dot, vector_gain, vector_walk, walk_along_xi)
+from .model_definition import BushingModel, CoupledKernels, SearchBox, SearchCoordinate, StateSpec
 from .spencer_model import SINGLE_BLOCK_CONSTRAINTS
 
 PARAMETER_SPECS = (
@@ -76,6 +76,47 @@ def switches(m, state, x, v):
     return (v, state[0])
 
 
+# ---------------------------------------------------------------------------- coupled kernels
+# The element on a displacement vector (3-vectors x, v [mm, mm/s], z [N]; a plane path has a zero
+# third component): F = c0*v + k0*x + alpha*z, dz = A*dx - |z|^(n-2)*(gamma*(z.dx) + beta*|z.dx|)*z,
+# the isotropic law that is eq. 1 along any line (integration.vector_gain). The state is z.
+def initial_state_coupled(m, x0):
+    """Virgin hysteresis: z = 0."""
+    return (0.0, 0.0, 0.0)
+
+
+def force_coupled(m, state, x, v):
+    """F = c0*v + k0*x + alpha*z [N], a 3-vector."""
+    c0, k0, alpha, A, beta, gamma, n = m
+    return tuple(c0 * v[i] + k0 * x[i] + alpha * state[i] for i in range(3))
+
+
+def jump_coupled(m, state, jump):
+    """z walks along the jump (a 3-vector, mm)."""
+    c0, k0, alpha, A, beta, gamma, n = m
+    return vector_walk(state, jump, A, beta, gamma, n, HEUN_JUMP_LIMIT, THETA_JUMP, DEFAULT_MAX_SUBSTEPS)
+
+
+def integrate_coupled(m, state, x, v, h, max_substeps):
+    """z walks along v*h; returns (state, 1, status)."""
+    c0, k0, alpha, A, beta, gamma, n = m
+    z, status = vector_walk(state, tuple(v[i] * h for i in range(3)), A, beta, gamma, n, 0.0, THETA, max_substeps)
+    if status == OK and not math.isfinite(z[0] + z[1] + z[2]):
+        status = NOT_FINITE
+    return z, 1, status
+
+
+def derivatives_coupled(m, state, x, v):
+    """dz/dt [N/s] (model exchange)."""
+    c0, k0, alpha, A, beta, gamma, n = m
+    return vector_gain(state, v, A, beta, gamma, n)
+
+
+def switches_coupled(m, state, x, v):
+    """z.v [N.mm/s]: where it changes sign the element's law switches branch."""
+    return (vector_dot(state, v),)
+
+
 SEARCH = SearchBox(
     (SearchCoordinate("k0", "stiffness", -3.0, 1.0), SearchCoordinate("c0", "damping", -4.0, 2.0),
      SearchCoordinate("A", "gain", -4.0, 1.0), SearchCoordinate("beta", "shape", 0.0, 20.0, "n"),
@@ -92,4 +133,7 @@ MODEL = BushingModel(
     derivatives, switches, constraints=SINGLE_BLOCK_CONSTRAINTS,
     switch_specs=(StateSpec("v", 0, "m/s", "the velocity input, which drives the element"),
                   StateSpec("z", 1, "N", "hysteretic force")),
-    search=SEARCH, plot_style=("C1", ":"), rank=20)
+    search=SEARCH, plot_style=("C1", ":"), rank=20,
+    coupled=CoupledKernels((StateSpec("z", 0, "N", "hysteretic force"),), initial_state_coupled,
+                           jump_coupled, integrate_coupled, force_coupled, derivatives_coupled, switches_coupled,
+                           (StateSpec("zv", 0, "N.m/s", "z.v: the element's branch"),)))

@@ -20,8 +20,9 @@ import math
 
 from .bushing_params import DAMPING, EXPONENT, GAIN, SPRING, WEIGHT, Constraint, ParameterSpec
 from .integration import (DEFAULT_MAX_SUBSTEPS, HEUN_JUMP_LIMIT, NOT_FINITE, OK, THETA_JUMP, TOO_MANY_SUBSTEPS,
-                          block_gain, block_power, block_step, substeps_needed, walk_along_xi)
-from .model_definition import BushingModel, SearchBox, SearchCoordinate, StateSpec
+                          block_gain, block_power, block_step, substeps_needed, vector_block_step, vector_dot,
+                          vector_gain, vector_substeps_needed, vector_walk, walk_along_xi)
+from .model_definition import BushingModel, CoupledKernels, SearchBox, SearchCoordinate, StateSpec
 
 PARAMETER_SPECS = (
     ParameterSpec("c0", "N.s/mm", "viscous damping in parallel with the Bouc-Wen element (large velocities)",
@@ -117,6 +118,78 @@ def switches(m, state, x, v):
     return ((c1 * v - k0 * (x - y) - alpha * z) / C, z)
 
 
+# ---------------------------------------------------------------------------- coupled kernels
+# On a displacement vector (3-vectors; integration's coupled blocks): y is a vector, each linear
+# element acts on each component and the Bouc-Wen element is the isotropic vector block. The
+# accumulator's offset x0 has no direction in the plane: the coupled model takes k1*x (a group
+# refuses x0 != 0; an axis offset and preload do that job). The state is (y, z), 6 floats.
+def initial_state_coupled(m, x0):
+    """At rest at the displacement x0 (a 3-vector): y = x0, z = 0."""
+    return (x0[0], x0[1], x0[2], 0.0, 0.0, 0.0)
+
+
+def _relative_velocity_coupled(m, y, z, x, v):
+    """The element's relative velocity u = (c1*v - k0*(x - y) - alpha*z)/(c0 + c1) [mm/s]."""
+    c0, k0, c1, k1, x0, alpha, C, blk = m
+    return tuple((c1 * v[i] - k0 * (x[i] - y[i]) - alpha * z[i]) / C for i in range(3))
+
+
+def force_coupled(m, state, x, v):
+    """F = c1*dy/dt + k1*x [N], a 3-vector."""
+    c0, k0, c1, k1, x0, alpha, C, blk = m
+    return tuple(c1 * ((alpha * state[3 + i] + c0 * v[i] + k0 * (x[i] - state[i])) / C) + k1 * x[i]
+                 for i in range(3))
+
+
+def jump_coupled(m, state, jump):
+    """The dashpots split the jump: y += c0/(c0 + c1)*jump, z walks along c1/(c0 + c1)*jump."""
+    c0, k0, c1, k1, x0, alpha, C, blk = m
+    z, status = vector_walk((state[3], state[4], state[5]), tuple(c1 / C * jump[i] for i in range(3)), blk[3], blk[4],
+                            blk[5], blk[6], HEUN_JUMP_LIMIT, THETA_JUMP, DEFAULT_MAX_SUBSTEPS)
+    if status != OK:
+        return state, status
+    return (*tuple(state[i] + c0 / C * jump[i] for i in range(3)), *z), OK
+
+
+def integrate_coupled(m, state, x, v, h, max_substeps):
+    """The vector block over the step; returns (state, substeps used, status)."""
+    c0, k0, c1, k1, x0, alpha, C, blk = m
+    y = (state[0], state[1], state[2])
+    z = (state[3], state[4], state[5])
+    elapsed = 0.0
+    used = 0
+    while True:
+        remaining = h - elapsed
+        u = _relative_velocity_coupled(m, y, z, tuple(x[i] + v[i] * elapsed for i in range(3)), v)
+        count = vector_substeps_needed(u, z, remaining, (0.0, 0.0, 0.0), blk, max_substeps)
+        if used + 1 > max_substeps or count > max_substeps:
+            return (*y, *z), used, TOO_MANY_SUBSTEPS
+        sub = remaining if count == 1 else remaining / count
+        u, z, xi = vector_block_step(u, z, sub, (0.0, 0.0, 0.0), blk)
+        elapsed = h if count == 1 else elapsed + sub
+        y = tuple(y[i] + v[i] * sub - xi[i] for i in range(3))
+        used += 1
+        if count == 1:
+            break
+    if not math.isfinite(y[0] + y[1] + y[2] + z[0] + z[1] + z[2]):
+        return (*y, *z), used, NOT_FINITE
+    return (*y, *z), used, OK
+
+
+def derivatives_coupled(m, state, x, v):
+    """(dy/dt, dz/dt) [mm/s, N/s] (model exchange)."""
+    c0, k0, c1, k1, x0, alpha, C, blk = m
+    z = (state[3], state[4], state[5])
+    u = _relative_velocity_coupled(m, (state[0], state[1], state[2]), z, x, v)
+    return (*tuple(v[i] - u[i] for i in range(3)), *vector_gain(z, u, blk[3], blk[4], blk[5], blk[6]))
+
+
+def switches_coupled(m, state, x, v):
+    """z.u [N.mm/s]: where it changes sign the element's law switches branch."""
+    z = (state[3], state[4], state[5])
+    return (vector_dot(z, _relative_velocity_coupled(m, (state[0], state[1], state[2]), z, x, v)),)
+
+
 SEARCH = SearchBox(
     (SearchCoordinate("k0", "stiffness", -5.0, 1.0), SearchCoordinate("k1", "stiffness", -3.0, 1.0),
      SearchCoordinate("c0", "damping", -4.0, 2.0),
@@ -137,4 +210,9 @@ MODEL = BushingModel(
     derivatives, switches,
     switch_specs=(StateSpec("u", 0, "m/s", "relative velocity of the Bouc-Wen element, v - dy/dt"),
                   StateSpec("z", 1, "N", "hysteretic force")),
-    constraints=SINGLE_BLOCK_CONSTRAINTS, search=SEARCH, plot_style=("C2", "-."), rank=10)
+    constraints=SINGLE_BLOCK_CONSTRAINTS, search=SEARCH, plot_style=("C2", "-."), rank=10,
+    coupled=CoupledKernels(
+        (StateSpec("y", 0, "m", "internal displacement (between the Bouc-Wen element and c1)"),
+         StateSpec("z", 1, "N", "hysteretic force")),
+        initial_state_coupled, jump_coupled, integrate_coupled, force_coupled, derivatives_coupled, switches_coupled,
+        (StateSpec("zu", 0, "N.m/s", "z.u: the element's branch"),), zero_parameters=("x0",)))

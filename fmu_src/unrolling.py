@@ -13,8 +13,9 @@ through :func:`unroll`, which writes each such call out term by term, i replaced
     tuple(k[i] * f[i] for i in range(3))   ->   (k[0] * f[0], k[1] * f[1], k[2] * f[2])
     sum(k[i] * f[i] for i in range(3))     ->   0 + k[0] * f[0] + k[1] * f[1] + k[2] * f[2]
 
-The terms' int arithmetic is folded (``state[3 + i]`` becomes ``state[3]``, ``state[4]`` ...: the
-C knows constant indices only), and a tuple written out inside a tuple display is spliced into it:
+The terms' int arithmetic is folded (``state[3 + i]`` becomes ``state[3]``, ``state[4]`` ...,
+``stiffness[i // 3]`` ``stiffness[0]``, ``stiffness[0]``, ``stiffness[0]``, ``stiffness[1]`` ...: the C
+knows constant indices only), and a tuple written out inside a tuple display is spliced into it:
 ``(v, 0.0, *tuple(... for i in range(N)))`` is one flat tuple of N + 2 values.
 
 The sum starts from the int 0 and adds left to right, as Python's ``sum`` does, so the unrolled
@@ -149,16 +150,21 @@ class _Substitute(ast.NodeTransformer):
         return node
 
 
+_INT_OPERATIONS = {ast.Add: int.__add__, ast.Sub: int.__sub__, ast.Mult: int.__mul__, ast.FloorDiv: int.__floordiv__,
+                   ast.Mod: int.__mod__}
+
+
 class _FoldInts(ast.NodeTransformer):
-    """``a + b``, ``a - b`` and ``a * b`` of int literals as one literal (exact)."""
+    """``a + b``, ``a - b``, ``a * b``, ``a // b`` and ``a % b`` of int literals as one literal
+    (exact, Python's int arithmetic: ``state[6 + i // 3]`` of element i of 3-vectors, written out)."""
 
     def visit_BinOp(self, node: ast.BinOp):
         self.generic_visit(node)
-        if (isinstance(node.op, (ast.Add, ast.Sub, ast.Mult)) and isinstance(node.left, ast.Constant)
+        if (type(node.op) in _INT_OPERATIONS and isinstance(node.left, ast.Constant)
                 and isinstance(node.right, ast.Constant) and type(node.left.value) is int
-                and type(node.right.value) is int):
-            value = {ast.Add: int.__add__, ast.Sub: int.__sub__, ast.Mult: int.__mul__}[type(node.op)](
-                node.left.value, node.right.value)
+                and type(node.right.value) is int and not (isinstance(node.op, (ast.FloorDiv, ast.Mod))
+                                                           and node.right.value == 0)):
+            value = _INT_OPERATIONS[type(node.op)](node.left.value, node.right.value)
             return ast.copy_location(ast.Constant(value), node)
         return node
 

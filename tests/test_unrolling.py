@@ -99,6 +99,16 @@ def test_indices_are_folded_and_a_written_out_tuple_is_spliced_into_a_display():
     assert unrolled_function(source, {})((1.0, 2.0, 3.0, 4.0, 5.0), 7.0) == namespace["kernel"]((1.0, 2.0, 3.0, 4.0, 5.0), 7.0)
 
 
+def test_floor_division_and_remainder_of_indices_are_folded_as_python_computes_them():
+    # element i of 3-vectors of a spectrum: its mode i // 3 and its component i % 3
+    source = "def kernel(k, v):\n    return tuple(k[i // 3] * v[i % 3] for i in range(6))\n"
+    text = ast.unparse(unroll(ast.parse(source), {}, "test"))
+    assert "return (k[0] * v[0], k[0] * v[1], k[0] * v[2], k[1] * v[0], k[1] * v[1], k[1] * v[2])" in text
+    namespace = {}
+    exec(source, namespace)
+    assert unrolled_function(source, {})((2.0, 3.0), (1.0, 5.0, 7.0)) == namespace["kernel"]((2.0, 3.0), (1.0, 5.0, 7.0))
+
+
 ALLOWED_IMPORTS = textwrap.dedent('''
     from __future__ import annotations
 
