@@ -28,8 +28,9 @@ from __future__ import annotations
 import math
 
 from .bushing_params import SPRING, ParameterSpec
-from .integration import (NOT_FINITE, OK, friction_force, friction_jump_turn, friction_turn, maxwell_decay, maxwell_step,
-                          vector_dot, vector_friction_force, vector_friction_jump_turn, vector_friction_turn)
+from .integration import (NOT_FINITE, OK, friction_force, friction_jump_turn, friction_turn, maxwell_decay,
+                          maxwell_step, vector_dot, vector_friction_force, vector_friction_jump_turn,
+                          vector_friction_turn)
 from .model_definition import BushingModel, CoupledKernels, SearchBox, SearchCoordinate, StateSpec
 
 FRICTION_LIMIT = dict(minimum=0.0, why="a friction force limit is a magnitude", bound_powers=(0, 0))
@@ -144,7 +145,8 @@ def update_coupled(m, state, x, v):
     k0, k3, limit, half_travel, k1, rate1, k2, rate2 = m
     travel, reversal = vector_friction_turn(limit, half_travel, (state[0], state[1], state[2]),
                                             (state[3], state[4], state[5]), v)
-    return (*travel, *reversal, *tuple(state[6 + i] for i in range(6)))
+    return (travel[0], travel[1], travel[2], reversal[0], reversal[1], reversal[2],
+            *tuple(state[6 + i] for i in range(6)))
 
 
 def jump_coupled(m, state, jump):
@@ -153,7 +155,7 @@ def jump_coupled(m, state, jump):
     k0, k3, limit, half_travel, k1, rate1, k2, rate2 = m
     travel, reversal = vector_friction_jump_turn(limit, half_travel, (state[0], state[1], state[2]),
                                                  (state[3], state[4], state[5]), jump)
-    return (*tuple(travel[i] + jump[i] for i in range(3)), *reversal,
+    return (*tuple(travel[i] + jump[i] for i in range(3)), reversal[0], reversal[1], reversal[2],
             *tuple(state[6 + i] + k1 * jump[i] for i in range(3)),
             *tuple(state[9 + i] + k2 * jump[i] for i in range(3))), OK
 
@@ -165,7 +167,7 @@ def integrate_coupled(m, state, x, v, h, max_substeps):
     travel, reversal = vector_friction_turn(limit, half_travel, (state[0], state[1], state[2]),
                                             (state[3], state[4], state[5]), v)
     decay1, decay2 = maxwell_decay(rate1, h), maxwell_decay(rate2, h)
-    new = (*tuple(travel[i] + v[i] * h for i in range(3)), *reversal,
+    new = (*tuple(travel[i] + v[i] * h for i in range(3)), reversal[0], reversal[1], reversal[2],
            *tuple(maxwell_step(state[6 + i], k1, decay1, v[i], h) for i in range(3)),
            *tuple(maxwell_step(state[9 + i], k2, decay2, v[i], h) for i in range(3)))
     if not math.isfinite(sum(new[i] for i in range(12))):

@@ -173,7 +173,14 @@ def model_source(model, machinery: str, appendix: str = "") -> str:
             + f"\nif 'prepare_step' not in globals():\n    from {machinery} import unprepared_step as prepare_step\n"
             + "\n\n" + inspect.getsource(integration.step_prepared) + "\n\n" + inspect.getsource(integration.step)
             + "\n\nstep_prepared = numba.njit(error_model='numpy', cache=True)(step_prepared)"
-            + "\nstep = numba.njit(error_model='numpy', cache=True)(step)\n" + appendix)
+            + "\nstep = numba.njit(error_model='numpy', cache=True)(step)\n"
+            + (_COUPLED_STEP if model.coupled is not None else "") + appendix)
+
+
+_COUPLED_STEP = ("\n\n" + inspect.getsource(integration.step_coupled)
+                 + "\n\nstep_coupled = numba.njit(error_model='numpy', cache=True)(step_coupled)\n")
+"""The coupled step protocol, bound to the module's ``jump_coupled`` and ``integrate_coupled``
+(``model_definition.CoupledKernels`` checks that they are the model's)."""
 
 
 def compiled_module(model, appendix: str = "", prefix: str = "bushing") -> types.ModuleType:

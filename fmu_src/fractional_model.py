@@ -35,8 +35,9 @@ import math
 
 from .berg_model import COUPLED_STATES, CUBIC, FRICTION_LIMIT, HALF_TRAVEL
 from .bushing_params import SPRING, ParameterSpec
-from .integration import (NOT_FINITE, OK, friction_force, friction_jump_turn, friction_turn, maxwell_decay, maxwell_step,
-                          vector_dot, vector_friction_force, vector_friction_jump_turn, vector_friction_turn)
+from .integration import (NOT_FINITE, OK, friction_force, friction_jump_turn, friction_turn, maxwell_decay,
+                          maxwell_step, vector_dot, vector_friction_force, vector_friction_jump_turn,
+                          vector_friction_turn)
 from .model_definition import BushingModel, CoupledKernels, SearchBox, SearchCoordinate, StateSpec
 
 MODES = 19
@@ -171,7 +172,8 @@ def update_coupled(m, state, x, v):
     k0, k3, limit, half_travel, stiffness, rates, dashpot = m
     travel, reversal = vector_friction_turn(limit, half_travel, (state[0], state[1], state[2]),
                                             (state[3], state[4], state[5]), v)
-    return (*travel, *reversal, *tuple(state[6 + i] for i in range(3 * ELEMENTS)))
+    return (travel[0], travel[1], travel[2], reversal[0], reversal[1], reversal[2],
+            *tuple(state[i] for i in range(6, COUPLED_SIZE)))
 
 
 def jump_coupled(m, state, jump):
@@ -180,8 +182,8 @@ def jump_coupled(m, state, jump):
     k0, k3, limit, half_travel, stiffness, rates, dashpot = m
     travel, reversal = vector_friction_jump_turn(limit, half_travel, (state[0], state[1], state[2]),
                                                  (state[3], state[4], state[5]), jump)
-    return (*tuple(travel[c] + jump[c] for c in range(3)), *reversal,
-            *tuple(state[6 + i] + stiffness[i // 3] * jump[i % 3] for i in range(3 * ELEMENTS))), OK
+    return (*tuple(travel[c] + jump[c] for c in range(3)), reversal[0], reversal[1], reversal[2],
+            *tuple(state[i] + stiffness[(i - 6) // 3] * jump[(i - 6) % 3] for i in range(6, COUPLED_SIZE))), OK
 
 
 def integrate_coupled(ms, state, x, v, h, max_substeps):
@@ -192,9 +194,9 @@ def integrate_coupled(ms, state, x, v, h, max_substeps):
     k0, k3, limit, half_travel, stiffness, rates, dashpot = m
     travel, reversal = vector_friction_turn(limit, half_travel, (state[0], state[1], state[2]),
                                             (state[3], state[4], state[5]), v)
-    new = (*tuple(travel[c] + v[c] * h for c in range(3)), *reversal,
-           *tuple(maxwell_step(state[6 + i], stiffness[i // 3], decays[i // 3], v[i % 3], h)
-                  for i in range(3 * ELEMENTS)))
+    new = (*tuple(travel[c] + v[c] * h for c in range(3)), reversal[0], reversal[1], reversal[2],
+           *tuple(maxwell_step(state[i], stiffness[(i - 6) // 3], decays[(i - 6) // 3], v[(i - 6) % 3], h)
+                  for i in range(6, COUPLED_SIZE)))
     if not math.isfinite(sum(new[i] for i in range(COUPLED_SIZE))):
         return new, 1, NOT_FINITE
     return new, 1, OK
@@ -204,7 +206,8 @@ def derivatives_coupled(m, state, x, v):
     """(dd/dt, 0, df_j/dt ...), 3-vectors each (model exchange)."""
     k0, k3, limit, half_travel, stiffness, rates, dashpot = m
     return (v[0], v[1], v[2], 0.0, 0.0, 0.0,
-            *tuple(stiffness[i // 3] * v[i % 3] - rates[i // 3] * state[6 + i] for i in range(3 * ELEMENTS)))
+            *tuple(stiffness[(i - 6) // 3] * v[(i - 6) % 3] - rates[(i - 6) // 3] * state[i]
+                   for i in range(6, COUPLED_SIZE)))
 
 
 def switches_coupled(m, state, x, v):

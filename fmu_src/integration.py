@@ -374,7 +374,10 @@ def vector_walk(z, travel, A, beta, gamma, n, heun_limit, theta, max_pieces):
         count = rotation_pieces(s0, s0 + g0 * along, across, A, beta, gamma, n, sigma, max_pieces)
         if used + 1 > max_pieces or count > max_pieces:
             return z, TOO_MANY_SUBSTEPS
-        piece = remaining if count == 1 else vector_scale(1.0 / count, remaining)
+        if count == 1:
+            piece = remaining
+        else:
+            piece = vector_scale(1.0 / count, remaining)
         predicted, status = vector_walk_frame(z, piece, e, A, beta, gamma, n, heun_limit, theta, max_pieces)
         if status != OK:
             return z, status

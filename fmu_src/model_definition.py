@@ -169,9 +169,15 @@ class CoupledKernels:
     step protocol ``integration.step_coupled`` bound to these kernels."""
 
     def __post_init__(self):
-        namespace = dict(sys.modules[self.integrate.__module__].__dict__)
+        # as BushingModel's step: the protocol's code with the kernel module's globals, which the
+        # compiled module (compiled_kernels) binds by name
+        module = sys.modules[self.integrate.__module__]
+        for name, kernel in (("jump_coupled", self.jump), ("integrate_coupled", self.integrate)):
+            if vars(module).get(name) is not kernel:
+                raise ModelContractError(f"{module.__name__}: the coupled step protocol calls its global {name!r}, "
+                                         f"which is not the coupled {name.split('_')[0]} kernel {kernel!r}")
+        namespace = dict(module.__dict__)
         namespace.setdefault("prepare_step", integration.unprepared_step)
-        namespace["jump_coupled"], namespace["integrate_coupled"] = self.jump, self.integrate
         object.__setattr__(self, "step", types.FunctionType(integration.step_coupled.__code__, namespace,
                                                             "step_coupled"))
 

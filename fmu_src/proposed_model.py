@@ -292,4 +292,5 @@ MODEL = BushingModel(
          StateSpec("w", 2, "m", "displacement of the right plate (eq. 4)"),
          StateSpec("z2", 3, "N", "hysteretic force of the right block (eq. 2)")),
         initial_state_coupled, jump_coupled, integrate_coupled, force_coupled, derivatives_coupled, switches_coupled,
-        (StateSpec("z1u1", 0, "N.m/s", "z1.u1: block 1's branch"), StateSpec("z2u2", 1, "N.m/s", "z2.u2: block 2's branch"))))
+        (StateSpec("z1u1", 0, "N.m/s", "z1.u1: block 1's branch"),
+         StateSpec("z2u2", 1, "N.m/s", "z2.u2: block 2's branch"))))

@@ -148,7 +148,7 @@ def jump_coupled(m, state, jump):
                             blk[5], blk[6], HEUN_JUMP_LIMIT, THETA_JUMP, DEFAULT_MAX_SUBSTEPS)
     if status != OK:
         return state, status
-    return (*tuple(state[i] + c0 / C * jump[i] for i in range(3)), *z), OK
+    return (*tuple(state[i] + c0 / C * jump[i] for i in range(3)), z[0], z[1], z[2]), OK
 
 
 def integrate_coupled(m, state, x, v, h, max_substeps):
@@ -163,7 +163,7 @@ def integrate_coupled(m, state, x, v, h, max_substeps):
         u = _relative_velocity_coupled(m, y, z, tuple(x[i] + v[i] * elapsed for i in range(3)), v)
         count = vector_substeps_needed(u, z, remaining, (0.0, 0.0, 0.0), blk, max_substeps)
         if used + 1 > max_substeps or count > max_substeps:
-            return (*y, *z), used, TOO_MANY_SUBSTEPS
+            return (y[0], y[1], y[2], z[0], z[1], z[2]), used, TOO_MANY_SUBSTEPS
         sub = remaining if count == 1 else remaining / count
         u, z, xi = vector_block_step(u, z, sub, (0.0, 0.0, 0.0), blk)
         elapsed = h if count == 1 else elapsed + sub
@@ -172,8 +172,8 @@ def integrate_coupled(m, state, x, v, h, max_substeps):
         if count == 1:
             break
     if not math.isfinite(y[0] + y[1] + y[2] + z[0] + z[1] + z[2]):
-        return (*y, *z), used, NOT_FINITE
-    return (*y, *z), used, OK
+        return (y[0], y[1], y[2], z[0], z[1], z[2]), used, NOT_FINITE
+    return (y[0], y[1], y[2], z[0], z[1], z[2]), used, OK
 
 
 def derivatives_coupled(m, state, x, v):
@@ -181,7 +181,8 @@ def derivatives_coupled(m, state, x, v):
     c0, k0, c1, k1, x0, alpha, C, blk = m
     z = (state[3], state[4], state[5])
     u = _relative_velocity_coupled(m, (state[0], state[1], state[2]), z, x, v)
-    return (*tuple(v[i] - u[i] for i in range(3)), *vector_gain(z, u, blk[3], blk[4], blk[5], blk[6]))
+    dz = vector_gain(z, u, blk[3], blk[4], blk[5], blk[6])
+    return (v[0] - u[0], v[1] - u[1], v[2] - u[2], dz[0], dz[1], dz[2])
 
 
 def switches_coupled(m, state, x, v):
