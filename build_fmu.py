@@ -50,7 +50,7 @@ SLAVE_MODULE = "bushing_slave.py"
 sys.path.insert(0, str(REPO))
 import fmu_src  # noqa: E402
 from fmu_src import __version__, bushing_params  # noqa: E402
-from fmu_src.axes import ONE_AXIS, SIX_AXIS_IDENTIFIER  # noqa: E402
+from fmu_src.axes import ONE_AXIS, SIX_AXIS_IDENTIFIER, SIX_AXIS_NAMES, Coupling  # noqa: E402
 from fmu_src.bushing_models import MODEL_CHOICES, MODEL_NAMES, get_model  # noqa: E402
 from fmu_src.parameter_files import (parameter_document, read_parameter_set, read_six_axis,  # noqa: E402
                                      save_parameters, save_six_axis, six_axis_document)
@@ -66,6 +66,7 @@ from . import axes, bushing_models, compiled_kernels, integration, model_definit
 # pure-Python step); STEP says which step runs (logged by every instance).
 AXES, STEP_AXES, STEP = compiled_kernels.compile_axes(
     parameter_files.fmu_axes(Path(__file__).with_name("default_parameters.json")))
+GROUPS = parameter_files.fmu_groups(Path(__file__).with_name("default_parameters.json"))
 '''
 SIX_AXIS = "six_axis"
 SIX_AXIS_DEFAULT_FILE = "params_six_axis_illustrative.json"
@@ -119,7 +120,7 @@ def fmu_axes(params_file: str | Path | None = None, model: str = "proposed"):
     if six:
         six_axes = read_six_axis(params_file)
         document = six_axis_document({axis: (one.model.identifier, one.parameters)
-                                      for axis, one in six_axes.axes.items()}, source)
+                                      for axis, one in six_axes.axes.items()}, source, six_axes.coupling)
         return SIX_AXIS_IDENTIFIER, "six-axis bushing", six_axes.fmu_axes(), document
     bushing = get_model(name)
     parameters = read_parameter_set(params_file, name).parameters
@@ -158,7 +159,11 @@ def build_native_fmu(params_file: str | Path | None = None, out_dir: str | Path 
     """
     from fmpy.validation import validate_fmu
     from fmu_src.native.build import build_native
-    identifier, _, axes, _ = fmu_axes(params_file, model)
+    identifier, _, axes, document = fmu_axes(params_file, model)
+    if groups_of(document):
+        raise BuildError(f"the native FMU does not build coupled groups yet ({params_file} couples "
+                         f"{Coupling.of(document['coupling']).describe()}): build the pythonfmu FMU (without --native), "
+                         "or the native FMU from the set without its \"coupling\"")
     build = build_native(axes, identifier, out_dir, fmi_version, platforms)
     problems = validate_fmu(str(build.path))
     if problems:
@@ -228,7 +233,7 @@ def build_fmu(params_file: str | Path | None = None, out_dir: str | Path = "dist
             for loaded in [m for m in sys.modules if m.startswith(module_name)]:
                 del sys.modules[loaded]
 
-    _rewrite_model_description(fmu_path, axes)
+    _rewrite_model_description(fmu_path, axes, groups_of(defaults_json))
     from fmpy.validation import validate_fmu
     problems = validate_fmu(str(fmu_path))
     if problems:
@@ -236,23 +241,31 @@ def build_fmu(params_file: str | Path | None = None, out_dir: str | Path = "dist
     return fmu_path
 
 
-def _rewrite_model_description(fmu_path: Path, axes: list) -> None:
+def groups_of(document: dict) -> tuple[tuple[int, ...], ...]:
+    """The coupled groups of a defaults document (positions of the six axes; none for one axis)."""
+    return tuple(tuple(SIX_AXIS_NAMES.index(name) for name in group)
+                 for group in Coupling.of(document.get("coupling")).groups)
+
+
+def _rewrite_model_description(fmu_path: Path, axes: list, groups=()) -> None:
     """``axes``: [(axes.Axis, model on it, parameters)], what the packed library reads back from
-    the defaults it is given (parameter_files.fmu_axes)."""
+    the defaults it is given (parameter_files.fmu_axes); ``groups``: its coupled groups."""
     with zipfile.ZipFile(fmu_path) as archive:
         entries = {info.filename: archive.read(info.filename) for info in archive.infolist()}
     root = ET.fromstring(entries["modelDescription.xml"])
     root.set("generationTool", f"boucwen-bushing {__version__} (build_fmu.py) with {root.get('generationTool')}")
     units, starts = {}, {}
-    for axis, model, parameters in axes:
+    grouped = {position for group in groups for position in group}
+    for position, (axis, model, parameters) in enumerate(axes):
         units.update({axis.displacement: axis.displacement_unit, axis.velocity: axis.velocity_unit,
                       axis.output: axis.output_unit})
-        units.update({axis.prefix + name: unit for name, unit in model.units.items()})
-        units.update({axis.prefix + s.name: axis.state_port(s.unit)[0] for s in model.states})
+        units.update({axis.prefix + name: unit for name, unit in model.fmu_units.items()})
+        states = model.coupled.states if position in grouped and model.coupled is not None else model.states
+        units.update({axis.prefix + s.name: axis.state_port(s.unit)[0] for s in states})
         starts.update({axis.prefix + name: value for name, value in parameters.items()})
     _add_units(root, units)
     _set_parameter_starts(root, starts)
-    _add_model_structure(root, [axis for axis, _, _ in axes])
+    _add_model_structure(root, [axis for axis, _, _ in axes], groups)
     text = parseString(ET.tostring(root, encoding="UTF-8")).toprettyxml(indent="  ", encoding="UTF-8")
     entries["modelDescription.xml"] = b"\n".join(line for line in text.splitlines() if line.strip())
     with zipfile.ZipFile(fmu_path, "w", zipfile.ZIP_DEFLATED) as archive:
@@ -287,19 +300,20 @@ def _set_parameter_starts(root: ET.Element, parameters: dict[str, float]) -> Non
             variable.find("Real").set("start", repr(parameters[variable.get("name")]))
 
 
-def _add_model_structure(root: ET.Element, axes) -> None:
+def _add_model_structure(root: ET.Element, axes, groups=()) -> None:
     index = {v.get("name"): str(i + 1) for i, v in enumerate(root.iter("ScalarVariable"))}
     structure = root.find("ModelStructure")
     for child in list(structure):
         structure.remove(child)
     # F = k0*y + c0*(c2*v + k2*(x - w) + alpha2*z2)/(c0 + c2) (+ a constant for the
     # baselines): direct feedthrough of its own axis's x and v, and of nothing else (the axes
-    # are uncoupled).
+    # are uncoupled), or of every member's of its coupled group (the force vector turns with them).
     outputs = ET.SubElement(structure, "Outputs")
-    for axis in axes:
-        ET.SubElement(outputs, "Unknown", index=index[axis.output],
-                      dependencies=f"{index[axis.displacement]} {index[axis.velocity]}",
-                      dependenciesKind="dependent dependent")
+    for position, axis in enumerate(axes):
+        group = next((g for g in groups if position in g), (position,))
+        inputs = [index[name] for i in group for name in (axes[i].displacement, axes[i].velocity)]
+        ET.SubElement(outputs, "Unknown", index=index[axis.output], dependencies=" ".join(inputs),
+                      dependenciesKind=" ".join(["dependent"] * len(inputs)))
     initial = ET.SubElement(structure, "InitialUnknowns")
     for axis in axes:
         ET.SubElement(initial, "Unknown", index=index[axis.output])
@@ -432,11 +446,15 @@ def build_release(out_dir: str | Path = RELEASE_DIR, allow_missing_platforms: bo
 
 
 def _write_default_ssv(default: Path, model: str, path: Path) -> None:
+    """The release's start values of ``model``: every parameter its FMU has, the mounting's (0
+    where the default set has none) included, so that the set applied to the FMU is all of it."""
+    def complete(one):
+        return {spec.name: one.parameters.get(spec.name, 0.0) for spec in one.model.fmu_specs}
     if model in (SIX_AXIS, SIX_AXIS_IDENTIFIER):
         six = read_six_axis(default)
-        save_six_axis(path, {axis: (one.model.identifier, one.parameters) for axis, one in six.axes.items()})
+        save_six_axis(path, {axis: (one.model.identifier, complete(one)) for axis, one in six.axes.items()})
     else:
-        save_parameters(path, read_parameter_set(default, model).parameters, model)
+        save_parameters(path, complete(read_parameter_set(default, model)), model)
 
 
 def _release_readme(staged: dict, bundle: ReleaseBundle) -> str:

@@ -110,12 +110,84 @@ SIX_AXIS_NAMES = tuple(axis.name for axis in SIX_AXES)
 SIX_AXIS_IDENTIFIER = "SixAxisBushing"
 
 
+GROUPS = {"translation": {"none": (), "radial": ("x", "y"), "spherical": ("x", "y", "z")},
+          "rotation": {"none": (), "conical": ("rx", "ry")}}
+"""The coupled groups of the six-axis FMU, per kind of axis: radial = x and y (the bushing's axis
+along J's z, Adams' convention), spherical = x, y and z, conical = rx and ry (tilt about the
+bushing's axis' normals). The axes of a group carry one model and one parameter set, whose coupled
+form (``model_definition.CoupledKernels``) acts on their displacements as one vector."""
+
+
+@dataclass(frozen=True)
+class Coupling:
+    """Which axes of the six-axis FMU are coupled: ``translation`` one of none, radial, spherical;
+    ``rotation`` one of none, conical (:data:`GROUPS`)."""
+    translation: str = "none"
+    rotation: str = "none"
+
+    def __post_init__(self):
+        for kind in ("translation", "rotation"):
+            name = getattr(self, kind)
+            if name not in GROUPS[kind]:
+                raise ParameterError(f"unknown {kind} coupling {name!r}; allowed: {', '.join(GROUPS[kind])}")
+
+    @classmethod
+    def of(cls, value) -> "Coupling":
+        """From a parameter file's ``"coupling"``: absent (none), an object {"translation": ...,
+        "rotation": ...}, or one group's name ("radial" is short for {"translation": "radial"})."""
+        if value is None:
+            return cls()
+        if isinstance(value, Coupling):
+            return value
+        if isinstance(value, str):
+            for kind, names in GROUPS.items():
+                if value in names:
+                    return cls(**{kind: value})
+            raise ParameterError(f"unknown coupling {value!r}; allowed: "
+                                 + ", ".join(name for names in GROUPS.values() for name in names if name != "none")
+                                 + ", or an object {\"translation\": ..., \"rotation\": ...}")
+        if isinstance(value, dict):
+            unknown = sorted(set(value) - set(GROUPS))
+            if unknown:
+                raise ParameterError(f"unknown coupling keys {unknown}; allowed: translation, rotation")
+            return cls(**{kind: str(name) for kind, name in value.items()})
+        raise ParameterError(f"coupling {value!r}: give a group's name or an object {{\"translation\": ..., "
+                             "\"rotation\": ...}")
+
+    @property
+    def named_groups(self) -> tuple[tuple[str, tuple[str, ...]], ...]:
+        """(the group's name, its axes) of each coupled group."""
+        return tuple((name, GROUPS[kind][name]) for kind, name in (("translation", self.translation),
+                                                                    ("rotation", self.rotation)) if name != "none")
+
+    @property
+    def groups(self) -> tuple[tuple[str, ...], ...]:
+        """The coupled groups' axis names (none for uncoupled axes)."""
+        return tuple(axes for _, axes in self.named_groups)
+
+    def as_json(self) -> dict[str, str]:
+        return {"translation": self.translation, "rotation": self.rotation}
+
+    def describe(self) -> str:
+        """In words, for messages: 'radial (x, y)', 'none'."""
+        return " and ".join(f"{name} ({', '.join(axes)})" for name, axes in self.named_groups) or "none"
+
+
+def group_name(names: tuple[str, ...]) -> str:
+    """The name of the coupled group of these axes (radial, spherical, conical)."""
+    for kind in GROUPS.values():
+        for name, group in kind.items():
+            if group == tuple(names) and name != "none":
+                return name
+    raise ParameterError(f"the axes {', '.join(names)} are no coupled group")
+
+
 def model_on_axis(model: BushingModel, axis: Axis) -> BushingModel:
     """``model`` with the parameter units of ``axis`` (the same kernels and checks)."""
     if not axis.rotational:
         return model
     specs = tuple(replace(spec, unit=ROTATIONAL_UNITS[spec.unit]) for spec in model.specs)
-    return replace(model, specs=specs, title=f"{model.title}, rotational")
+    return replace(model, specs=specs, title=f"{model.title}, rotational", rotational=True)
 
 
 def six_axis(name: str) -> Axis:

@@ -38,7 +38,7 @@ from __future__ import annotations
 
 import sys
 import types
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Callable, Mapping
 
 from . import integration
@@ -52,6 +52,16 @@ millimetres entered where metres are expected), and :meth:`BushingModel.plausibl
 is the force there."""
 STIFFNESS_UNITS = ("N/mm", "N.mm/rad")
 DAMPING_UNITS = ("N.s/mm", "N.mm.s/rad")
+
+MOUNTING_SPECS = (
+    ParameterSpec("offset", "mm", "displacement where the model sits at its own zero: F = model(x - offset) + "
+                  "preload, as MSC Adams' BUSHING takes it"),
+    ParameterSpec("preload", "N", "force added to the model's: F = model(x - offset) + preload", bound_powers=(0, 0)),
+)
+"""How an axis mounts its model: every model on every axis takes them (0 and 0: the model as it
+is, bit for bit). A model with a parameter of the same name (Kelvin-Voigt's preload, the same
+constant force) keeps its own; on a rotational axis they are in rad and N.mm."""
+MOUNTING_NAMES = tuple(spec.name for spec in MOUNTING_SPECS)
 
 
 class ModelContractError(ValueError):
@@ -227,6 +237,8 @@ class BushingModel:
     coupled: CoupledKernels | None = None
     """The model on a displacement vector (a coupled group of axes); None: it has none (it acts
     on each axis alone: Kelvin-Voigt, whose linear elements couple nothing)."""
+    rotational: bool = False
+    """On a rotational axis (``axes.model_on_axis``): its units read rad for mm, N.mm for N."""
     step: Callable = field(init=False, repr=False, compare=False)
     """step(constants, state, state_x, x, v, h, max_substeps) -> (state, substeps, status): the
     step protocol of ``integration.step`` bound to this model's ``jump`` and ``integrate``."""
@@ -253,6 +265,31 @@ class BushingModel:
         return tuple(spec.name for spec in self.specs)
 
     @property
+    def mounting_specs(self) -> tuple[ParameterSpec, ...]:
+        """The mounting's parameters this model takes besides its own (``MOUNTING_SPECS`` but a name
+        the model has itself), in the units of its axis."""
+        units = {"mm": "rad", "N": "N.mm"} if self.rotational else {}
+        return tuple(replace(spec, unit=units.get(spec.unit, spec.unit)) for spec in MOUNTING_SPECS
+                     if spec.name not in self.parameter_names)
+
+    @property
+    def fmu_specs(self) -> tuple[ParameterSpec, ...]:
+        """Every parameter an FMU's axis of this model has: the model's, then its mounting's."""
+        return self.specs + self.mounting_specs
+
+    @property
+    def fmu_units(self) -> dict[str, str]:
+        """The unit of every parameter an FMU's axis of this model has (:attr:`fmu_specs`)."""
+        return {spec.name: spec.unit for spec in self.fmu_specs}
+
+    def mounting(self, params: Mapping[str, float]) -> tuple[float, float]:
+        """(offset [mm or rad], preload [N or N.mm]) of a parameter set: 0 where not given, and the
+        preload 0 where the model has its own (its force holds it)."""
+        names = {spec.name for spec in self.mounting_specs}
+        return (float(params.get("offset", 0.0)) if "offset" in names else 0.0,
+                float(params.get("preload", 0.0)) if "preload" in names else 0.0)
+
+    @property
     def units(self) -> dict[str, str]:
         return {spec.name: spec.unit for spec in self.specs}
 
@@ -265,7 +302,8 @@ class BushingModel:
         """(errors, warnings) for a parameter set of this model, never raising. Errors make it
         unusable (missing, non-numbers, NaN, what the equations cannot take); warnings are
         physically doubtful but simulable values."""
-        errors = number_errors(params, self.units, f" of the {self.name} model")
+        mounting = {spec.name: spec.unit for spec in self.mounting_specs if spec.name in params}
+        errors = number_errors(params, {**self.units, **mounting}, f" of the {self.name} model")
         if errors:
             return errors, []
         values = {name: float(params[name]) for name in self.parameter_names}
@@ -273,16 +311,17 @@ class BushingModel:
         return range_errors(values, self.specs) + errors, warnings
 
     def check(self, params: Mapping[str, float]) -> dict[str, float]:
-        """The parameters as floats in spec order, or ParameterError listing every problem
-        (unknown names included)."""
+        """The parameters as floats in spec order, then the mounting's where given (``offset``,
+        ``preload``), or ParameterError listing every problem (unknown names included)."""
         errors, _ = self.validate(params)
-        unknown = sorted(set(params) - set(self.parameter_names))
+        allowed = [spec.name for spec in self.fmu_specs]
+        unknown = sorted(set(params) - set(allowed))
         if unknown:
             errors.append(f"unknown parameter names {unknown} for the {self.name} model; "
-                          f"allowed: {', '.join(self.parameter_names)}")
+                          f"allowed: {', '.join(allowed)}")
         if errors:
             raise ParameterError(f"invalid {self.name} parameters: " + "; ".join(errors))
-        return {name: float(params[name]) for name in self.parameter_names}
+        return {name: float(params[name]) for name in allowed if name in params}
 
     def values(self, params: Mapping[str, float]) -> tuple[float, ...]:
         """The values in spec order, the ``p`` of :meth:`prepare` (no validation)."""
@@ -307,11 +346,11 @@ class BushingModel:
         wrong units (millimetres in the metre port). On a rotational axis (``axes``): rad, rad/s
         and N.mm."""
         total = 0.0
-        for spec in self.specs:
+        for spec in self.fmu_specs:
             powers = self.bound_powers(spec)
             if powers is not None:
                 weight = abs(params.get(self.gain_weight(spec.name), 1.0))
-                total += abs(params[spec.name]) * weight * travel ** powers[0] * velocity ** powers[1]
+                total += abs(params.get(spec.name, 0.0)) * weight * travel ** powers[0] * velocity ** powers[1]
         return total + abs(self.force_offset(params))
 
     @staticmethod

@@ -28,7 +28,7 @@ from pathlib import Path
 from typing import Mapping
 from xml.etree import ElementTree as ET
 
-from .axes import ONE_AXIS, SIX_AXES, SIX_AXIS_IDENTIFIER, SIX_AXIS_NAMES, model_on_axis
+from .axes import ONE_AXIS, SIX_AXES, SIX_AXIS_IDENTIFIER, SIX_AXIS_NAMES, Coupling, model_on_axis
 from .bushing_models import BushingModel, MODELS, get_model
 from .bushing_params import UNIT_DEFINITIONS, UNIT_SYSTEM, ParameterError
 
@@ -218,9 +218,10 @@ def _ssv_values(raw: Mapping[str, tuple[str | None, str | None]], model: Bushing
     ParameterError starts with ``where`` (the file, and the axis)."""
     values = {}
     for name, (text, unit) in raw.items():
-        if unit is not None and name in model.units and unit != model.units[name]:
+        units = model.fmu_units
+        if unit is not None and name in units and unit != units[name]:
             raise ParameterError(f"{where}: parameter {name} has unit {unit!r}; expected "
-                                 f"{model.units[name]!r}{units_note}")
+                                 f"{units[name]!r}{units_note}")
         try:
             values[name] = float(text)
         except (TypeError, ValueError):
@@ -234,8 +235,8 @@ def _model_of_ssv(set_name: str | None, names: set[str]) -> BushingModel | None:
     for model in MODELS.values():
         if set_name == model.identifier:
             return model
-    for model in MODELS.values():
-        if names == set(model.parameter_names):
+    for model in MODELS.values():     # its own parameters, and the mounting's where given
+        if set(model.parameter_names) <= names <= set(model.fmu_units):
             return model
     return None
 
@@ -284,7 +285,7 @@ def save_parameters(path: str | Path, params: Mapping[str, float], model: str = 
 
 
 def _write_ssv(path: Path, params: Mapping[str, float], model: BushingModel) -> None:
-    write_ssv_values(path, model.identifier, model.check(params), model.units)
+    write_ssv_values(path, model.identifier, model.check(params), model.fmu_units)
 
 
 def write_ssv_values(path: Path, set_name: str, values: Mapping[str, float], units: Mapping[str, str]) -> None:
@@ -315,9 +316,15 @@ def write_ssv_values(path: Path, set_name: str, values: Mapping[str, float], uni
 @dataclass
 class SixAxisSet:
     """The six axes of a ``SixAxisBushing``: each axis's model (with the axis's units, see
-    ``axes.model_on_axis``) and parameters, in the order x, y, z, rx, ry, rz."""
+    ``axes.model_on_axis``) and parameters, in the order x, y, z, rx, ry, rz, and which of them
+    are coupled (``axes.Coupling``; checked by :func:`check_groups`)."""
     axes: dict[str, ParameterSet]
     provenance: dict = field(default_factory=dict)
+    coupling: Coupling = field(default_factory=Coupling)
+
+    def fmu_groups(self) -> tuple[tuple[int, ...], ...]:
+        """The coupled groups as positions in :meth:`fmu_axes` (x = 0 ... rz = 5)."""
+        return tuple(tuple(SIX_AXIS_NAMES.index(name) for name in group) for group in self.coupling.groups)
 
     def flat(self) -> dict[str, float]:
         """The FMU's parameter names and values: {"x.k0": ..., "rz.c": ...}."""
@@ -346,6 +353,10 @@ def read_six_axis(path: str | Path) -> SixAxisSet:
                              "(rotational axes in N.mm, rad, s)")
     found = document["axes"]
     _check_axis_names(path, set(found))
+    try:
+        coupling = Coupling.of(document.get("coupling"))
+    except ParameterError as exc:
+        raise ParameterError(f"{path}: {exc}") from None
     axes = {}
     for axis in SIX_AXES:
         entry = found[axis.name]
@@ -357,7 +368,37 @@ def read_six_axis(path: str | Path) -> SixAxisSet:
             axes[axis.name] = ParameterSet(model, model.check(entry["parameters"]))
         except ParameterError as exc:
             raise ParameterError(f"{path}, axis {axis.name}: {exc}") from None
-    return SixAxisSet(axes, dict(document.get("fit", {})))
+    check_groups(coupling, axes, f"{path}: ")
+    return SixAxisSet(axes, dict(document.get("fit", {})), coupling)
+
+
+def check_groups(coupling: Coupling, axes: Mapping[str, ParameterSet], where: str = "") -> None:
+    """Refuse a coupled group whose axes carry different models or parameters (their mounting may
+    differ: an offset and a preload per axis), or a parameter that a coupled model requires to be 0
+    (``CoupledKernels.zero_parameters``); ParameterError names the group, the axes, the values and
+    what is allowed."""
+    for kind, group in coupling.named_groups:
+        sets = {name: axes[name] for name in group}
+        label = f"{where}the {kind} group ({', '.join(group)})"
+        models = {name: one.model.name for name, one in sets.items()}
+        if len(set(models.values())) > 1:
+            listed = ", ".join(f"{axis}: {model}" for axis, model in models.items())
+            raise ParameterError(f"{label} carries different models ({listed}); the axes of a group carry one model "
+                                 "and one parameter set")
+        model = sets[group[0]].model
+        differing = [name for name in model.parameter_names
+                     if len({one.parameters[name] for one in sets.values()}) > 1]
+        if differing:
+            values = ["; ".join(", ".join(f"{axis}.{name} = {sets[axis].parameters[name]!r}" for axis in group)
+                                + f" [{model.units[name]}]" for name in differing)]
+            raise ParameterError(f"{label}: {values[0]} differ; the axes of a group carry one parameter set (their "
+                                 "offset and preload may differ)")
+        for name in (model.coupled.zero_parameters if model.coupled is not None else ()):
+            value = sets[group[0]].parameters[name]
+            if value != 0.0:
+                raise ParameterError(f"{label}: {name} = {value!r} [{model.units[name]}] must be 0 in a coupled "
+                                     "group (it has no direction in the plane); give the axes an offset and a "
+                                     "preload instead")
 
 
 def _check_axis_names(path: Path, names: set[str]) -> None:
@@ -403,28 +444,41 @@ def _read_six_axis_ssv(path: Path) -> SixAxisSet:
     return SixAxisSet(axes, {})
 
 
-def six_axis_document(axes: Mapping[str, tuple[str, Mapping[str, float]]], provenance: Mapping | None = None) -> dict:
+def six_axis_document(axes: Mapping[str, tuple[str, Mapping[str, float]]], provenance: Mapping | None = None,
+                      coupling=None) -> dict:
     """The JSON document of six axes, ``axes`` = {axis: (model name or identifier, parameters)}
-    (validated, each in its axis's units)."""
+    (validated, each in its axis's units), with ``coupling`` (``axes.Coupling`` or what
+    ``Coupling.of`` takes; written where any group is coupled, checked by :func:`check_groups`)."""
     path = Path("<six-axis set>")
     _check_axis_names(path, set(axes))
+    coupling = Coupling.of(coupling)
     document = {"model": SIX_AXIS_IDENTIFIER, "units": UNIT_SYSTEM, "axes": {}, "fit": dict(provenance or {})}
+    if coupling.groups:
+        document["coupling"] = coupling.as_json()
+    sets = {}
     for axis in SIX_AXES:
         name, params = axes[axis.name]
         try:
             model = model_on_axis(get_model(name), axis)
-            document["axes"][axis.name] = {"model": model.identifier, "parameters": model.check(params)}
+            sets[axis.name] = ParameterSet(model, model.check(params))
+            document["axes"][axis.name] = {"model": model.identifier, "parameters": sets[axis.name].parameters}
         except ParameterError as exc:
             raise ParameterError(f"axis {axis.name}: {exc}") from None
+    check_groups(coupling, sets)
     return document
 
 
 def save_six_axis(path: str | Path, axes: Mapping[str, tuple[str, Mapping[str, float]]],
-                  provenance: Mapping | None = None) -> Path:
+                  provenance: Mapping | None = None, coupling=None) -> Path:
     """Write six axes (see :func:`six_axis_document`): ``.ssv`` as SSP 1.0 ParameterValues with
-    the FMU's names (``x.k0``), else JSON."""
+    the FMU's names (``x.k0``), else JSON. SSP holds values only: a coupled set is refused as
+    ``.ssv`` (its coupling is the JSON file's, which ``build_fmu.py --params`` builds the FMU with;
+    the values of an ``.ssv`` apply to such an FMU as start values)."""
     path = Path(path)
-    document = six_axis_document(axes, provenance)
+    document = six_axis_document(axes, provenance, coupling)
+    if path.suffix.lower() == ".ssv" and "coupling" in document:
+        raise ParameterError(f"{path}: SSP parameter values cannot hold the coupling "
+                             f"({Coupling.of(coupling).describe()}); write the coupled set as .json")
     if path.suffix.lower() == ".ssv":
         values, units = {}, {}
         for axis in SIX_AXES:
@@ -432,7 +486,7 @@ def save_six_axis(path: str | Path, axes: Mapping[str, tuple[str, Mapping[str, f
             model = model_on_axis(get_model(entry["model"]), axis)
             for name, value in entry["parameters"].items():
                 values[f"{axis.name}.{name}"] = value
-                units[f"{axis.name}.{name}"] = model.units[name]
+                units[f"{axis.name}.{name}"] = model.fmu_units[name]
         write_ssv_values(path, SIX_AXIS_IDENTIFIER, values, units)
     else:
         path.write_text(json.dumps(document, indent=2) + "\n", encoding="utf-8")
@@ -447,3 +501,11 @@ def fmu_axes(path: str | Path) -> list:
         return read_six_axis(path).fmu_axes()
     one = read_parameter_set(path)
     return [(ONE_AXIS, one.model, one.parameters)]
+
+
+def fmu_groups(path: str | Path) -> tuple[tuple[int, ...], ...]:
+    """The coupled groups of the FMU with the JSON parameter file ``path``, as positions in
+    :func:`fmu_axes` (none for a one-axis file)."""
+    if _json_document(Path(path)).get("model") == SIX_AXIS_IDENTIFIER:
+        return read_six_axis(path).fmu_groups()
+    return ()

@@ -2,8 +2,9 @@
 native FMU's generator writes them, in the same order, so both FMUs have the same names, value
 references, causalities, units and descriptions.
 
-Per axis (``axes``), in this order: the model's parameters (spec order), the displacement and
-velocity inputs, the output, then the model's states as the model names them (``StateSpec``).
+Per axis (``axes``), in this order: the model's parameters (spec order) and its mounting's
+(``BushingModel.mounting_specs``: offset, preload), the displacement and velocity inputs, the
+output, then the model's states as the model names them (``StateSpec``).
 A value reference is the variable's position in the list (pythonfmu numbers them so). The
 native FMU adds, after all of them, the derivative of each state for model exchange
 (:func:`derivative_variables`).
@@ -23,25 +24,30 @@ class FmuVariable:
     description: str
     axis: int               # position of the axis in the FMU's axes
     kind: str               # parameter, displacement, velocity, output, state, derivative, indicator
-    index: int              # the parameter's position in spec order; the state's in the kernels' tuple
+    index: int              # the parameter's position in BushingModel.fmu_specs; the state's in the kernels' tuple
     scale: float = 1.0      # port value = scale * kernel value (states and their derivatives)
     start: float | None = None
     state: int = -1         # derivatives: the value reference of their state
 
 
-def fmu_variables(axis_models) -> list[FmuVariable]:
+def fmu_variables(axis_models, groups=()) -> list[FmuVariable]:
     """The variables of an FMU whose axes are ``axis_models`` [(axes.Axis, model on that axis,
-    parameters)], parameters starting at those values, the inputs at 0."""
+    parameters)], parameters starting at those values, the inputs at 0. ``groups``: the coupled
+    groups (tuples of positions in ``axis_models``): a member's states are its component of the
+    group's coupled state (``CoupledKernels.states``, component c of vector i at 3*i + c), named as
+    the axis's own would be."""
     out: list[FmuVariable] = []
+    component = {position: c for group in groups for c, position in enumerate(group)
+                 if axis_models[group[0]][1].coupled is not None}
 
     def add(**fields):
         out.append(FmuVariable(value_reference=len(out), **fields))
 
     for position, (axis, model, parameters) in enumerate(axis_models):
-        for index, spec in enumerate(model.specs):
+        for index, spec in enumerate(model.fmu_specs):    # the model's, then its mounting's (default 0)
             add(name=axis.prefix + spec.name, causality="parameter", variability="tunable", unit=spec.unit,
                 description=f"{axis.label}{spec.description} [{spec.unit}]", axis=position, kind="parameter",
-                index=index, start=float(parameters[spec.name]))
+                index=index, start=float(parameters.get(spec.name, 0.0)))
         what = "rotation" if axis.rotational else "displacement"
         add(name=axis.displacement, causality="input", variability="continuous", unit=axis.displacement_unit,
             description=(f"relative {what} of I with respect to J about/along {axis.name[-1]} "
@@ -56,11 +62,13 @@ def fmu_variables(axis_models) -> list[FmuVariable]:
                          f"for a positive {axis.displacement} [{axis.output_unit}]" if axis.name else
                          "bushing force, positive for positive x (force on the base) [N]"),
             axis=position, kind="output", index=0)
-        for state in model.states:
+        coupled = position in component
+        part = " (this axis's component of the coupled group's)" if coupled else ""
+        for state in (model.coupled.states if coupled else model.states):
             unit, scale = axis.state_port(state.unit)
             add(name=axis.prefix + state.name, causality="local", variability="continuous", unit=unit,
-                description=f"{axis.label}internal state: {state.meaning} [{unit}]", axis=position, kind="state",
-                index=state.index, scale=scale)
+                description=f"{axis.label}internal state: {state.meaning}{part} [{unit}]", axis=position,
+                kind="state", index=3 * state.index + component[position] if coupled else state.index, scale=scale)
     return out
 
 

@@ -146,6 +146,10 @@ def main(argv: list[str] | None = None) -> int:
                                  help="an axis (x, y, z, rx, ry, rz) and its one-axis parameter or fit file; "
                                       "repeat for each axis. Rotational axes (rx, ry, rz) read in N.mm, rad, s")
     assemble_parser.add_argument("--out", type=Path, required=True, help="six-axis file to write (.json or .ssv)")
+    assemble_parser.add_argument("--coupling", metavar="GROUPS", default=None,
+                                 help="coupled groups: radial (x, y), spherical (x, y, z), conical (rx, ry), or "
+                                      "two of them with a comma (radial,conical); the axes of a group need one "
+                                      "model and one parameter set (a .json file)")
     missing = assemble_parser.add_mutually_exclusive_group()
     missing.add_argument("--rigid-missing", action="store_true",
                          help="an axis without a file becomes a stiff Kelvin-Voigt spring")

@@ -280,9 +280,28 @@ def assemble_command(args) -> int:
         if name in files:
             raise UsageError(f"--axis {name} is given twice")
         files[name] = Path(file)
-    path = assemble(files, args.out, rigid_missing=args.rigid_missing, default=args.default)
+    path = assemble(files, args.out, rigid_missing=args.rigid_missing, default=args.default,
+                    coupling=coupling_of(args.coupling))
     print(f"wrote {path}")
     return 0
+
+
+def coupling_of(text: str | None):
+    """``axes.Coupling`` of --coupling: a group's name, or two (a translation's and a rotation's)
+    separated by a comma; UsageError naming what is allowed."""
+    from fmu_src.axes import GROUPS, Coupling
+    if text is None:
+        return Coupling()
+    chosen = {}
+    for name in (part.strip() for part in text.split(",") if part.strip()):
+        kind = next((kind for kind, names in GROUPS.items() if name in names and name != "none"), None)
+        if kind is None or kind in chosen:
+            allowed = ", ".join(name for names in GROUPS.values() for name in names if name != "none")
+            raise UsageError(f"--coupling {text}: " + (f"{name!r} is not a group" if kind is None else
+                                                        f"two {kind} groups") + f"; allowed: {allowed}, or a "
+                             "translation group and conical separated by a comma (radial,conical)")
+        chosen[kind] = name
+    return Coupling(**chosen)
 
 
 def fit_many_command(args) -> int:

@@ -47,7 +47,8 @@ def simulate(parameters, time_s, displacement_mm, velocity_mm_s=None, model: str
     -------
     numpy.ndarray
         Force [N] at every sample; the bushing starts in relaxed equilibrium at the first
-        displacement.
+        displacement. A set with a mounting (``offset`` [mm], ``preload`` [N]) gives
+        model(x - offset) + preload, as the FMU does.
 
     Raises
     ------
@@ -57,8 +58,10 @@ def simulate(parameters, time_s, displacement_mm, velocity_mm_s=None, model: str
         Arrays of different lengths, or times that do not increase.
     """
     values, bushing = _parameters_and_model(parameters, model)
-    driven = prepare_input(time_s, displacement_mm, velocity_mm_s, steps=steps_per_sample)
-    return simulate_driven(parameter_matrix([values], bushing), driven, model=bushing)[0]
+    offset, preload = bushing.mounting(values)      # F = model(x - offset) + preload; 0 and 0: as it is
+    driven = prepare_input(time_s, np.asarray(displacement_mm, dtype=float) - offset, velocity_mm_s,
+                           steps=steps_per_sample)
+    return simulate_driven(parameter_matrix([values], bushing), driven, model=bushing)[0] + preload
 
 
 def simulate_driven(matrix: np.ndarray, driven: DrivenInput, max_substeps: int | None = None,

@@ -20,10 +20,14 @@ no damping. Stiff for an explicit co-simulation step: a master may need a shorte
 
 
 def assemble(axis_files: Mapping[str, str | Path], out: str | Path, rigid_missing: bool = False,
-             default: str | Path | None = None) -> Path:
+             default: str | Path | None = None, coupling=None) -> Path:
     """Write the six-axis file ``out`` (JSON or .ssv) from ``axis_files`` {axis: one-axis parameter
     or fit file}. An axis without a file takes its set from the six-axis file ``default``, or,
-    with ``rigid_missing``, a rigid Kelvin-Voigt spring (RIGID_STIFFNESS); otherwise it is an error."""
+    with ``rigid_missing``, a rigid Kelvin-Voigt spring (RIGID_STIFFNESS); otherwise it is an error.
+    ``coupling`` (``axes.Coupling`` or what ``Coupling.of`` takes; default: the ``default`` file's,
+    else none) couples groups of axes: the isotropic coupled model has the one-axis parameters, so
+    one fit along one axis gives a group's set (``--axis x=P --axis y=P``); a group whose axes differ
+    is refused (``parameter_files.check_groups``), and a coupled set must be JSON."""
     for name in axis_files:
         six_axis(name)   # an unknown axis name is an error naming the six
     if rigid_missing and default is not None:
@@ -51,4 +55,6 @@ def assemble(axis_files: Mapping[str, str | Path], out: str | Path, rigid_missin
             raise ParameterError(f"no parameter file for the axes {', '.join(missing)}: give --axis NAME=FILE for "
                                  "each, or --rigid-missing (a stiff spring), or --default SIX.json (those axes "
                                  "from another six-axis file)")
-    return save_six_axis(out, axes, {"assembled_from": sources})
+    if coupling is None and fallback is not None:
+        coupling = fallback.coupling
+    return save_six_axis(out, axes, {"assembled_from": sources}, coupling)

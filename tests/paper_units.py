@@ -26,3 +26,12 @@ PARAMETER_UNITS = {
              "c2": "N.s/mm"},
     "fractional": {"k0": "N/mm", "k3": "N/mm^3", "Ff_max": "N", "x2": "mm", "b": "N.s^alpha/mm", "alpha": "1"},
 }
+
+MOUNTING_UNITS = {"offset": "mm", "preload": "N"}
+"""Every FMU axis's mounting, F = model(x - offset) + preload: a length and a force (Kelvin-Voigt's
+preload is its own parameter, the same force)."""
+
+
+def fmu_parameter_units(model: str) -> dict[str, str]:
+    """The parameters an FMU of ``model`` declares: the model's, then its mounting's."""
+    return {**PARAMETER_UNITS[model], **MOUNTING_UNITS}

@@ -12,7 +12,7 @@ from fmu_src.bushing_models import MODELS
 from fmu_src.parameter_files import load_parameters
 from identification.compiled_core import simulate_model_held
 from identification.protocols import Sine, sample_times
-from paper_units import PARAMETER_UNITS
+from paper_units import PARAMETER_UNITS, fmu_parameter_units
 from test_fmu_numerics import simulate_with_fmpy
 
 BASELINES = tuple(name for name in MODELS if name != "proposed")
@@ -46,9 +46,9 @@ def test_baseline_fmu_validates_and_declares_its_own_identifier_and_units(baseli
     assert {"x", "v", "F"} <= set(variables)
     assert (variables["x"].unit, variables["v"].unit, variables["F"].unit) == ("m", "m/s", "N")
     defaults = load_parameters(build_fmu.default_parameter_file(model), model)
-    assert {v.name for v in description.modelVariables if v.causality == "parameter"} == set(PARAMETER_UNITS[model])
-    for name, unit in PARAMETER_UNITS[model].items():
-        assert variables[name].unit == unit and float(variables[name].start) == defaults[name], name
+    assert {v.name for v in description.modelVariables if v.causality == "parameter"} == set(fmu_parameter_units(model))
+    for name, unit in fmu_parameter_units(model).items():
+        assert variables[name].unit == unit and float(variables[name].start) == defaults.get(name, 0.0), name
 
 
 @pytest.mark.parametrize("model", BASELINES)

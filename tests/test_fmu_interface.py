@@ -5,7 +5,7 @@ from fmpy import read_model_description
 from fmpy.validation import validate_fmu
 
 from conftest import paper_parameters
-from paper_units import PARAMETER_UNITS
+from paper_units import PARAMETER_UNITS, fmu_parameter_units
 
 PROPOSED_UNITS = PARAMETER_UNITS["proposed"]
 
@@ -24,8 +24,9 @@ def test_ports_are_si_and_parameters_in_paper_units(fmu_path):
         assert variables[name].unit == "N"
     for name in ("y", "w"):
         assert variables[name].unit == "m"
-    assert {v.name for v in description.modelVariables if v.causality == "parameter"} == set(PROPOSED_UNITS)
-    for name, unit in PROPOSED_UNITS.items():
+    parameters = {v.name for v in description.modelVariables if v.causality == "parameter"}
+    assert parameters == set(fmu_parameter_units("proposed"))
+    for name, unit in fmu_parameter_units("proposed").items():
         assert variables[name].variability == "tunable"
         assert variables[name].unit == unit, name
     defined = {unit.name: unit for unit in description.unitDefinitions}

@@ -180,9 +180,9 @@ class ModelCode:
     def tables(self, suffix: str, model: BushingModel) -> str:
         """The parameter rules of ``model`` (this model on one kind of axis: its units) and its
         ``bw_model``, named ``bw_model_<name><suffix>``."""
-        index = {spec.name: i for i, spec in enumerate(model.specs)}
+        index = {spec.name: i for i, spec in enumerate(model.fmu_specs)}
         specs = []
-        for spec in model.specs:
+        for spec in model.fmu_specs:      # the model's, then its mounting's
             weight = index.get(model.gain_weight(spec.name), -1)
             powers = model.bound_powers(spec)
             specs.append(f"    {{{c_string(spec.name)}, {c_string(spec.unit)}, {int(spec.minimum is not None)}, "
@@ -205,7 +205,9 @@ class ModelCode:
         kernels = ", ".join(f"bw_{self.name}_{kernel}" for kernel in
                             ("prepare", "initial_state", "step", "jump", "force", "derivatives", "switches",
                              "update", "force_tangent", "derivatives_tangent", "jump_tangent"))
+        mounting = {spec.name: index[spec.name] for spec in model.mounting_specs}
         out += (f"static const bw_model bw_model_{name} = {{{c_string(self.name)}, {len(model.specs)}, "
+                f"{len(model.fmu_specs)}, {mounting.get('offset', -1)}, {mounting.get('preload', -1)}, "
                 f"{len(self.state_type)}, {self.switches}, bw_specs_{name}, {len(constraints)}, "
                 f"{'bw_constraints_' + name if constraints else 'NULL'}, {kernels}}};\n")
         return out
@@ -260,7 +262,7 @@ def model_source(axis_models, identifier: str) -> GeneratedModel:
             parts.append(models[model.name].tables(suffix, model))
     axis_lines = []
     for position, (axis, model, parameters) in enumerate(axis_models):
-        values = ", ".join(c_double(parameters[spec.name]) for spec in model.specs)
+        values = ", ".join(c_double(parameters.get(spec.name, 0.0)) for spec in model.fmu_specs)
         parts.append(f"static const double bw_defaults_{position}[] = {{{values}}};")
         suffix = "_rotational" if axis.rotational else ""
         plausible = (1.0, 50.0) if axis.rotational else (100.0, 1000.0)
@@ -288,7 +290,7 @@ def model_source(axis_models, identifier: str) -> GeneratedModel:
         f"#define BW_INSTANTIATION_TOKEN {c_string(token)}\n"
         f"#define BW_AXES {len(axis_models)}\n"
         f"#define BW_VARIABLES {len(variables)}\n"
-        f"#define BW_MAX_PARAMETERS {max(len(m.specs) for _, m, _ in axis_models)}\n"
+        f"#define BW_MAX_PARAMETERS {max(len(m.fmu_specs) for _, m, _ in axis_models)}\n"
         f"#define BW_MAX_STATES {max([1] + [len(code.state_type) for code in models.values()])}\n"
         f"#define BW_MAX_SWITCHES {max([1] + [code.switches for code in models.values()])}\n"
         f"#define BW_CONTINUOUS_STATES {states}\n"

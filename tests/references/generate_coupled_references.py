@@ -238,13 +238,18 @@ def parameters(model: str) -> dict:
 
 def solve(model: str, path: str, tighter: float = 1.0) -> np.ndarray:
     """(samples, 5): time, dx, dy, Fx, Fy along the straight pieces between the samples."""
-    bushing = FACTORIES[model](parameters(model))
     t = samples()
-    xy = PATHS[path](t)
+    return solve_path(FACTORIES[model](parameters(model)), t, PATHS[path](t), SAMPLE_S, tighter)
+
+
+def solve_path(bushing, t: np.ndarray, xy: np.ndarray, step_s: float, tighter: float = 1.0) -> np.ndarray:
+    """(samples, 5): time, dx, dy, Fx, Fy of ``bushing`` (one of the classes above, with its
+    parameters) along the straight pieces between the samples ``xy`` [mm] at the times ``t`` [s],
+    ``step_s`` [s] apart."""
     state = bushing.initial()
     out = [(t[0], *xy[0], 0.0, 0.0)]
     for k in range(len(t) - 1):
-        x0, v = xy[k], (xy[k + 1] - xy[k]) / SAMPLE_S
+        x0, v = xy[k], (xy[k + 1] - xy[k]) / step_s
         if hasattr(bushing, "start_piece"):
             bushing.start_piece(x0, v)
         solution = solve_ivp(lambda s, y: bushing.rates(y, x0 + v * (s - t[k]), v), (t[k], t[k + 1]), state,

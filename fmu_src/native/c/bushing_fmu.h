@@ -71,7 +71,10 @@ typedef struct {
  * Python kernels; the constants are the model's own struct, behind void pointers). */
 typedef struct {
     const char *name;
-    int parameters;
+    int parameters;     /* the model's own (what prepare takes) */
+    int fmu_parameters; /* and its mounting's after them (model_definition.MOUNTING_SPECS): specs has this many */
+    int offset;         /* the mounting's offset and preload among them, or -1 (a model with its own preload) */
+    int preload;
     int states;
     int switches;
     const bw_parameter_spec *specs;

@@ -23,9 +23,9 @@
 typedef void (*bw_log_function)(void *fmi_instance, bw_status status, const char *category, const char *message);
 
 typedef struct {
-    double parameters[BW_MAX_PARAMETERS];
+    double parameters[BW_MAX_PARAMETERS];   /* the model's, then its mounting's (offset, preload) */
     double x, v;                     /* the ports as set (m or rad, per s) */
-    double x_now;                    /* kernel displacement: x as set, else x_k + v_k*h */
+    double x_now;                    /* the model's displacement: x as set less the offset, else x_k + v_k*h */
     double state[BW_MAX_STATES];     /* committed, kernel units */
     double state_x;                  /* kernel displacement the committed state belongs to */
     double last_output;              /* last finite output, port units */
@@ -115,6 +115,15 @@ static void bw_error(bw_instance *inst, const char *format, const char *text) {
 
 /* ------------------------------------------------------------------------------- parameters */
 
+/* The mounting (model_definition.MOUNTING_SPECS): F = model(x - offset) + preload, kernel units. */
+static double bw_offset(const bw_axis *axis, const bw_model *model) {
+    return model->offset >= 0 ? axis->parameters[model->offset] : 0.0;
+}
+
+static double bw_preload(const bw_axis *axis, const bw_model *model) {
+    return model->preload >= 0 ? axis->parameters[model->preload] : 0.0;
+}
+
 /* Validate and prepare one axis's parameters (as BushingModel.validate), logging every
    problem; 1 if usable. Warnings are logged once per change, as the Python FMU does. */
 static int bw_check_axis(bw_instance *inst, int a) {
@@ -123,7 +132,7 @@ static int bw_check_axis(bw_instance *inst, int a) {
     const bw_model *model = spec->model;
     char value[40];
     int i, t, errors = 0;
-    for (i = 0; i < model->parameters; i++) {
+    for (i = 0; i < model->fmu_parameters; i++) {
         const bw_parameter_spec *p = &model->specs[i];
         double x = axis->parameters[i];
         if (!isfinite(x)) {
@@ -134,7 +143,7 @@ static int bw_check_axis(bw_instance *inst, int a) {
         }
     }
     if (!errors) {
-        for (i = 0; i < model->parameters; i++) {
+        for (i = 0; i < model->fmu_parameters; i++) {
             const bw_parameter_spec *p = &model->specs[i];
             double x = axis->parameters[i];
             int above = !p->has_minimum || (p->exclusive ? x > p->minimum : x >= p->minimum);
@@ -177,7 +186,7 @@ static int bw_check_axis(bw_instance *inst, int a) {
     model->prepare(axis->parameters, &axis->constants);
     {   /* the plausible bound (BushingModel.plausible_force_bound), in port units */
         double total = 0.0, offset, rest[BW_MAX_STATES];
-        for (i = 0; i < model->parameters; i++) {
+        for (i = 0; i < model->fmu_parameters; i++) {
             const bw_parameter_spec *p = &model->specs[i];
             double weight = p->weight >= 0 ? fabs(axis->parameters[p->weight]) : 1.0;
             if (p->in_bound) {
@@ -248,7 +257,10 @@ static void bw_reset(bw_instance *inst) {
     memset(&inst->data, 0, sizeof inst->data);
     for (a = 0; a < BW_AXES; a++) {
         bw_axis *axis = &inst->data.axes[a];
-        for (i = 0; i < bw_axis_specs[a].model->parameters; i++) axis->parameters[i] = bw_axis_specs[a].defaults[i];
+        for (i = 0; i < bw_axis_specs[a].model->fmu_parameters; i++) {
+            axis->parameters[i] = bw_axis_specs[a].defaults[i];
+        }
+        axis->x_now = -bw_offset(axis, bw_axis_specs[a].model);
         axis->parameters_changed = 1;
         axis->output_bound = HUGE_VAL;
     }
@@ -303,6 +315,8 @@ static bw_status bw_set_parameter(bw_instance *inst, const bw_variable *var, dou
     axis->parameters[var->index] = value;
     axis->parameters_changed = 1;
     axis->output_is_current = 0;
+    /* the model's displacement moves with the offset (a jump if it changes during the run) */
+    if (var->index == spec->model->offset) axis->x_now = axis->x * spec->to_kernel - value;
     if (!isfinite(value)) {
         char text[40];
         bw_format_double(text, sizeof text, value);
@@ -318,7 +332,7 @@ static bw_status bw_set_displacement(bw_instance *inst, int a, double value) {
     const bw_axis_spec *spec = &bw_axis_specs[a];
     char text[40];
     axis->x = value;
-    axis->x_now = value * spec->to_kernel;
+    axis->x_now = value * spec->to_kernel - bw_offset(axis, spec->model);
     axis->output_is_current = 0;
     if (!isfinite(value)) {
         bw_format_double(text, sizeof text, value);
@@ -370,7 +384,7 @@ static double bw_output(bw_instance *inst, int a) {
             status = spec->model->jump(&axis->constants, state, axis->x_now - axis->state_x);
         }
         output = spec->model->force(&axis->constants, state, axis->x_now, axis->v * spec->to_kernel)
-                 * spec->from_kernel;
+                 * spec->from_kernel + bw_preload(axis, spec->model) * spec->from_kernel;
         if (status == BW_KERNEL_OK && isfinite(output)) {
             axis->last_output = output;
             axis->output_is_current = 1;
@@ -527,7 +541,8 @@ static bw_status bw_do_step(bw_instance *inst, double current_time, double h) {
                              "parameters", t_text, spec->label, x, v);
         }
         x_end[a] = x + v * h;
-        outputs[a] = spec->model->force(&axis->constants, states[a], x_end[a], v) * spec->from_kernel;
+        outputs[a] = spec->model->force(&axis->constants, states[a], x_end[a], v) * spec->from_kernel
+                     + bw_preload(axis, spec->model) * spec->from_kernel;
         if (!isfinite(outputs[a])) {
             char x_port[40], v_port[40];
             bw_format_double(t_text, sizeof t_text, current_time);
