@@ -160,11 +160,7 @@ def build_native_fmu(params_file: str | Path | None = None, out_dir: str | Path 
     from fmpy.validation import validate_fmu
     from fmu_src.native.build import build_native
     identifier, _, axes, document = fmu_axes(params_file, model)
-    if groups_of(document):
-        raise BuildError(f"the native FMU does not build coupled groups yet ({params_file} couples "
-                         f"{Coupling.of(document['coupling']).describe()}): build the pythonfmu FMU (without --native), "
-                         "or the native FMU from the set without its \"coupling\"")
-    build = build_native(axes, identifier, out_dir, fmi_version, platforms)
+    build = build_native(axes, identifier, out_dir, fmi_version, platforms, groups_of(document))
     problems = validate_fmu(str(build.path))
     if problems:
         raise BuildError(f"{build.path} fails validation:\n  " + "\n  ".join(problems))

@@ -4,7 +4,9 @@
  * step of every run, one per line.
  *
  * usage: c_master_timing FMU_SO GUID STEPS REPEATS AXES VR_X VR_V VR_F [VR_X VR_V VR_F ...]
- * The first three axes are driven by 2 mm / 10 Hz sines (in m), the others by 0.02 rad / 10 Hz. */
+ * The first three axes are driven by 2 mm / 10 Hz sines (in m), the others by 0.02 rad / 10 Hz; in
+ * phase, or with C_MASTER_PHASED set in the environment a third of a half period apart axis by axis
+ * (axis a at the phase a*pi/3: a coupled group then moves in its plane, not along a line). */
 #define _POSIX_C_SOURCE 199309L   /* clock_gettime under -std=c99 */
 #include <dlfcn.h>
 #include <math.h>
@@ -33,6 +35,8 @@ int main(int argc, char **argv) {
     fmi2CallbackFunctions callbacks = {logger, calloc, free, NULL, NULL};
     fmi2ValueReference inputs[12], outputs[6];
     double values[12], forces[6], *amplitudes, *rates, pi = acos(-1.0), h = 1e-3, sink = 0.0;
+    double cos_phase[6], sin_phase[6];
+    int phased = getenv("C_MASTER_PHASED") != NULL;
     if (argc < 9) return 1;
     fmu = dlopen(argv[1], RTLD_NOW | RTLD_LOCAL);
     if (!fmu) {
@@ -44,6 +48,8 @@ int main(int argc, char **argv) {
     axes = atoi(argv[5]);
     if (axes < 1 || axes > 6 || argc != 6 + 3 * axes) return 1;
     for (a = 0; a < axes; a++) {
+        cos_phase[a] = cos(a * pi / 3.0);
+        sin_phase[a] = sin(a * pi / 3.0);
         inputs[2 * a] = (fmi2ValueReference)atoi(argv[6 + 3 * a]);
         inputs[2 * a + 1] = (fmi2ValueReference)atoi(argv[7 + 3 * a]);
         outputs[a] = (fmi2ValueReference)atoi(argv[8 + 3 * a]);
@@ -76,8 +82,13 @@ int main(int argc, char **argv) {
             for (k = 0; k < steps; k++) {
                 for (a = 0; a < axes; a++) {
                     double scale = a < 3 ? 2e-3 : 0.02;
-                    values[2 * a] = scale * amplitudes[k];
-                    values[2 * a + 1] = scale * rates[k];
+                    if (phased) {   /* sin(wt + phase) and its rate, by the angle-addition identities */
+                        values[2 * a] = scale * (amplitudes[k] * cos_phase[a] + rates[k] / (2 * pi * 10) * sin_phase[a]);
+                        values[2 * a + 1] = scale * (rates[k] * cos_phase[a] - 2 * pi * 10 * amplitudes[k] * sin_phase[a]);
+                    } else {
+                        values[2 * a] = scale * amplitudes[k];
+                        values[2 * a + 1] = scale * rates[k];
+                    }
                 }
                 if (fmi2SetReal(c, inputs, 2 * (size_t)axes, values) != fmi2OK) return 7;
                 if (fmi2DoStep(c, k * h, h, fmi2True) != fmi2OK) return 8;

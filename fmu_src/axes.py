@@ -90,9 +90,14 @@ class Axis:
 
     def state_port(self, unit: str) -> tuple[str, float]:
         """(FMU unit, kernel -> port factor) of a state declared in "N", "m", "m/s" or "1"
-        (model_definition)."""
+        (model_definition), or of a coupled group's event indicator in "N.m/s" (z.u: N times mm/s,
+        or N.mm times rad/s) or "m2/s" (d.v: mm^2/s, or rad^2/s)."""
         if unit == "1":
             return ("1", 1.0)
+        if unit == "N.m/s":
+            return ("N.m/s", 1e-3)
+        if unit == "m2/s":
+            return ("rad2/s", 1.0) if self.rotational else ("m2/s", 1e-6)
         if unit == "N":
             return ("N.m", 1e-3) if self.rotational else ("N", 1.0)
         if unit == "m/s":

@@ -138,6 +138,9 @@ UNIT_DEFINITIONS: dict[str, dict[str, str] | None] = {
     "N/s": {"kg": "1", "m": "1", "s": "-3"},
     "1/s": {"s": "-1"},
     "N.m/s": {"kg": "1", "m": "2", "s": "-3"},
+    # event indicators of coupled groups: d.v of a friction's travel and velocity
+    "m2/s": {"m": "2", "s": "-1"},
+    "rad2/s": {"rad": "2", "s": "-1"},
     "N.mm/rad^3": {"kg": "1", "m": "2", "s": "-2", "rad": "-3", "factor": "0.001"},
     "N.mm.s^alpha/rad": None,
     "(N.mm)^(1-n)/rad": None,

@@ -82,13 +82,18 @@ def derivative_variables(variables: list[FmuVariable]) -> list[FmuVariable]:
             for i, s in enumerate(states)]
 
 
-def indicator_variables(first_reference: int, axis_models) -> list[FmuVariable]:
+def indicator_variables(first_reference: int, axis_models, groups=()) -> list[FmuVariable]:
     """``<axis.>event.<switch>`` for every switch of every axis (``BushingModel.switch_specs``):
     the quantities whose sign change is a state event, the event indicators of model exchange
-    (FMI 3 declares them as variables), numbered from ``first_reference``."""
+    (FMI 3 declares them as variables), numbered from ``first_reference``. A coupled group's
+    switches (``CoupledKernels.switch_specs``, of the group as a whole) are its first member's."""
     out = []
+    grouped = {position: group for group in groups for position in group
+               if axis_models[group[0]][1].coupled is not None}
     for position, (axis, model, _) in enumerate(axis_models):
-        for switch in model.switch_specs:
+        if position in grouped and grouped[position][0] != position:
+            continue
+        for switch in (model.coupled.switch_specs if position in grouped else model.switch_specs):
             unit, scale = axis.state_port(switch.unit)
             out.append(FmuVariable(f"{axis.prefix}event.{switch.name}", first_reference + len(out), "local",
                                    "continuous", unit, f"{axis.label}event indicator: {switch.meaning} (its sign "

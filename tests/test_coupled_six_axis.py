@@ -217,11 +217,6 @@ def test_a_coupled_set_round_trips_in_json_and_is_refused_as_ssv(tmp_path):
         save_six_axis(tmp_path / "back.ssv", axes, coupling=six.coupling)
 
 
-def test_the_native_build_refuses_a_coupled_set_for_now(tmp_path):
-    with pytest.raises(build_fmu.BuildError, match="the native FMU does not build coupled groups yet"):
-        build_fmu.build_native_fmu(six_axis_file(tmp_path, "radial"), tmp_path, model="six_axis")
-
-
 def test_assemble_couples_one_fit_on_a_groups_axes_and_refuses_axes_that_differ(tmp_path, capsys):
     from identification.__main__ import main
     one, other = DATA / "params_table5_combined.json", DATA / "params_table2_sine.json"

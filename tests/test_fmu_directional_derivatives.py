@@ -25,6 +25,8 @@ from fmu_src.bushing_models import MODELS
 FMUS = (*MODELS, "six_axis")
 VERSIONS = (2, 3)
 RELATIVE = 1e-6           # the issue's target for central differences of the FMU's outputs
+CS_STEP = 1e-6
+"""The co-simulation differences' step, relative to a known's nominal size."""
 POINTS = 12
 FINITE_POINTS = 10_000
 
@@ -232,7 +234,7 @@ def test_co_simulation_dF_dx_dF_dv_are_those_of_the_output_the_fmu_returns(fmus,
             opened.set_inputs(inputs + step * np.eye(len(inputs))[j])
             return opened.get(opened.outputs)
         for j, v in enumerate(opened.inputs):
-            h = 1e-6 * scales[j]
+            h = CS_STEP * scales[j]
             if no_jump and not is_velocity(v):
                 h *= 1.0 if inputs[j + 1] >= 0.0 else -1.0
                 difference[:, j] = (-3.0 * output(j, 0.0) + 4.0 * output(j, h) - output(j, 2.0 * h)) / (2.0 * h)

@@ -156,6 +156,16 @@ def docstring_and_pass(a):
     return a
 
 
+def values_only_an_unused_value_reads(a, i):
+    """A value never read is not computed, and so neither is what only it reads (else the C would
+    set variables it never uses, which -Werror refuses): a tangent of a value that feeds a count."""
+    doubled = a * 2.0
+    unused = doubled + 1.0         # noqa: F841 (the point of the case)
+    count = i * 2
+    unused_too = count * 3         # noqa: F841
+    return a + 1.0
+
+
 SUPPORTED = [
     (arithmetic, [(1.5, 0.3), (-2.75, 1e-300), (1e308, -3.0)]),
     (int_true_division, [(7, 3), (-7, 2), (1, 3)]),
@@ -177,6 +187,7 @@ SUPPORTED = [
     (module_constants, [(0.1,), (-7.0,)]),
     (unrolled_tuple_and_sum, [((0.1, 0.2, 0.3),), ((1e16, -1e16, 1.0),)]),
     (docstring_and_pass, [(0.5,), (-0.0,)]),
+    (values_only_an_unused_value_reads, [(0.5, 3)]),
 ]
 
 

@@ -64,10 +64,10 @@ def fmi_header_directory() -> Path:
     return folder
 
 
-def write_sources(folder: Path, axis_models, identifier: str, fmi_version: int):
+def write_sources(folder: Path, axis_models, identifier: str, fmi_version: int, groups=()):
     """Write the FMU's sources/ into ``folder``; returns the generated model (``generate``)."""
     folder.mkdir(parents=True, exist_ok=True)
-    generated = model_source(axis_models, identifier)
+    generated = model_source(axis_models, identifier, groups)
     (folder / "bushing_model.c").write_text(generated.source)
     functions = f"fmi{fmi_version}_functions.c"
     for name in (*HAND_WRITTEN, functions):
@@ -118,9 +118,10 @@ def missing_platforms(fmi_version: int, platforms: tuple[str, ...] | None = None
 
 
 def build_native(axis_models, identifier: str, out_dir: str | Path, fmi_version: int = 2,
-                 platforms: tuple[str, ...] | None = None) -> NativeBuild:
+                 platforms: tuple[str, ...] | None = None, groups=()) -> NativeBuild:
     """Write ``out_dir/<identifier>.fmu``, a native FMU (FMI ``fmi_version``, co-simulation and
-    model exchange) of the axes ``axis_models`` [(axes.Axis, model on that axis, parameters)].
+    model exchange) of the axes ``axis_models`` [(axes.Axis, model on that axis, parameters)] with
+    the coupled ``groups`` (tuples of positions among them).
     ``platforms``: default every platform whose compiler is here (linux64 with the system's
     ``cc``, win64 with mingw-w64); the result says which were skipped and why."""
     compilers = platform_compilers(fmi_version)
@@ -135,12 +136,13 @@ def build_native(axis_models, identifier: str, out_dir: str | Path, fmi_version:
     with tempfile.TemporaryDirectory(prefix="bushing_native_") as stage:
         stage = Path(stage)
         sources = stage / "sources"
-        generated = write_sources(sources, axis_models, identifier, fmi_version)
+        generated = write_sources(sources, axis_models, identifier, fmi_version, groups)
         if fmi_version == 2:
             xml = model_description.fmi2(axis_models, identifier, generated.token,
-                                         event_indicators=generated.event_indicators, source_file=f"{identifier}.c")
+                                         event_indicators=generated.event_indicators, source_file=f"{identifier}.c",
+                                         groups=groups)
         else:
-            xml = model_description.fmi3(axis_models, identifier, generated.token)
+            xml = model_description.fmi3(axis_models, identifier, generated.token, groups)
             (sources / "buildDescription.xml").write_bytes(model_description.build_description(identifier))
         (stage / "modelDescription.xml").write_bytes(xml)
         build.platforms = [platform for platform in wanted if platform not in build.skipped]

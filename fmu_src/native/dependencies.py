@@ -65,3 +65,48 @@ def axis_dependencies(model: BushingModel) -> AxisDependencies:
     if any(moved[i] and i in output for i in range(states)):
         cosimulation.add(X)
     return AxisDependencies(frozenset(output), tuple(frozenset(r) for r in rates), frozenset(cosimulation))
+
+
+@dataclass(frozen=True)
+class GroupDependencies:
+    """A coupled group's dependencies (``model_definition.CoupledKernels``): knowns are its flat
+    state's indices, (X, c) and (V, c) for component c of the inputs; per output component and per
+    rate of the flat state."""
+    output: tuple                  # model exchange: F[c] on states and inputs
+    rates: tuple                   # model exchange: d(state i)/dt
+    cosimulation_output: tuple     # co-simulation: F[c] on the inputs (through the jump for x)
+
+
+def group_dependencies(model: BushingModel) -> GroupDependencies:
+    """``model``'s coupled form's dependencies, by the same activity analysis as one axis's."""
+    kernels = model.coupled
+    states = kernels.size
+    generator = Generator()
+    knowns = list(range(states)) + [(X, c) for c in range(3)] + [(V, c) for c in range(3)]
+    output, rates = [set() for _ in range(3)], [set() for _ in range(states)]
+
+    def activity(known):
+        vector = lambda kind: tuple(known == (kind, c) for c in range(3))   # noqa: E731
+        return (False, tuple(known == i for i in range(states)), vector(X), vector(V))
+
+    for known in knowns:
+        activities = activity(known)
+        for c, active in enumerate(_elements(generator.spec(kernels.force, activities).return_activity, 3)):
+            if active:
+                output[c].add(known)
+        for i, active in enumerate(_elements(generator.spec(kernels.derivatives, activities).return_activity,
+                                             states)):
+            if active:
+                rates[i].add(known)
+    cosimulation = []
+    for c in range(3):
+        found = {known for known in knowns if not isinstance(known, int) and known in output[c]}
+        for j in range(3):   # the jump along component j moves the state the force reads
+            jumped = generator.spec(kernels.jump, (False, (False,) * states, tuple(k == j for k in range(3))))
+            moved = _elements(jumped.return_activity[0] if isinstance(jumped.return_activity, tuple)
+                              else jumped.return_activity, states)
+            if any(moved[i] and i in output[c] for i in range(states)):
+                found.add((X, j))
+        cosimulation.append(frozenset(found))
+    return GroupDependencies(tuple(frozenset(o) for o in output), tuple(frozenset(r) for r in rates),
+                             tuple(cosimulation))

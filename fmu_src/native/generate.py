@@ -25,6 +25,7 @@ import uuid
 from dataclasses import dataclass
 
 from .. import integration
+from ..axes import group_name as axis_group_name
 from ..tangents import tangent
 from ..model_definition import BushingModel
 from ..variables import FmuVariable, derivative_variables, fmu_variables, indicator_variables
@@ -54,7 +55,7 @@ def c_double(value: float) -> str:
 class ModelCode:
     """One model's translated kernels and the C types of their tuples."""
 
-    def __init__(self, translation: Translation, model: BushingModel):
+    def __init__(self, translation: Translation, model: BushingModel, coupled: bool = False):
         self.model = model
         self.name = model.name
         parameters = (DOUBLE,) * len(model.specs)
@@ -81,6 +82,7 @@ class ModelCode:
                                                             (m, s, DOUBLE, DOUBLE))
         if model.update is not None:
             self.kernels["update"] = translation.function(model.update, (m, s, DOUBLE, DOUBLE))
+        self.coupled = CoupledCode(translation, model, self.constants_type) if coupled else None
         self.switches = len(self.kernels["switches"].return_type)
         if [s.index for s in model.switch_specs] != list(range(self.switches)):
             raise ValueError(f"{model.name}: switch_specs must name the {self.switches} values switches() returns, "
@@ -137,6 +139,8 @@ class ModelCode:
                 + ("".join(f"    {out}[{i}] = r.f{i};\n" for i in range(count)) or
                    f"    (void)r;\n    (void){out};\n" + ("    (void)s;\n" if not states else "")) + "}\n")
         lines.append(self.tangent_wrappers())
+        if self.coupled is not None:
+            lines.append(self.coupled.wrappers(name, constants))
         return "\n".join(lines)
 
     def tangent_wrappers(self) -> str:
@@ -206,19 +210,134 @@ class ModelCode:
                             ("prepare", "initial_state", "step", "jump", "force", "derivatives", "switches",
                              "update", "force_tangent", "derivatives_tangent", "jump_tangent"))
         mounting = {spec.name: index[spec.name] for spec in model.mounting_specs}
+        coupled = f"&bw_coupled_{self.name}" if self.coupled is not None else "NULL"
         out += (f"static const bw_model bw_model_{name} = {{{c_string(self.name)}, {len(model.specs)}, "
                 f"{len(model.fmu_specs)}, {mounting.get('offset', -1)}, {mounting.get('preload', -1)}, "
                 f"{len(self.state_type)}, {self.switches}, bw_specs_{name}, {len(constraints)}, "
-                f"{'bw_constraints_' + name if constraints else 'NULL'}, {kernels}}};\n")
+                f"{'bw_constraints_' + name if constraints else 'NULL'}, {kernels}, {coupled}}};\n")
         return out
 
 
-def all_variables(axis_models) -> list[FmuVariable]:
+VECTOR = (DOUBLE, DOUBLE, DOUBLE)
+
+
+class CoupledCode:
+    """A model's coupled kernels (``model_definition.CoupledKernels``) translated for a coupled
+    group: 3-vectors for x, v, a jump and the force, the flat state; with the array interface of
+    ``bw_coupled_model`` (``c/bushing_fmu.h``)."""
+
+    def __init__(self, translation: Translation, model: BushingModel, constants_type):
+        kernels = model.coupled
+        self.kernels_spec = kernels
+        self.size = kernels.size
+        m, s, v = constants_type, (DOUBLE,) * kernels.size, VECTOR
+        self.kernels = {
+            "initial_state": translation.function(kernels.initial_state, (m, v)),
+            "step": translation.function(kernels.step, (m, s, v, v, v, DOUBLE, INT)),
+            "jump": translation.function(kernels.jump, (m, s, v)),
+            "force": translation.function(kernels.force, (m, s, v, v)),
+            "derivatives": translation.function(kernels.derivatives, (m, s, v, v)),
+            "switches": translation.function(kernels.switches, (m, s, v, v)),
+            "force_tangent": translation.function(tangent(kernels.force), (m, s, v, v, s, v, v)),
+            "derivatives_tangent": translation.function(tangent(kernels.derivatives), (m, s, v, v, s, v, v)),
+            "jump_tangent": translation.function(tangent(kernels.jump, inactive=("m", "state")), (m, s, v, v)),
+        }
+        if kernels.update is not None:
+            self.kernels["update"] = translation.function(kernels.update, (m, s, v, v))
+        self.switches = len(self.kernels["switches"].return_type)
+        if [spec.index for spec in kernels.switch_specs] != list(range(self.switches)):
+            raise ValueError(f"{model.name}: the coupled switch_specs must name the {self.switches} values its "
+                             "switches() returns, in order")
+        index = {spec.name: i for i, spec in enumerate(model.specs)}
+        self.zero_parameters = [index[name] for name in kernels.zero_parameters]
+        self.translation = translation
+
+    def literal(self, array: str, count: int, t: str | None = None) -> str:
+        """A C compound literal of ``count`` doubles from ``array`` (a tuple of doubles' struct)."""
+        t = t or self.translation.c_type((DOUBLE,) * count)
+        return f"({t}){{{', '.join(f'{array}[{i}]' for i in range(count))}}}"
+
+    def wrappers(self, name: str, constants: str) -> str:
+        k = self.kernels
+        size = self.size
+        state = self.literal("s", size)
+        vec = lambda array: self.literal(array, 3)     # noqa: E731 (a 3-vector's literal)
+        copy = lambda source, target, count: "".join(   # noqa: E731
+            f"    {target}[{i}] = {source}.f{i};\n" for i in range(count))
+
+        def elements(expression: str, t, count: int) -> list[str]:
+            # a tangent that does not depend on the direction at all is the scalar 0.0
+            return [f"{expression}.f{i}" for i in range(count)] if isinstance(t, tuple) else [expression] * count
+
+        c_type = self.translation.c_type
+        call = f"({constants}, {state}, {vec('x')}, {vec('v')}"
+        tangent_call = f"({constants}, {state}, {vec('x')}, {vec('v')}, {self.literal('ds', size)}, {vec('dx')}, {vec('dv')})"
+        lines = [
+            f"static void bw_{name}_coupled_initial_state(const void *c, const double *x, double *s) {{\n"
+            f"    {c_type(k['initial_state'].return_type)} r = {k['initial_state'].name}({constants}, {vec('x')});\n"
+            + copy("r", "s", size) + "}\n",
+            f"static int bw_{name}_coupled_step(const void *c, double *s, const double *state_x, const double *x, "
+            f"const double *v, double h, int max_substeps) {{\n"
+            f"    {c_type(k['step'].return_type)} r = {k['step'].name}({constants}, {state}, {vec('state_x')}, "
+            f"{vec('x')}, {vec('v')}, h, max_substeps);\n" + copy("r.f0", "s", size) + "    return r.f2;\n}\n",
+            f"static int bw_{name}_coupled_jump(const void *c, double *s, const double *jump) {{\n"
+            f"    {c_type(k['jump'].return_type)} r = {k['jump'].name}({constants}, {state}, {vec('jump')});\n"
+            + copy("r.f0", "s", size) + "    return r.f1;\n}\n",
+            f"static void bw_{name}_coupled_force(const void *c, const double *s, const double *x, const double *v, "
+            f"double *force) {{\n    {c_type(k['force'].return_type)} r = {k['force'].name}{call});\n"
+            + copy("r", "force", 3) + "}\n",
+        ]
+        for kernel, out, count in (("derivatives", "rates", size), ("switches", "values", self.switches)):
+            lines.append(
+                f"static void bw_{name}_coupled_{kernel}(const void *c, const double *s, const double *x, "
+                f"const double *v, double *{out}) {{\n    {c_type(k[kernel].return_type)} r = {k[kernel].name}{call});\n"
+                + (copy("r", out, count) or f"    (void)r;\n    (void){out};\n") + "}\n")
+        if "update" in k:
+            compare = " || ".join(f"r.f{i} != s[{i}]" for i in range(size))
+            lines.append(
+                f"static int bw_{name}_coupled_update(const void *c, double *s, const double *x, const double *v) {{\n"
+                f"    {c_type(k['update'].return_type)} r = {k['update'].name}{call});\n    int changed = {compare};\n"
+                + copy("r", "s", size) + "    return changed;\n}\n")
+        else:
+            lines.append(f"static int bw_{name}_coupled_update(const void *c, double *s, const double *x, "
+                         "const double *v) {\n    (void)c;\n    (void)s;\n    (void)x;\n    (void)v;\n    return 0;\n}\n")
+        force, rates, jump = k["force_tangent"], k["derivatives_tangent"], k["jump_tangent"]
+        d_force = elements("r.f1", force.return_type[1], 3)
+        d_rates = elements("r.f1", rates.return_type[1], size)
+        jumped = elements("r.f0.f0", jump.return_type[0][0], size)
+        derivative = jump.return_type[1]
+        d_state = elements("r.f1.f0", derivative[0], size) if isinstance(derivative, tuple) else ["0.0"] * size
+        lines.append(
+            f"static void bw_{name}_coupled_force_tangent(const void *c, const double *s, const double *x, "
+            f"const double *v, const double *ds, const double *dx, const double *dv, double *d_force) {{\n"
+            f"    {c_type(force.return_type)} r = {force.name}{tangent_call};\n"
+            + "".join(f"    d_force[{i}] = {e};\n" for i, e in enumerate(d_force)) + "}\n")
+        lines.append(
+            f"static void bw_{name}_coupled_derivatives_tangent(const void *c, const double *s, const double *x, "
+            f"const double *v, const double *ds, const double *dx, const double *dv, double *d_rates) {{\n"
+            f"    {c_type(rates.return_type)} r = {rates.name}{tangent_call};\n"
+            + "".join(f"    d_rates[{i}] = {e};\n" for i, e in enumerate(d_rates)) + "}\n")
+        lines.append(
+            f"static int bw_{name}_coupled_jump_tangent(const void *c, double *s, const double *jump, "
+            f"const double *d_jump, double *ds) {{\n"
+            f"    {c_type(jump.return_type)} r = {jump.name}({constants}, {state}, {vec('jump')}, {vec('d_jump')});\n"
+            + "".join(f"    s[{i}] = {e};\n" for i, e in enumerate(jumped))
+            + "".join(f"    ds[{i}] = {e};\n" for i, e in enumerate(d_state)) + "    return r.f0.f1;\n}\n")
+        zeros = ", ".join(str(i) for i in self.zero_parameters) or "0"
+        kernels = ", ".join(f"bw_{name}_coupled_{kernel}" for kernel in
+                            ("initial_state", "step", "jump", "force", "derivatives", "switches", "update",
+                             "force_tangent", "derivatives_tangent", "jump_tangent"))
+        lines.append(f"static const bw_coupled_model bw_coupled_{name} = {{{size}, {self.switches}, "
+                     f"{len(self.zero_parameters)}, {{{zeros}}}, {kernels}}};\n")
+        return "\n".join(lines)
+
+
+def all_variables(axis_models, groups=()) -> list[FmuVariable]:
     """The native FMU's variables: the pythonfmu FMU's, then the states' derivatives, the event
     indicators and the time (FMI 3 requires the independent variable)."""
-    variables = fmu_variables(axis_models)
+    variables = fmu_variables(axis_models, groups)
     variables += derivative_variables(variables)
-    variables += indicator_variables(len(variables), axis_models)
+    variables += indicator_variables(len(variables), axis_models, groups)
     return variables + [FmuVariable("time", len(variables), "independent", "continuous", "s",
                                     "simulation time [s]", 0, "time", 0)]
 
@@ -237,16 +356,19 @@ class GeneratedModel:
     event_indicators: int
 
 
-def model_source(axis_models, identifier: str) -> GeneratedModel:
+def model_source(axis_models, identifier: str, groups=()) -> GeneratedModel:
     """bushing_model.c for an FMU whose axes are ``axis_models`` [(axes.Axis, model on that axis,
-    parameters)]. The instantiation token is derived from the C and the identifier, so a
-    rebuild of the same FMU gives the same token."""
+    parameters)] with the coupled ``groups`` (tuples of positions among them; a group of a model
+    without a coupled form, Kelvin-Voigt, is its axes as they are). The instantiation token is
+    derived from the C and the identifier, so a rebuild of the same FMU gives the same token."""
     translation = Translation(prefix="bw")
+    groups = tuple(tuple(group) for group in groups if axis_models[group[0]][1].coupled is not None)
+    coupled = {axis_models[group[0]][1].name for group in groups}
     models: dict[str, ModelCode] = {}
     for _, model, _ in axis_models:
         if model.name not in models:
-            models[model.name] = ModelCode(translation, model)
-    variables = all_variables(axis_models)
+            models[model.name] = ModelCode(translation, model, model.name in coupled)
+    variables = all_variables(axis_models, groups)
     kernels = translation.source()
 
     parts = [kernels, "\ntypedef union {"]
@@ -267,11 +389,24 @@ def model_source(axis_models, identifier: str) -> GeneratedModel:
         suffix = "_rotational" if axis.rotational else ""
         plausible = (1.0, 50.0) if axis.rotational else (100.0, 1000.0)
         axis_lines.append(
-            f"    {{{c_string(axis.label)}, {c_string(axis.displacement)}, {c_string(axis.velocity)}, "
+            f"    {{{c_string(axis.name)}, {c_string(axis.label)}, {c_string(axis.displacement)}, {c_string(axis.velocity)}, "
             f"{c_string(axis.output)}, {int(axis.rotational)}, {c_double(axis.to_kernel)}, {c_double(axis.from_kernel)}, "
             f"{c_double(axis.plausible_travel)}, {c_double(plausible[0])}, {c_double(plausible[1])}, "
             f"&bw_model_{model.name}{suffix}, bw_defaults_{position}}}")
     parts.append("\nstatic const bw_axis_spec bw_axis_specs[BW_AXES] = {\n" + ",\n".join(axis_lines) + "\n};\n")
+    group_of, component = [-1] * len(axis_models), [0] * len(axis_models)
+    group_lines = []
+    for g, group in enumerate(groups):
+        names = ", ".join(axis_models[i][0].name for i in group)
+        label = f"the {axis_group_name(tuple(axis_models[i][0].name for i in group))} group ({names}): "
+        members = ", ".join(str(i) for i in group) + ", 0" * (3 - len(group))
+        group_lines.append(f"    {{{c_string(label)}, {len(group)}, {{{members}}}}}")
+        for c, i in enumerate(group):
+            group_of[i], component[i] = g, c
+    parts.append("static const bw_group_spec bw_group_specs[BW_GROUP_SLOTS] = {\n"
+                 + (",\n".join(group_lines) or '    {"", 0, {0, 0, 0}}') + "\n};\n")
+    parts.append("static const int bw_axis_group[BW_AXES] = {" + ", ".join(map(str, group_of)) + "};")
+    parts.append("static const int bw_axis_component[BW_AXES] = {" + ", ".join(map(str, component)) + "};\n")
     parts.append("static const bw_variable bw_variables[BW_VARIABLES] = {\n" + ",\n".join(
         f"    {{{c_string(v.name)}, {KINDS[v.kind]}, {v.axis}, {v.index}, {c_double(v.scale)}}}" for v in variables)
         + "\n};\n")
@@ -293,6 +428,10 @@ def model_source(axis_models, identifier: str) -> GeneratedModel:
         f"#define BW_MAX_PARAMETERS {max(len(m.fmu_specs) for _, m, _ in axis_models)}\n"
         f"#define BW_MAX_STATES {max([1] + [len(code.state_type) for code in models.values()])}\n"
         f"#define BW_MAX_SWITCHES {max([1] + [code.switches for code in models.values()])}\n"
+        f"#define BW_GROUPS {len(groups)}\n"
+        f"#define BW_GROUP_SLOTS {max(1, len(groups))}\n"
+        f"#define BW_MAX_GROUP_STATES {max([1] + [c.coupled.size for c in models.values() if c.coupled])}\n"
+        f"#define BW_MAX_GROUP_SWITCHES {max([1] + [c.coupled.switches for c in models.values() if c.coupled])}\n"
         f"#define BW_CONTINUOUS_STATES {states}\n"
         f"#define BW_EVENT_INDICATORS {indicators}\n"
         f"#define BW_KERNEL_OK {integration.OK}\n"

@@ -12,7 +12,7 @@ from xml.etree import ElementTree as ET
 from .. import __version__
 from ..bushing_params import UNIT_DEFINITIONS
 from ..variables import FmuVariable, fmu_description
-from .dependencies import V, X, axis_dependencies
+from .dependencies import V, X, axis_dependencies, group_dependencies
 from .generate import all_variables, c_double, nominal
 
 LOG_CATEGORIES = (("logStatusWarning", "Warnings: values accepted but doubtful (units, the paper's constraints)"),
@@ -53,15 +53,21 @@ def _common_attributes(identifier: str, token_name: str, token: str, axis_models
             "variableNamingConvention": "structured"}
 
 
-def _dependencies(variables: list[FmuVariable], axis_models, interfaces) -> dict[int, list[FmuVariable]]:
+def _dependencies(variables: list[FmuVariable], axis_models, interfaces, groups=()) -> dict[int, list[FmuVariable]]:
     """{value reference of an output or a state's derivative: the knowns it depends on} for an FMU
     with ``interfaces`` (``dependencies.axis_dependencies`` of the axis's model): an output's
     states and inputs in model exchange, its inputs in co-simulation (x through the jump too), the
-    union where the FMU has both; a state derivative's states and inputs."""
+    union where the FMU has both; a state derivative's states and inputs. A coupled group's
+    (``groups``) by ``dependencies.group_dependencies``, across its members."""
     found = {}
     by_model = {}
+    grouped = {position: group for group in groups for position in group}
+    by_group = {}
     for v in variables:
         if v.kind not in ("output", "derivative"):
+            continue
+        if v.axis in grouped:
+            found[v.value_reference] = _group_knowns(v, variables, axis_models, grouped[v.axis], interfaces, by_group)
             continue
         model = axis_models[v.axis][1]
         if model.name not in by_model:
@@ -78,15 +84,34 @@ def _dependencies(variables: list[FmuVariable], axis_models, interfaces) -> dict
     return found
 
 
+def _group_knowns(v: FmuVariable, variables, axis_models, group, interfaces, cache) -> list[FmuVariable]:
+    """The knowns of an output or a state's derivative of a coupled group's member (``_dependencies``)."""
+    model = axis_models[group[0]][1]
+    if model.name not in cache:
+        cache[model.name] = group_dependencies(model)
+    dependencies = cache[model.name]
+    if v.kind == "output":
+        c = group.index(v.axis)
+        wanted = (dependencies.output[c] if "me" in interfaces else frozenset()) | \
+            (dependencies.cosimulation_output[c] if "cs" in interfaces else frozenset())
+    else:
+        wanted = dependencies.rates[next(s for s in variables if s.value_reference == v.state).index]
+    members = set(group)
+    return [k for k in variables if k.axis in members and (
+        (k.kind == "state" and k.index in wanted) or (k.kind == "displacement" and (X, group.index(k.axis)) in wanted)
+        or (k.kind == "velocity" and (V, group.index(k.axis)) in wanted))]
+
+
 def _unknown(parent: ET.Element, tag: str, key: str, value: str, knowns: list[FmuVariable], reference) -> None:
     ET.SubElement(parent, tag, {key: value, "dependencies": " ".join(str(reference(k)) for k in knowns),
                                 "dependenciesKind": " ".join("dependent" for _ in knowns)})
 
 
 def fmi2(axis_models, identifier: str, token: str, interfaces=INTERFACES, event_indicators: int = 0,
-         source_file: str | None = None) -> bytes:
-    """FMI 2.0 modelDescription.xml (``interfaces``: "cs" and/or "me")."""
-    variables = all_variables(axis_models)
+         source_file: str | None = None, groups=()) -> bytes:
+    """FMI 2.0 modelDescription.xml (``interfaces``: "cs" and/or "me"; ``groups``: the coupled groups)."""
+    groups = _coupled(axis_models, groups)
+    variables = all_variables(axis_models, groups)
     attributes = _common_attributes(identifier, "guid", token, axis_models, "2.0")
     if "me" in interfaces:
         attributes["numberOfEventIndicators"] = str(event_indicators)
@@ -121,7 +146,7 @@ def fmi2(axis_models, identifier: str, token: str, interfaces=INTERFACES, event_
         ET.SubElement(element, "Real", real)
     structure = ET.SubElement(root, "ModelStructure")
     outputs = ET.SubElement(structure, "Outputs")
-    dependencies = _dependencies(variables, axis_models, interfaces)
+    dependencies = _dependencies(variables, axis_models, interfaces, groups)
 
     def position(k):
         return index[k.value_reference]
@@ -140,9 +165,15 @@ def fmi2(axis_models, identifier: str, token: str, interfaces=INTERFACES, event_
     return _pretty(root)
 
 
-def fmi3(axis_models, identifier: str, token: str) -> bytes:
-    """FMI 3.0 modelDescription.xml, co-simulation and model exchange."""
-    variables = all_variables(axis_models)
+def _coupled(axis_models, groups) -> tuple:
+    """The groups whose model has a coupled form (a Kelvin-Voigt group is its axes as they are)."""
+    return tuple(tuple(group) for group in groups if axis_models[group[0]][1].coupled is not None)
+
+
+def fmi3(axis_models, identifier: str, token: str, groups=()) -> bytes:
+    """FMI 3.0 modelDescription.xml, co-simulation and model exchange (``groups``: the coupled groups)."""
+    groups = _coupled(axis_models, groups)
+    variables = all_variables(axis_models, groups)
     root = ET.Element("fmiModelDescription", _common_attributes(identifier, "instantiationToken", token, axis_models,
                                                                 "3.0"))
     capabilities = {"modelIdentifier": identifier, "needsExecutionTool": "false",
@@ -166,7 +197,7 @@ def fmi3(axis_models, identifier: str, token: str) -> bytes:
             attributes["nominal"] = c_double(nominal(v))
         ET.SubElement(model_variables, "Float64", attributes)
     structure = ET.SubElement(root, "ModelStructure")
-    dependencies = _dependencies(variables, axis_models, INTERFACES)
+    dependencies = _dependencies(variables, axis_models, INTERFACES, groups)
 
     def reference(k):
         return k.value_reference

@@ -88,6 +88,28 @@ class TranslationError(ValueError):
     """A kernel the C translation cannot follow (the message names the function and line)."""
 
 
+def live_reads(tree: ast.AST) -> set[str]:
+    """The names a function's C reads: every name loaded but in the value of an assignment to a
+    name that nothing reads (the translation drops such an assignment, so what only it read would
+    be set and never used, which C warns of), to a fixpoint: a tangent computed for a value that
+    feeds only a count (``d_g0`` of a gain that sets the substeps) drops with what it alone read."""
+    assignments = [node for node in ast.walk(tree) if isinstance(node, (ast.Assign, ast.AugAssign))
+                   and isinstance(node.targets[0] if isinstance(node, ast.Assign) else node.target, ast.Name)
+                   and (not isinstance(node, ast.Assign) or len(node.targets) == 1)]
+    owner = {}
+    for node in assignments:
+        target = (node.targets[0] if isinstance(node, ast.Assign) else node.target).id
+        for child in ast.walk(node.value):
+            owner[id(child)] = target
+    loads = [n for n in ast.walk(tree) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)]
+    read = {n.id for n in loads}
+    while True:
+        live = {n.id for n in loads if id(n) not in owner or owner[id(n)] in read}
+        if live == read:
+            return read
+        read = live
+
+
 def merge(a: Type, b: Type) -> Type:
     """The type that holds values of both: int and double give double; tuples merge by element."""
     if a == b:
@@ -178,7 +200,7 @@ class _Function:
             raise self.error(self.tree, f"called with {len(argument_types)} arguments")
         self.locals: dict[str, Type] = dict(zip(self.arguments, argument_types))
         # C warns of variables set but never read: names never read are neither declared nor set
-        self.read = {n.id for n in ast.walk(self.tree) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)}
+        self.read = live_reads(self.tree)
         self.loop_names = {n.target.id for n in ast.walk(self.tree)
                            if isinstance(n, ast.For) and isinstance(n.target, ast.Name)}
         self.check_loop_variables(self.tree, frozenset())

@@ -67,6 +67,34 @@ typedef struct {
     const char *why;
 } bw_constraint;
 
+/* A model's coupled form on a group of axes (model_definition.CoupledKernels): its kernels on
+ * 3-vectors x, v, a jump and the force (a group of two axes has a zero third component), the state
+ * flat (component c of vector i at 3*i + c), the model's constants as its one-axis kernels take
+ * them. Tangents in the direction (d_state, dx, dv); jump_tangent takes the state through a jump
+ * and writes d(state after the jump) in the jump's direction d_jump. */
+typedef struct {
+    int states;
+    int switches;
+    int zero_parameters;          /* how many of the model's parameters a group requires to be 0 */
+    int zero_parameter[BW_MAX_TERMS];
+    void (*initial_state)(const void *constants, const double *x0, double *state);
+    int (*step)(const void *constants, double *state, const double *state_x, const double *x, const double *v,
+                double h, int max_substeps);
+    int (*jump)(const void *constants, double *state, const double *jump);
+    void (*force)(const void *constants, const double *state, const double *x, const double *v, double *force);
+    void (*derivatives)(const void *constants, const double *state, const double *x, const double *v,
+                        double *rates);
+    void (*switch_values)(const void *constants, const double *state, const double *x, const double *v,
+                          double *values);
+    int (*update)(const void *constants, double *state, const double *x, const double *v);
+    void (*force_tangent)(const void *constants, const double *state, const double *x, const double *v,
+                          const double *d_state, const double *dx, const double *dv, double *d_force);
+    void (*derivatives_tangent)(const void *constants, const double *state, const double *x, const double *v,
+                                const double *d_state, const double *dx, const double *dv, double *d_rates);
+    int (*jump_tangent)(const void *constants, double *state, const double *jump, const double *d_jump,
+                        double *d_state);
+} bw_coupled_model;
+
 /* A model: its parameter rules and its kernels (generated wrappers around the translated
  * Python kernels; the constants are the model's own struct, behind void pointers). */
 typedef struct {
@@ -96,10 +124,19 @@ typedef struct {
     void (*derivatives_tangent)(const void *constants, const double *state, double x, double v, const double *d_state,
                                 double dx, double dv, double *d_rates);
     int (*jump_tangent)(const void *constants, double *state, double jump, double *d_state);
+    const bw_coupled_model *coupled;   /* its coupled form, where a coupled group of this FMU runs it; else NULL */
 } bw_model;
+
+/* A coupled group of axes (axes.Coupling): its members, positions among the axes, in order. */
+typedef struct {
+    const char *label;          /* how messages name it: "the radial group (x, y): " */
+    int members;
+    int axis[3];
+} bw_group_spec;
 
 /* An axis of the FMU (fmu_src/axes.py): its ports, units and model. */
 typedef struct {
+    const char *name;           /* x, y, z, rx, ry, rz; "" for a one-axis FMU */
     const char *label;          /* how messages name it: "axis rz: ", or "" for a one-axis FMU */
     const char *displacement;   /* port names */
     const char *velocity;

@@ -37,9 +37,20 @@ typedef struct {
     bw_constants constants;
 } bw_axis;
 
+/* A coupled group of axes (bw_group_specs): one state of its model's coupled form on its members'
+   displacement vector; each member keeps its ports, parameters, mounting and output. */
+typedef struct {
+    double state[BW_MAX_GROUP_STATES];   /* committed, kernel units */
+    double state_x[3];                   /* kernel displacement vector the committed state belongs to */
+    int usable;                          /* its members' parameters are one usable set */
+    int equal;                           /* its members' parameters are equal (checked at each change) */
+    int parameters_changed;
+} bw_group;
+
 /* Everything an FMU state saves and restores: the instance's data without its callbacks. */
 typedef struct {
     bw_axis axes[BW_AXES];
+    bw_group groups[BW_GROUP_SLOTS];
     int initial_state_pending;       /* set at the exit of initialization, or at the first valid step */
     double time;
 } bw_data;
@@ -122,6 +133,62 @@ static double bw_offset(const bw_axis *axis, const bw_model *model) {
 
 static double bw_preload(const bw_axis *axis, const bw_model *model) {
     return model->preload >= 0 ? axis->parameters[model->preload] : 0.0;
+}
+
+/* ------------------------------------------------------------------------------- coupled groups */
+
+static const bw_coupled_model *bw_group_kernels(int g) {
+    return bw_axis_specs[bw_group_specs[g].axis[0]].model->coupled;
+}
+
+static const void *bw_group_constants(const bw_instance *inst, int g) {
+    return &inst->data.axes[bw_group_specs[g].axis[0]].constants;
+}
+
+/* The members' model displacements and velocities as 3-vectors (kernel units; 0 beyond them). */
+static void bw_group_inputs(const bw_instance *inst, int g, double *x, double *v) {
+    const bw_group_spec *spec = &bw_group_specs[g];
+    int c;
+    for (c = 0; c < 3; c++) x[c] = v[c] = 0.0;
+    for (c = 0; c < spec->members; c++) {
+        const bw_axis *axis = &inst->data.axes[spec->axis[c]];
+        x[c] = axis->x_now;
+        v[c] = axis->v * bw_axis_specs[spec->axis[c]].to_kernel;
+    }
+}
+
+/* Whether the members' own parameters are one set (their mounting may differ), and the coupled
+   model's zero parameters 0 (Spencer's x0); logs every difference, naming the group, the axes and
+   the values (as parameter_files.check_groups). */
+static int bw_check_group(bw_instance *inst, int g) {
+    const bw_group_spec *spec = &bw_group_specs[g];
+    const bw_model *model = bw_axis_specs[spec->axis[0]].model;
+    const bw_axis *first = &inst->data.axes[spec->axis[0]];
+    char a[40], b[40];
+    int i, c, equal = 1;
+    for (i = 0; i < model->parameters; i++) {
+        for (c = 1; c < spec->members; c++) {
+            const bw_axis *other = &inst->data.axes[spec->axis[c]];
+            if (other->parameters[i] == first->parameters[i]) continue;
+            bw_format_double(a, sizeof a, first->parameters[i]);
+            bw_format_double(b, sizeof b, other->parameters[i]);
+            bw_log(inst, BW_ERROR, "logStatusError", "%s%s.%s = %s, %s.%s = %s [%s] differ: the axes of a coupled "
+                   "group carry one parameter set (set them alike)", spec->label, bw_axis_specs[spec->axis[0]].name,
+                   model->specs[i].name, a, bw_axis_specs[spec->axis[c]].name, model->specs[i].name, b,
+                   model->specs[i].unit);
+            equal = 0;
+        }
+    }
+    for (i = 0; i < model->coupled->zero_parameters; i++) {
+        int k = model->coupled->zero_parameter[i];
+        if (first->parameters[k] == 0.0) continue;
+        bw_format_double(a, sizeof a, first->parameters[k]);
+        bw_log(inst, BW_ERROR, "logStatusError", "%s%s = %s [%s] must be 0 in a coupled group (it has no direction "
+               "in the plane); give the axes an offset and a preload instead", spec->label, model->specs[k].name, a,
+               model->specs[k].unit);
+        equal = 0;
+    }
+    return equal;
 }
 
 /* Validate and prepare one axis's parameters (as BushingModel.validate), logging every
@@ -212,6 +279,18 @@ static int bw_check_parameters(bw_instance *inst) {
         }
         usable = usable && axis->usable;
     }
+    for (a = 0; a < BW_GROUPS; a++) {
+        bw_group *group = &inst->data.groups[a];
+        const bw_group_spec *spec = &bw_group_specs[a];
+        int c, members = 1;
+        for (c = 0; c < spec->members; c++) members = members && inst->data.axes[spec->axis[c]].usable;
+        if (group->parameters_changed && members) {
+            group->parameters_changed = 0;
+            group->equal = bw_check_group(inst, a);
+        }
+        group->usable = members && group->equal && !group->parameters_changed;
+        usable = usable && group->usable;
+    }
     return usable;
 }
 
@@ -262,6 +341,7 @@ static void bw_reset(bw_instance *inst) {
         }
         axis->x_now = -bw_offset(axis, bw_axis_specs[a].model);
         axis->parameters_changed = 1;
+        if (bw_axis_group[a] >= 0) inst->data.groups[bw_axis_group[a]].parameters_changed = 1;
         axis->output_bound = HUGE_VAL;
     }
     inst->data.initial_state_pending = 1;
@@ -271,12 +351,18 @@ static void bw_reset(bw_instance *inst) {
 }
 
 static void bw_set_initial_state(bw_instance *inst) {
-    int a;
+    int a, g;
     for (a = 0; a < BW_AXES; a++) {
         bw_axis *axis = &inst->data.axes[a];
-        bw_axis_specs[a].model->initial_state(&axis->constants, axis->x_now, axis->state);
+        if (bw_axis_group[a] < 0) bw_axis_specs[a].model->initial_state(&axis->constants, axis->x_now, axis->state);
         axis->state_x = axis->x_now;
         axis->output_is_current = 0;
+    }
+    for (g = 0; g < BW_GROUPS; g++) {
+        bw_group *group = &inst->data.groups[g];
+        double v[3];
+        bw_group_inputs(inst, g, group->state_x, v);
+        bw_group_kernels(g)->initial_state(bw_group_constants(inst, g), group->state_x, group->state);
     }
     inst->data.initial_state_pending = 0;
 }
@@ -315,6 +401,12 @@ static bw_status bw_set_parameter(bw_instance *inst, const bw_variable *var, dou
     axis->parameters[var->index] = value;
     axis->parameters_changed = 1;
     axis->output_is_current = 0;
+    if (bw_axis_group[var->axis] >= 0) {
+        const bw_group_spec *group = &bw_group_specs[bw_axis_group[var->axis]];
+        int c;
+        inst->data.groups[bw_axis_group[var->axis]].parameters_changed = 1;
+        for (c = 0; c < group->members; c++) inst->data.axes[group->axis[c]].output_is_current = 0;
+    }
     /* the model's displacement moves with the offset (a jump if it changes during the run) */
     if (var->index == spec->model->offset) axis->x_now = axis->x * spec->to_kernel - value;
     if (!isfinite(value)) {
@@ -327,13 +419,23 @@ static bw_status bw_set_parameter(bw_instance *inst, const bw_variable *var, dou
     return BW_OK;
 }
 
+/* An input of axis a changed: its output is stale, and so is every other member's of its group. */
+static void bw_inputs_changed(bw_instance *inst, int a) {
+    inst->data.axes[a].output_is_current = 0;
+    if (bw_axis_group[a] >= 0) {
+        const bw_group_spec *group = &bw_group_specs[bw_axis_group[a]];
+        int c;
+        for (c = 0; c < group->members; c++) inst->data.axes[group->axis[c]].output_is_current = 0;
+    }
+}
+
 static bw_status bw_set_displacement(bw_instance *inst, int a, double value) {
     bw_axis *axis = &inst->data.axes[a];
     const bw_axis_spec *spec = &bw_axis_specs[a];
     char text[40];
     axis->x = value;
     axis->x_now = value * spec->to_kernel - bw_offset(axis, spec->model);
-    axis->output_is_current = 0;
+    bw_inputs_changed(inst, a);
     if (!isfinite(value)) {
         bw_format_double(text, sizeof text, value);
         bw_log(inst, BW_ERROR, "logStatusError", "input %s = %s %s is not a finite number; the next doStep will "
@@ -358,7 +460,7 @@ static bw_status bw_set_velocity(bw_instance *inst, int a, double value) {
     bw_axis *axis = &inst->data.axes[a];
     const bw_axis_spec *spec = &bw_axis_specs[a];
     axis->v = value;
-    axis->output_is_current = 0;
+    bw_inputs_changed(inst, a);
     if (!isfinite(value)) {
         char text[40];
         bw_format_double(text, sizeof text, value);
@@ -371,12 +473,56 @@ static bw_status bw_set_velocity(bw_instance *inst, int a, double value) {
 /* The axis's output at the current inputs: where x was set away from the displacement of the
    committed state (co-simulation), it includes the model's response to that jump. Never NaN:
    where it cannot be computed it keeps its last finite value, and says so once. */
+/* A coupled group's outputs at the current inputs (each member's, port units, mounting included),
+   the committed state taken through the displacement jump to them in co-simulation; 1 if every one
+   is finite. */
+static int bw_group_outputs(bw_instance *inst, int g, double *outputs) {
+    const bw_group_spec *spec = &bw_group_specs[g];
+    const bw_group *group = &inst->data.groups[g];
+    const bw_coupled_model *kernels = bw_group_kernels(g);
+    const void *constants = bw_group_constants(inst, g);
+    double state[BW_MAX_GROUP_STATES], x[3], v[3], force[3];
+    int c, status = BW_KERNEL_OK;
+    bw_group_inputs(inst, g, x, v);
+    memcpy(state, group->state, sizeof state);
+    if (!inst->model_exchange && (x[0] != group->state_x[0] || x[1] != group->state_x[1] ||
+                                  x[2] != group->state_x[2])) {
+        double jump[3];
+        for (c = 0; c < 3; c++) jump[c] = x[c] - group->state_x[c];
+        status = kernels->jump(constants, state, jump);
+    }
+    kernels->force(constants, state, x, v, force);
+    for (c = 0; c < spec->members; c++) {
+        const bw_axis_spec *member = &bw_axis_specs[spec->axis[c]];
+        outputs[c] = force[c] * member->from_kernel
+                     + bw_preload(&inst->data.axes[spec->axis[c]], member->model) * member->from_kernel;
+        if (!isfinite(outputs[c])) status = BW_KERNEL_NOT_FINITE;
+    }
+    return status == BW_KERNEL_OK;
+}
+
 static double bw_output(bw_instance *inst, int a) {
     bw_axis *axis = &inst->data.axes[a];
     const bw_axis_spec *spec = &bw_axis_specs[a];
     const char *reason = "the parameters are invalid (see the errors above)";
+    int g = bw_axis_group[a];
     if (axis->output_is_current) return axis->last_output;
-    if (bw_check_parameters(inst) || axis->usable) {
+    if (g >= 0) {
+        if (bw_check_parameters(inst) || inst->data.groups[g].usable) {
+            double outputs[3];
+            int c;
+            if (bw_group_outputs(inst, g, outputs)) {
+                for (c = 0; c < bw_group_specs[g].members; c++) {
+                    bw_axis *member = &inst->data.axes[bw_group_specs[g].axis[c]];
+                    member->last_output = outputs[c];
+                    member->output_is_current = 1;
+                    member->stale_output_logged = 0;
+                }
+                return axis->last_output;
+            }
+            reason = "it is not finite at the inputs set (check their units: the FMU takes metres and m/s)";
+        }
+    } else if (bw_check_parameters(inst) || axis->usable) {
         double state[BW_MAX_STATES], output;
         int status = BW_KERNEL_OK;
         memcpy(state, axis->state, sizeof state);
@@ -440,7 +586,10 @@ static bw_status bw_get_real(bw_instance *inst, unsigned int reference, double *
     case BW_DISPLACEMENT: *value = axis->x; break;
     case BW_VELOCITY: *value = axis->v; break;
     case BW_OUTPUT: *value = bw_output(inst, var->axis); break;
-    case BW_STATE: *value = axis->state[var->index] * var->scale; break;
+    case BW_STATE:
+        *value = (bw_axis_group[var->axis] >= 0 ? inst->data.groups[bw_axis_group[var->axis]].state[var->index]
+                                                 : axis->state[var->index]) * var->scale;
+        break;
     case BW_DERIVATIVE: *value = bw_rate(inst, var->axis, var->index) * var->scale; break;
     case BW_INDICATOR: *value = bw_switch(inst, var->axis, var->index) * var->scale; break;
     case BW_TIME: *value = inst->data.time; break;
@@ -493,8 +642,9 @@ static void bw_count_jump(bw_instance *inst, int a, double current_time, double 
    (BW_DISCARD) and leaves every axis as it was. */
 static bw_status bw_do_step(bw_instance *inst, double current_time, double h) {
     double states[BW_AXES][BW_MAX_STATES], x_end[BW_AXES], outputs[BW_AXES];
+    double group_states[BW_GROUP_SLOTS][BW_MAX_GROUP_STATES], group_x_end[BW_GROUP_SLOTS][3];
     char t_text[40], h_text[40];      /* formatted only for a message: the step's hot path does no text */
-    int a;
+    int a, g;
     if (!(h > 0.0 && h < HUGE_VAL)) {
         bw_format_double(h_text, sizeof h_text, h);
         return bw_refuse(inst, "communication step size %s s must be a finite number > 0", h_text);
@@ -522,11 +672,12 @@ static bw_status bw_do_step(bw_instance *inst, double current_time, double h) {
         }
     }
     if (inst->data.initial_state_pending) bw_set_initial_state(inst);
-    for (a = 0; a < BW_AXES; a++) {   /* every axis first, then commit all */
+    for (a = 0; a < BW_AXES; a++) {   /* every axis and group first, then commit all */
         const bw_axis_spec *spec = &bw_axis_specs[a];
         bw_axis *axis = &inst->data.axes[a];
         double x = axis->x_now, v = axis->v * spec->to_kernel;
         int status;
+        if (bw_axis_group[a] >= 0) continue;     /* stepped with its group below */
         memcpy(states[a], axis->state, sizeof states[a]);
         status = spec->model->step(&axis->constants, states[a], axis->state_x, x, v, h, BW_MAX_SUBSTEPS);
         if (status != BW_KERNEL_OK) bw_format_double(t_text, sizeof t_text, current_time);
@@ -554,6 +705,41 @@ static bw_status bw_do_step(bw_instance *inst, double current_time, double h) {
                              spec->rotational ? "rad/s" : "m/s");
         }
     }
+    for (g = 0; g < BW_GROUPS; g++) {
+        const bw_group_spec *group = &bw_group_specs[g];
+        const bw_coupled_model *kernels = bw_group_kernels(g);
+        const void *constants = bw_group_constants(inst, g);
+        double x[3], v[3], force[3];
+        int c, status;
+        bw_group_inputs(inst, g, x, v);
+        memcpy(group_states[g], inst->data.groups[g].state, sizeof group_states[g]);
+        status = kernels->step(constants, group_states[g], inst->data.groups[g].state_x, x, v, h, BW_MAX_SUBSTEPS);
+        if (status != BW_KERNEL_OK) bw_format_double(t_text, sizeof t_text, current_time);
+        if (status == BW_KERNEL_TOO_MANY_SUBSTEPS) {
+            return bw_refuse(inst, "doStep at t = %s s refused: %sthe step of %g s would need more than %d substeps "
+                             "(x = (%g, %g, %g) mm, v = (%g, %g, %g) mm/s); check the units of the inputs (the FMU "
+                             "takes metres and m/s) or shorten the communication step", t_text, group->label, h,
+                             BW_MAX_SUBSTEPS, x[0], x[1], x[2], v[0], v[1], v[2]);
+        }
+        if (status != BW_KERNEL_OK) {
+            return bw_refuse(inst, "doStep at t = %s s refused: %sthe step gave a non-finite state at x = (%g, %g, %g) "
+                             "mm, v = (%g, %g, %g) mm/s; check the units of the inputs (the FMU takes metres and m/s) "
+                             "and the parameters", t_text, group->label, x[0], x[1], x[2], v[0], v[1], v[2]);
+        }
+        for (c = 0; c < 3; c++) group_x_end[g][c] = x[c] + v[c] * h;
+        kernels->force(constants, group_states[g], group_x_end[g], v, force);
+        for (c = 0; c < group->members; c++) {
+            const bw_axis_spec *spec = &bw_axis_specs[group->axis[c]];
+            a = group->axis[c];
+            x_end[a] = group_x_end[g][c];
+            outputs[a] = force[c] * spec->from_kernel + bw_preload(&inst->data.axes[a], spec->model) * spec->from_kernel;
+            if (!isfinite(outputs[a])) {
+                bw_format_double(t_text, sizeof t_text, current_time);
+                return bw_refuse(inst, "doStep at t = %s s refused: %s%s would be %g %s; check the units of the inputs",
+                                 t_text, group->label, spec->output, outputs[a], spec->rotational ? "N.m" : "N");
+            }
+        }
+    }
     for (a = 0; a < BW_AXES; a++) {
         const bw_axis_spec *spec = &bw_axis_specs[a];
         bw_axis *axis = &inst->data.axes[a];
@@ -572,10 +758,14 @@ static bw_status bw_do_step(bw_instance *inst, double current_time, double h) {
                    spec->rotational ? "radians" : "metres");
         }
         if (!inst->jump_warned) bw_count_jump(inst, a, current_time, h);
-        memcpy(axis->state, states[a], sizeof axis->state);
+        if (bw_axis_group[a] < 0) memcpy(axis->state, states[a], sizeof axis->state);
         axis->state_x = axis->x_now = x_end[a];
         axis->last_output = outputs[a];
         axis->output_is_current = 1;
+    }
+    for (g = 0; g < BW_GROUPS; g++) {
+        memcpy(inst->data.groups[g].state, group_states[g], sizeof group_states[g]);
+        memcpy(inst->data.groups[g].state_x, group_x_end[g], sizeof group_x_end[g]);
     }
     inst->data.time = current_time + h;
     return BW_OK;
@@ -589,6 +779,14 @@ static double bw_rate(bw_instance *inst, int a, int index) {
     const bw_axis_spec *spec = &bw_axis_specs[a];
     bw_axis *axis = &inst->data.axes[a];
     double rates[BW_MAX_STATES];
+    int g = bw_axis_group[a];
+    if (g >= 0) {    /* a coupled group's state: index into its flat state */
+        double group_rates[BW_MAX_GROUP_STATES], x[3], v[3];
+        if (!inst->data.groups[g].usable) return 0.0;
+        bw_group_inputs(inst, g, x, v);
+        bw_group_kernels(g)->derivatives(bw_group_constants(inst, g), inst->data.groups[g].state, x, v, group_rates);
+        return group_rates[index];
+    }
     if (!axis->usable) return 0.0;
     spec->model->derivatives(&axis->constants, axis->state, axis->x_now, axis->v * spec->to_kernel, rates);
     return rates[index];
@@ -598,6 +796,15 @@ static double bw_switch(bw_instance *inst, int a, int index) {
     const bw_axis_spec *spec = &bw_axis_specs[a];
     bw_axis *axis = &inst->data.axes[a];
     double values[BW_MAX_SWITCHES];
+    int g = bw_axis_group[a];
+    if (g >= 0) {    /* a coupled group's switches (its first member's indicators) */
+        double group_values[BW_MAX_GROUP_SWITCHES], x[3], v[3];
+        if (!inst->data.groups[g].usable) return 0.0;
+        bw_group_inputs(inst, g, x, v);
+        bw_group_kernels(g)->switch_values(bw_group_constants(inst, g), inst->data.groups[g].state, x, v,
+                                           group_values);
+        return group_values[index];
+    }
     if (!axis->usable) return 0.0;
     spec->model->switch_values(&axis->constants, axis->state, axis->x_now, axis->v * spec->to_kernel, values);
     return values[index];
@@ -613,12 +820,26 @@ static int bw_update_discrete_states(bw_instance *inst, int apply) {
         const bw_axis_spec *spec = &bw_axis_specs[a];
         bw_axis *axis = &inst->data.axes[a];
         double state[BW_MAX_STATES];
+        if (bw_axis_group[a] >= 0) continue;
         memcpy(state, axis->state, sizeof state);
         if (spec->model->update(&axis->constants, state, axis->x_now, axis->v * spec->to_kernel)) {
             changed = 1;
             if (!apply) return 1;
             memcpy(axis->state, state, sizeof axis->state);
             axis->output_is_current = 0;
+        }
+    }
+    for (a = 0; a < BW_GROUPS; a++) {
+        bw_group *group = &inst->data.groups[a];
+        double state[BW_MAX_GROUP_STATES], x[3], v[3];
+        int c;
+        memcpy(state, group->state, sizeof state);
+        bw_group_inputs(inst, a, x, v);
+        if (bw_group_kernels(a)->update(bw_group_constants(inst, a), state, x, v)) {
+            changed = 1;
+            if (!apply) return 1;
+            memcpy(group->state, state, sizeof group->state);
+            for (c = 0; c < bw_group_specs[a].members; c++) inst->data.axes[bw_group_specs[a].axis[c]].output_is_current = 0;
         }
     }
     return changed;
@@ -635,7 +856,10 @@ static bw_status bw_get_continuous_states(bw_instance *inst, double *values, siz
     if (count != BW_CONTINUOUS_STATES) return bw_wrong_count(inst, "continuous states: asked for", count, BW_CONTINUOUS_STATES);
     for (i = 0; i < BW_VARIABLES && k < count; i++) {
         const bw_variable *var = &bw_variables[i];
-        if (var->kind == BW_STATE) values[k++] = inst->data.axes[var->axis].state[var->index] * var->scale;
+        int g = bw_axis_group[var->axis];
+        if (var->kind != BW_STATE) continue;
+        values[k++] = (g >= 0 ? inst->data.groups[g].state[var->index] : inst->data.axes[var->axis].state[var->index])
+                      * var->scale;
     }
     return BW_OK;
 }
@@ -647,10 +871,17 @@ static bw_status bw_set_continuous_states(bw_instance *inst, const double *value
     for (i = 0; i < BW_VARIABLES && k < count; i++) {
         const bw_variable *var = &bw_variables[i];
         bw_axis *axis = &inst->data.axes[var->axis];
+        int g = bw_axis_group[var->axis];
         if (var->kind != BW_STATE) continue;
-        axis->state[var->index] = values[k++] / var->scale;
+        if (g >= 0) {
+            double v[3];
+            inst->data.groups[g].state[var->index] = values[k++] / var->scale;
+            bw_group_inputs(inst, g, inst->data.groups[g].state_x, v);   /* it belongs to the inputs set */
+        } else {
+            axis->state[var->index] = values[k++] / var->scale;
+        }
         axis->state_x = axis->x_now;      /* the host's state belongs to the inputs it set */
-        axis->output_is_current = 0;
+        bw_inputs_changed(inst, var->axis);
     }
     return BW_OK;
 }
@@ -830,6 +1061,73 @@ static bw_status bw_axis_tangent(bw_instance *inst, const char *function, int a,
     return BW_OK;
 }
 
+/* A coupled group's direction: its flat state's, and the members' inputs' as 3-vectors (kernel units). */
+typedef struct {
+    double d_state[BW_MAX_GROUP_STATES];
+    double dx[3], dv[3];
+} bw_group_direction;
+
+/* Group g's members' outputs (port units) and its states' derivatives (kernel units, NULL: not
+   wanted) in a direction, as bw_axis_tangent for one axis: in co-simulation through the jump from
+   the committed state to the inputs, at no jump (of rounding size) a jump of twice that along the
+   velocity, the side the motion continues on. */
+static bw_status bw_group_tangent(bw_instance *inst, const char *function, int g, const bw_group_direction *direction,
+                                  double *d_output, double *d_rates) {
+    const bw_group_spec *spec = &bw_group_specs[g];
+    const bw_group *group = &inst->data.groups[g];
+    const bw_coupled_model *kernels = bw_group_kernels(g);
+    const void *constants = bw_group_constants(inst, g);
+    double state[BW_MAX_GROUP_STATES], d_state[BW_MAX_GROUP_STATES], x[3], v[3], d_force[3];
+    int c, i;
+    bw_group_inputs(inst, g, x, v);
+    memcpy(state, group->state, sizeof state);
+    memcpy(d_state, direction->d_state, sizeof d_state);
+    for (c = 0; c < 3; c++) {
+        if (!isfinite(x[c]) || !isfinite(v[c])) {
+            bw_log(inst, BW_ERROR, "logStatusError", "%s: %sthe inputs are not finite numbers", function, spec->label);
+            return BW_ERROR;
+        }
+    }
+    if (!inst->model_exchange) {
+        double jump[3], length = 0.0, speed = 0.0;
+        for (c = 0; c < 3; c++) {
+            jump[c] = x[c] - group->state_x[c];
+            length += jump[c] * jump[c];
+            speed += v[c] * v[c];
+        }
+        if (sqrt(length) <= BW_ROUNDING_JUMP && speed > 0.0) {
+            for (c = 0; c < 3; c++) jump[c] = 2.0 * BW_ROUNDING_JUMP * v[c] / sqrt(speed);
+        }
+        if (kernels->jump_tangent(constants, state, jump, direction->dx, d_state) != BW_KERNEL_OK) {
+            bw_log(inst, BW_ERROR, "logStatusError", "%s: %sthe outputs cannot be differentiated: the displacement "
+                   "jump from the committed state cannot be taken (check the units of the inputs: metres)", function,
+                   spec->label);
+            return BW_ERROR;
+        }
+    }
+    kernels->force_tangent(constants, state, x, v, d_state, direction->dx, direction->dv, d_force);
+    for (c = 0; c < spec->members; c++) {
+        const bw_axis_spec *member = &bw_axis_specs[spec->axis[c]];
+        d_output[c] = d_force[c] * member->from_kernel;
+        if (!isfinite(d_output[c])) {
+            bw_log(inst, BW_ERROR, "logStatusError", "%s: the derivative of %s is not finite (%g): check the units of "
+                   "the inputs and the states set", function, member->output, d_output[c]);
+            return BW_ERROR;
+        }
+    }
+    if (d_rates) {
+        kernels->derivatives_tangent(constants, state, x, v, d_state, direction->dx, direction->dv, d_rates);
+        for (i = 0; i < kernels->states; i++) {
+            if (!isfinite(d_rates[i])) {
+                bw_log(inst, BW_ERROR, "logStatusError", "%s: %sthe derivative of the rate of state %d is not finite "
+                       "(%g): check the units of the inputs and the states set", function, spec->label, i, d_rates[i]);
+                return BW_ERROR;
+            }
+        }
+    }
+    return BW_OK;
+}
+
 /* An unknown's value in its axis's tangent (port units). */
 static double bw_unknown_tangent(unsigned int unknown, double d_output, const double *d_rates) {
     const bw_variable *var = &bw_variables[unknown];
@@ -841,24 +1139,56 @@ static bw_status bw_directional_derivative(bw_instance *inst, const char *functi
                                            size_t n_unknowns, const unsigned int knowns[], size_t n_knowns,
                                            const double seed[], double sensitivity[]) {
     bw_direction directions[BW_AXES];
+    bw_group_direction group_directions[BW_GROUP_SLOTS];
     double d_output[BW_AXES] = {0.0}, d_rates[BW_AXES][BW_MAX_STATES] = {{0.0}};
-    int wanted[BW_AXES] = {0};
+    double group_d_output[BW_GROUP_SLOTS][3] = {{0.0}}, group_d_rates[BW_GROUP_SLOTS][BW_MAX_GROUP_STATES] = {{0.0}};
+    int wanted[BW_AXES] = {0}, group_wanted[BW_GROUP_SLOTS] = {0};
     size_t i;
-    int a;
+    int a, g;
     bw_status status = bw_check_derivative_variables(inst, function, unknowns, n_unknowns, knowns, n_knowns);
     if (status != BW_OK) return status;
     memset(directions, 0, sizeof directions);
-    for (i = 0; i < n_knowns; i++) bw_seed(&directions[bw_variables[knowns[i]].axis], knowns[i], seed[i]);
-    for (i = 0; i < n_unknowns; i++) wanted[bw_variables[unknowns[i]].axis] = 1;
+    memset(group_directions, 0, sizeof group_directions);
+    for (i = 0; i < n_knowns; i++) {
+        const bw_variable *var = &bw_variables[knowns[i]];
+        g = bw_axis_group[var->axis];
+        if (g < 0) {
+            bw_seed(&directions[var->axis], knowns[i], seed[i]);
+        } else if (var->kind == BW_DISPLACEMENT) {
+            group_directions[g].dx[bw_axis_component[var->axis]] += seed[i] * bw_axis_specs[var->axis].to_kernel;
+        } else if (var->kind == BW_VELOCITY) {
+            group_directions[g].dv[bw_axis_component[var->axis]] += seed[i] * bw_axis_specs[var->axis].to_kernel;
+        } else if (var->kind == BW_STATE) {
+            group_directions[g].d_state[var->index] += seed[i] / var->scale;
+        }
+    }
+    for (i = 0; i < n_unknowns; i++) {
+        a = bw_variables[unknowns[i]].axis;
+        if (bw_axis_group[a] >= 0) group_wanted[bw_axis_group[a]] = 1;
+        else wanted[a] = 1;
+    }
     for (a = 0; a < BW_AXES; a++) {
         if (!wanted[a]) continue;
         status = bw_axis_tangent(inst, function, a, &directions[a], &d_output[a],
                                  inst->model_exchange ? d_rates[a] : NULL);
         if (status != BW_OK) return status;
     }
+    for (g = 0; g < BW_GROUPS; g++) {
+        if (!group_wanted[g]) continue;
+        status = bw_group_tangent(inst, function, g, &group_directions[g], group_d_output[g],
+                                  inst->model_exchange ? group_d_rates[g] : NULL);
+        if (status != BW_OK) return status;
+    }
     for (i = 0; i < n_unknowns; i++) {
-        a = bw_variables[unknowns[i]].axis;
-        sensitivity[i] = bw_unknown_tangent(unknowns[i], d_output[a], d_rates[a]);
+        const bw_variable *var = &bw_variables[unknowns[i]];
+        a = var->axis;
+        g = bw_axis_group[a];
+        if (g < 0) {
+            sensitivity[i] = bw_unknown_tangent(unknowns[i], d_output[a], d_rates[a]);
+        } else {
+            sensitivity[i] = var->kind == BW_OUTPUT ? group_d_output[g][bw_axis_component[a]]
+                                                    : group_d_rates[g][var->index] * var->scale;
+        }
     }
     return BW_OK;
 }

@@ -378,27 +378,27 @@ static int bw3_derivative_arguments(fmi3Instance instance, const char *function,
 }
 
 /* fmi3GetAdjointDerivative (FMI 3 only, so here rather than in bushing_instance.c):
-   sensitivity = J^T * seed, one tangent per known (the column of J that the known's entry of
-   J^T * seed needs), so it equals the transposed Jacobian of bw_directional_derivative to
-   rounding. */
+   sensitivity = J^T * seed, one directional derivative per known (the column of J that the
+   known's entry of J^T * seed needs; an axis's tangent, or a coupled group's), so it equals the
+   transposed Jacobian of bw_directional_derivative to rounding. */
 static bw_status bw_adjoint_derivative(bw_instance *inst, const char *function, const unsigned int unknowns[],
                                        size_t n_unknowns, const unsigned int knowns[], size_t n_knowns,
                                        const double seed[], double sensitivity[]) {
-    double d_rates[BW_MAX_STATES] = {0.0};
+    double column[BW_VARIABLES];
+    const double one = 1.0;
     size_t i, j;
     bw_status status = bw_check_derivative_variables(inst, function, unknowns, n_unknowns, knowns, n_knowns);
     if (status != BW_OK) return status;
+    if (n_unknowns > BW_VARIABLES) {
+        bw_log(inst, BW_ERROR, "logStatusError", "%s: %lu unknowns: this FMU has %d variables", function,
+               (unsigned long)n_unknowns, BW_VARIABLES);
+        return BW_ERROR;
+    }
     for (j = 0; j < n_knowns; j++) {
-        bw_direction direction;
-        double d_output, sum = 0.0;
-        int a = bw_variables[knowns[j]].axis;
-        memset(&direction, 0, sizeof direction);
-        bw_seed(&direction, knowns[j], 1.0);
-        status = bw_axis_tangent(inst, function, a, &direction, &d_output, inst->model_exchange ? d_rates : NULL);
+        double sum = 0.0;
+        status = bw_directional_derivative(inst, function, unknowns, n_unknowns, &knowns[j], 1, &one, column);
         if (status != BW_OK) return status;
-        for (i = 0; i < n_unknowns; i++) {
-            if (bw_variables[unknowns[i]].axis == a) sum += seed[i] * bw_unknown_tangent(unknowns[i], d_output, d_rates);
-        }
+        for (i = 0; i < n_unknowns; i++) sum += seed[i] * column[i];
         sensitivity[j] = sum;
     }
     return BW_OK;
