@@ -115,6 +115,12 @@ def main(argv: list[str] | None = None) -> int:
                                      "kdyn_N_per_mm,loss_angle_deg[,preload_mm][,weight]): each model predicts it")
     compare_parser.add_argument("--models", default=",".join(MODEL_NAMES),
                                 help=f"comma-separated models (default: {','.join(MODEL_NAMES)})")
+    compare_parser.add_argument("--coupling", default=None, metavar="LIST",
+                                help="couplings to weigh on the held-out multi-axis files: none and radial (x, y) "
+                                     "or spherical (x, y, z), comma-separated (e.g. none,radial)")
+    compare_parser.add_argument("--validate-multiaxis", action="append", type=Path, default=[], metavar="FILE",
+                                help="multi-axis test held out of the fits (CSV time_s,dx_mm,dy_mm,Fx_N,Fy_N[,dz_mm,"
+                                     "Fz_N]); each model predicts it with each --coupling; repeatable")
     compare_parser.add_argument("--out", type=Path, required=True,
                                 help="directory for the fitted parameter files, the table (CSV) and the plots")
 

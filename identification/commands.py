@@ -334,9 +334,37 @@ def compare_command(args) -> int:
     if unknown:
         raise UsageError(f"unknown models {unknown}; choose from {', '.join(MODEL_NAMES)}")
     models = [get_model(name) for name in models]          # resolved once, passed on
+    couplings = couplings_of(args.coupling, args.validate_multiaxis)
+    from identification.multiaxis import load_multiaxis
+    multiaxis = [load_multiaxis(path) for path in args.validate_multiaxis]    # a bad file: refused before any fit
+    planar = [m.name for m in multiaxis if m.displacement_mm.shape[1] != 3]
+    if "spherical" in couplings and planar:
+        raise UsageError(f"--coupling spherical needs multi-axis files of three axes (dz_mm, Fz_N); "
+                         f"{', '.join(planar)} {'has' if len(planar) == 1 else 'have'} two")
     prepare_directory(args.out, "--out")
     validation = args.validate or [Path(t.measurement.source) for t in tests]
     compare_models(models, tests, validation, args.out, preset=args.preset, seed=args.seed, workers=args.workers,
                    scheduler=args.scheduler, screening=args.screening, starts=args.starts,
-                   ensemble=not args.no_ensemble, table=table)
+                   ensemble=not args.no_ensemble, table=table, multiaxis=multiaxis, couplings=couplings)
     return 0
+
+
+COMPARED_COUPLINGS = ("none", "radial", "spherical")
+
+
+def couplings_of(text: str | None, multiaxis_files) -> tuple[str, ...]:
+    """The couplings of compare's --coupling (none, radial, spherical), each checked against the
+    multi-axis files it needs; UsageError naming what is allowed."""
+    if text is None:
+        if multiaxis_files:
+            raise UsageError("--validate-multiaxis needs --coupling: the couplings to weigh, e.g. --coupling none,radial")
+        return ()
+    couplings = tuple(part.strip() for part in text.split(",") if part.strip())
+    unknown = [name for name in couplings if name not in COMPARED_COUPLINGS]
+    if unknown or not couplings:
+        raise UsageError(f"--coupling {text}: {', '.join(map(repr, unknown)) or 'nothing'} is not a coupling compare "
+                         f"weighs; allowed: {', '.join(COMPARED_COUPLINGS)}, comma-separated")
+    if not multiaxis_files:
+        raise UsageError(f"--coupling {text} needs held-out multi-axis files to weigh them on: give "
+                         "--validate-multiaxis FILE")
+    return couplings

@@ -40,7 +40,7 @@ import numpy as np
 
 from fmu_src.bushing_models import BushingModel, resolve_model
 from identification.engine import make_engine
-from identification.errors import FitNotConvergedWarning
+from identification.errors import FitNotConvergedWarning, IdentificationError
 from identification.fit_result import FLOOR_FACTOR, FitResult, TableFit, information_criterion
 from identification.fitting import fit, table_fit
 from identification.interrupt import writing
@@ -147,7 +147,7 @@ def _predicting_best(pool: list[Assessment], tolerance: float, why: list[str]) -
 def compare_models(models: Sequence[str | BushingModel], tests: Sequence[RigTest], validation_files: Sequence[Path],
                    out_dir: Path, preset: str = "default", seed: int = 0, workers: int | None = None,
                    scheduler=None, screening: int | None = None, starts: int | None = None, ensemble: bool = True,
-                   table: KdynTable | None = None) -> dict:
+                   table: KdynTable | None = None, multiaxis=(), couplings: Sequence[str] = ()) -> dict:
     """Fit every model on ``tests``, assess it on the training tests, on the ``validation_files``
     and on the held-out dynamic-stiffness ``table``, write the files (module docstring) and
     recommend one. ``models``: names or ``BushingModel``s, each resolved once here and passed on.
@@ -191,20 +191,95 @@ def compare_models(models: Sequence[str | BushingModel], tests: Sequence[RigTest
     if table is not None:
         plot_table_comparison(table, {a.model: a.table for a in assessments}, out_dir / f"compare_{table.name}.png")
     recommendation = recommend(assessments)
+    coupling = weigh_couplings(parameters, bushings, multiaxis, couplings, recommendation.model) if couplings else None
 
     print(format_assessments(assessments, recommendation))
     if validation:
         print(format_comparison(errors, models, [Path(m.source).name for m in validation], training_names))
     if table is not None:
         print(format_table_errors(table, assessments))
+    if coupling is not None:
+        print(coupling.format())
     _write_csvs(out_dir, assessments, recommendation, errors, table)
-    print(f"wrote {out_dir}/comparison.csv, validation.csv{', kdyn_errors.csv' if table is not None else ''}, "
-          "params_<model>.json and compare_*.png", file=sys.stderr)
+    if coupling is not None:
+        coupling.write(out_dir / "coupling.csv")
+    print(f"wrote {out_dir}/comparison.csv, validation.csv{', kdyn_errors.csv' if table is not None else ''}"
+          f"{', coupling.csv' if coupling is not None else ''}, params_<model>.json and compare_*.png", file=sys.stderr)
     if recommendation.caveat:
         print(f"note: {recommendation.caveat}")
+    if coupling is not None:
+        print(f"recommended coupling: {coupling.chosen} ({coupling.reason})")
     print(f"why: {recommendation.reason}")
     print(f"recommended: {recommendation.model}")
-    return {"parameters": parameters, "errors": errors, "assessments": assessments, "recommendation": recommendation}
+    return {"parameters": parameters, "errors": errors, "assessments": assessments, "recommendation": recommendation,
+            "coupling": coupling}
+
+
+@dataclass
+class CouplingChoice:
+    """How each model predicts the held-out multi-axis files with each coupling, and the coupling
+    chosen for the recommended model: the lowest mean NRMSE of the force vector, where another is
+    within ``PREDICTION_TOLERANCE`` of it the simpler (none before radial before spherical)."""
+    errors: dict                        # (model, coupling): [NRMSE per file]
+    files: list[str]
+    couplings: tuple[str, ...]
+    model: str
+    chosen: str
+    reason: str
+
+    def format(self) -> str:
+        lines = [f"held-out multi-axis files ({', '.join(self.files)}): mean NRMSE of the force vector"]
+        lines.append(f"{'model':17s}" + "".join(f"{coupling:>12s}" for coupling in self.couplings))
+        for model in dict.fromkeys(m for m, _ in self.errors):
+            lines.append(f"{model:17s}" + "".join(f"{np.mean(self.errors[model, c]):12.2%}" for c in self.couplings))
+        return "\n".join(lines)
+
+    def write(self, path: Path) -> None:
+        with writing(path) as temporary, open(temporary, "w", newline="") as handle:
+            writer = csv.writer(handle)
+            writer.writerow(["model", "coupling", "file", "vector_nrmse", "chosen"])
+            for (model, coupling), values in self.errors.items():
+                for name, value in zip(self.files, values):
+                    writer.writerow([model, coupling, name, f"{value:.6g}",
+                                     model == self.model and coupling == self.chosen])
+
+
+def weigh_couplings(parameters: dict, bushings, multiaxis, couplings: Sequence[str], model: str,
+                    tolerance: float = PREDICTION_TOLERANCE) -> CouplingChoice:
+    """Each model's predictions of the multi-axis files with each coupling (``multiaxis.simulate_multiaxis``:
+    none, its one-axis model on each axis; radial and spherical, its coupled form), and the coupling
+    for ``model`` (:class:`CouplingChoice`). A spherical coupling needs files of three axes, radial
+    of two or of three (then on x and y, z alone)."""
+    from identification.multiaxis import simulate_multiaxis, vector_nrmse
+    errors = {}
+    for bushing in bushings:
+        for coupling in couplings:
+            values = []
+            for m in multiaxis:
+                d = m.displacement_mm.shape[1]
+                if coupling == "spherical" and d != 3:
+                    raise IdentificationError(f"{m.source}: the spherical coupling needs three axes (dz_mm, Fz_N); "
+                                              "this file has two")
+                if coupling == "radial" and d == 3:     # x and y coupled, z on its own
+                    plane = simulate_multiaxis(parameters[bushing.name], m.time_s, m.displacement_mm[:, :2],
+                                               bushing, coupled=True)
+                    axial = simulate_multiaxis(parameters[bushing.name], m.time_s, m.displacement_mm, bushing,
+                                               coupled=False)[:, 2:]
+                    predicted = np.column_stack([plane, axial])
+                else:
+                    predicted = simulate_multiaxis(parameters[bushing.name], m.time_s, m.displacement_mm, bushing,
+                                                   coupled=coupling != "none")
+                values.append(vector_nrmse(predicted, m.force_N))
+            errors[bushing.name, coupling] = values
+    means = {coupling: float(np.mean(errors[model, coupling])) for coupling in couplings}
+    best = min(means.values())
+    order = [c for c in ("none", "radial", "spherical") if c in couplings]
+    chosen = next(c for c in order if means[c] <= (1.0 + tolerance) * best)
+    others = ", ".join(f"{c} {means[c]:.2%}" for c in order if c != chosen)
+    reason = (f"{model} predicts the held-out multi-axis files with {means[chosen]:.2%} NRMSE of the force vector"
+              + (f" against {others}" if others else "")
+              + ("; the simplest within 10 % of the best" if chosen != min(means, key=means.get) else ""))
+    return CouplingChoice(errors, [m.name for m in multiaxis], tuple(couplings), model, chosen, reason)
 
 
 def format_assessments(assessments: Sequence[Assessment], recommendation: Recommendation) -> str:

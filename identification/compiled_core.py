@@ -73,6 +73,35 @@ def _population_forces(matrix, t, x, v, out_index, out_velocity, max_substeps, s
     return forces
 
 
+def _coupled_population_forces(matrix, t, x, v, max_substeps):
+    """Force vectors (P, samples, 3) of every parameter set (rows of ``matrix``) on the path ``x``
+    (samples, 3) [mm], the model's coupled form under the FMU's input convention: over
+    [t_k, t_k+1] the displacement x_k + v_k*(t - t_k) with ``v`` (samples, 3) the step's velocity,
+    the force at t_k+1 with the velocity v_k; relaxed at x_0. NaN from where a candidate fails.
+
+    Written here, never called here: compiled in a coupled model's generated module, where
+    ``initial_state_coupled``, ``step_coupled`` and ``force_coupled`` are its compiled kernels."""
+    count, samples = matrix.shape[0], t.size
+    forces = np.full((count, samples, 3), np.nan)
+    for i in numba.prange(count):
+        m = prepare(_VALUES(matrix[i]))
+        state_x = (x[0, 0], x[0, 1], x[0, 2])
+        state = initial_state_coupled(m, state_x)
+        f = force_coupled(m, state, state_x, (v[0, 0], v[0, 1], v[0, 2]))
+        forces[i, 0, 0], forces[i, 0, 1], forces[i, 0, 2] = f[0], f[1], f[2]
+        for k in range(samples - 1):
+            h = t[k + 1] - t[k]
+            position = (x[k, 0], x[k, 1], x[k, 2])
+            velocity = (v[k, 0], v[k, 1], v[k, 2])
+            state, used, status = step_coupled(m, state, state_x, position, velocity, h, max_substeps)
+            if status != _OK:
+                break
+            state_x = (position[0] + velocity[0] * h, position[1] + velocity[1] * h, position[2] + velocity[2] * h)
+            f = force_coupled(m, state, state_x, velocity)
+            forces[i, k + 1, 0], forces[i, k + 1, 1], forces[i, k + 1, 2] = f[0], f[1], f[2]
+    return forces
+
+
 def _population_appendix(model) -> str:
     """The population loops for ``model``: ``_VALUES(row)`` (the row's values as the tuple its
     ``prepare`` takes), ``_simulate_population`` and ``_sine_steady_state``
@@ -86,7 +115,10 @@ def _population_appendix(model) -> str:
             + f"ROUNDING = {steady_state.ROUNDING!r}\n\n\n"
             + inspect.getsource(steady_state._sine_steady_state)
             + "\n\n_sine_steady_state = numba.njit(error_model='numpy', parallel=True, cache=True)"
-              "(_sine_steady_state)\n")
+              "(_sine_steady_state)\n"
+            + ("\n\n" + inspect.getsource(_coupled_population_forces)
+               + "\n\n_simulate_coupled_population = numba.njit(error_model='numpy', parallel=True, cache=True)"
+                 "(_coupled_population_forces)\n" if model.coupled is not None else ""))
 
 
 _compiled_models: dict[str, types.ModuleType] = {}
@@ -137,6 +169,28 @@ def simulate_population_at(parameter_sets, time_s, displacement_mm, velocity_mm_
     model = resolve_model(model)
     return compiled_model(model)._simulate_population(parameter_matrix(parameter_sets, model), t, x, v, out_index,
                                                       out_velocity, max_substeps, *_step_sizes(t))
+
+
+def simulate_coupled_held(parameter_sets, time_s, displacement_mm, velocity_mm_s,
+                          max_substeps: int = _MAX_SUBSTEPS, model: str | BushingModel = "proposed") -> np.ndarray:
+    """Force vectors [N], shape (P, samples, d), of P parameter sets of ``model``'s coupled form on
+    the path ``displacement_mm`` (samples, d = 2 or 3) [mm] with the steps' velocities
+    ``velocity_mm_s`` (samples, d) [mm/s], under the FMU's input convention (as
+    :func:`simulate_population_held` for one axis). Runs on all cores."""
+    model = resolve_model(model)
+    if model.coupled is None:
+        raise ValueError(f"the {model.name} model has no coupled form")
+    t = np.ascontiguousarray(time_s, dtype=float)
+    x = np.atleast_2d(np.asarray(displacement_mm, dtype=float))
+    v = np.atleast_2d(np.asarray(velocity_mm_s, dtype=float))
+    d = x.shape[1]
+    if not (t.ndim == 1 and t.size >= 2 and x.shape == v.shape == (t.size, d) and d in (2, 3)):
+        raise ValueError(f"time (samples,) and displacement and velocity (samples, 2 or 3): got {t.shape}, {x.shape}, "
+                         f"{v.shape}")
+    pad = lambda a: np.ascontiguousarray(np.column_stack([a, np.zeros((t.size, 3 - d))]))   # noqa: E731
+    forces = compiled_model(model)._simulate_coupled_population(parameter_matrix(parameter_sets, model), t, pad(x),
+                                                                pad(v), max_substeps)
+    return forces[:, :, :d]
 
 
 MAX_STEP_SIZES = 256
