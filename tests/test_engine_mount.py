@@ -21,11 +21,13 @@ STEP = 1e-3
 STOP = 0.12
 
 
-def run_road(out: Path, native: bool = False):
+def run_road(out: Path, native: bool = False, coupling: str = "none"):
     """The road case written as SSP in ``out`` and run in libcosim and fmpy: (body, libcosim, fmpy)."""
-    bushing_fmu, body_fmu = engine_mount.build_fmus(out / "fmus", native=native)
+    out.mkdir(parents=True, exist_ok=True)
+    bushing_set = engine_mount.coupled_set(out, coupling)
+    bushing_fmu, body_fmu = engine_mount.build_fmus(out / "fmus", bushing_set, native=native)
     body = engine_mount.body_parameters()
-    parts = engine_mount.write_system(out / "EngineMount", bushing_fmu, body_fmu, STOP, body)
+    parts = engine_mount.write_system(out / "EngineMount", bushing_fmu, body_fmu, STOP, body, bushing_set)
     libcosim = ssp_system.run_libcosim(out / "EngineMount", parts, STEP, STOP)
     fmpy_run = ssp_system.run_fmpy(parts, engine_mount.connections(), STEP, STOP)
     return body, libcosim, fmpy_run
@@ -53,6 +55,18 @@ def test_with_native_six_axis_fmus_libcosim_and_fmpy_agree_and_give_the_pythonfm
     _, libcosim, fmpy_run = run_road(tmp_path, native=True)
     assert max(ssp_system.largest_difference(libcosim, fmpy_run).values()) <= 1e-12
     assert max(ssp_system.largest_difference(libcosim, libcosim_python).values()) <= 1e-12
+
+
+@pytest.mark.parametrize("native", [False, True])
+def test_with_radially_coupled_mounts_the_masters_agree_and_the_momentum_balances(road_runs, tmp_path, native):
+    # x and y of every mount one coupled group: each axis's force now depends on the other's motion
+    body, libcosim, fmpy_run = run_road(tmp_path, native=native, coupling="radial")
+    assert max(ssp_system.largest_difference(libcosim, fmpy_run).values()) < 1e-9
+    balance = engine_mount.momentum_balance(fmpy_run, STEP, body)
+    assert balance["momentum"] < 1e-6 and balance["angular momentum"] < 1e-6
+    _, uncoupled, _ = road_runs
+    left = [np.hypot(run["bushing_left.Fx"], run["bushing_left.Fy"]) for run in (libcosim, uncoupled)]
+    assert 0.0 < np.max(np.abs(left[0] - left[1])) < 0.1 * np.max(left[1])     # it changes the forces, a little
 
 
 def test_momentum_changes_by_the_bushing_impulses(road_runs):
