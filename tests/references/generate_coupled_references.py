@@ -98,15 +98,20 @@ def bouc_wen(z: np.ndarray, u: np.ndarray, A: float, beta: float, gamma: float, 
     return A * u - r2 ** (0.5 * n - 1.0) * (gamma * zu + beta * abs(zu)) * z
 
 
-class Proposed:
-    """Eqs. 1-5 on each component; state (y, z1, w, z2), 2-vectors each."""
-    size = 8
+class _Bushing:
+    """A coupled model of parameters ``p`` whose ODE state (``size`` floats) starts at rest at 0."""
+    size = 0
 
     def __init__(self, p):
         self.p = p
 
     def initial(self):
         return np.zeros(self.size)
+
+
+class Proposed(_Bushing):
+    """Eqs. 1-5 on each component; state (y, z1, w, z2), 2-vectors each."""
+    size = 8
 
     def rates(self, s, x, v):
         p = self.p
@@ -122,17 +127,14 @@ class Proposed:
         return p["k0"] * s[0:2] + p["c0"] * dw
 
 
-class Spencer:
+class Spencer(_Bushing):
     """Spencer et al. on each component (x0 = 0); state (y, z). Spencer's gamma on |z.u|, beta on z.u."""
     size = 4
 
     def __init__(self, p):
         if p["x0"] != 0.0:
             raise ValueError("the coupled Spencer model takes x0 = 0")
-        self.p = p
-
-    def initial(self):
-        return np.zeros(self.size)
+        super().__init__(p)
 
     def u(self, s, x, v):
         p = self.p
@@ -148,15 +150,9 @@ class Spencer:
         return p["c1"] * (v - self.u(s, x, v)) + p["k1"] * x
 
 
-class SingleBoucWen:
+class SingleBoucWen(_Bushing):
     """F = c0*v + k0*x + alpha*z; state z."""
     size = 2
-
-    def __init__(self, p):
-        self.p = p
-
-    def initial(self):
-        return np.zeros(self.size)
 
     def rates(self, s, x, v):
         p = self.p
