@@ -325,17 +325,18 @@ def across_decay(s0, s1, xi_parallel, A):
     return 0.0
 
 
-def rotation_pieces(s0, s_end, across, A, beta, gamma, n, sigma, limit):
+def rotation_pieces(s0, zn, s_end, across, A, beta, gamma, n, sigma, limit):
     """Pieces so that z's direction turns by at most THETA_ROTATION per piece, weighted by the
-    nonlinear share of the gain: from the parallel force s0 [N] towards about s_end, with
-    ``across`` the norm of A times the travel across z [N]; at most ``limit`` + 1 (the caller's
-    limit of substeps, so that more is refused, not computed)."""
+    nonlinear share of the gain: from the parallel force s0 [N] (``zn`` = |s0|^n) towards about
+    s_end, with ``across`` the norm of A times the travel across z [N]; at most ``limit`` + 1 (the
+    caller's limit of substeps, so that more is refused, not computed)."""
     if across == 0.0 or A == 0.0:
         return 1
     reference = max(abs(s0), abs(s_end))
     if reference == 0.0:
         return 1
-    share = abs(gamma + beta * sigma) * reference ** n / abs(A)
+    power = zn if reference == abs(s0) else reference ** n
+    share = abs(gamma + beta * sigma) * power / abs(A)
     turn = across / reference * share
     if turn <= THETA_ROTATION:
         return 1
@@ -367,26 +368,25 @@ def vector_walk(z, travel, A, beta, gamma, n, heun_limit, theta, max_pieces):
     while True:
         e = block_frame(z, remaining, (0.0, 0.0, 0.0))
         s0 = vector_dot(z, e)
+        zn = abs(s0) ** n
         along = vector_dot(remaining, e)
         sigma = 1.0 if along * s0 >= 0.0 else -1.0
-        g0 = A - (gamma + beta * sigma) * abs(s0) ** n
+        g0 = A - (gamma + beta * sigma) * zn
         across = A * vector_norm(vector_axpy(-along, e, remaining))
-        count = rotation_pieces(s0, s0 + g0 * along, across, A, beta, gamma, n, sigma, max_pieces)
+        count = rotation_pieces(s0, zn, s0 + g0 * along, across, A, beta, gamma, n, sigma, max_pieces)
         if used + 1 > max_pieces or count > max_pieces:
             return z, TOO_MANY_SUBSTEPS
         if count == 1:
             piece = remaining
         else:
             piece = vector_scale(1.0 / count, remaining)
-        predicted, status = vector_walk_frame(z, piece, e, A, beta, gamma, n, heun_limit, theta, max_pieces)
+        # the frame of the mean of z and its linear prediction at the piece's end, z + g0*along*e + A*across
+        along_piece = vector_dot(piece, e)
+        predicted = vector_axpy(g0 * along_piece, e, vector_axpy(A, vector_axpy(-along_piece, e, piece), z))
+        middle = vector_direction(vector_axpy(1.0, z, predicted), e)
+        predicted, status = vector_walk_frame(z, piece, middle, A, beta, gamma, n, heun_limit, theta, max_pieces)
         if status != OK:
             return z, status
-        middle = vector_direction(vector_axpy(1.0, z, predicted), e)
-        if middle[0] != e[0] or middle[1] != e[1] or middle[2] != e[2]:
-            predicted, status = vector_walk_frame(z, piece, middle, A, beta, gamma, n, heun_limit, theta,
-                                                  max_pieces)
-            if status != OK:
-                return z, status
         z = predicted
         used += 1
         if count == 1:
@@ -428,28 +428,46 @@ def vector_block_frame(u, z, h, a, blk, e):
             vector_axpy(xi_along, e, vector_axpy(h * phi1, u_across, vector_scale(h * h * phi2, a_across))))
 
 
-def vector_block_step(u, z, h, a, blk):
-    """A coupled block (3-vectors u [mm/s], z [N], drive a [mm/s^2]) advanced by h [s]: in the
-    frame of z, then again in the frame of the mean of z's start and predicted end; returns
-    (u, z, xi), xi the relative displacement over the step."""
-    e = block_frame(z, u, a)
-    u1, z1, xi = vector_block_frame(u, z, h, a, blk, e)
-    middle = vector_direction(vector_axpy(1.0, z, z1), e)
-    if middle[0] != e[0] or middle[1] != e[1] or middle[2] != e[2]:
-        return vector_block_frame(u, z, h, a, blk, middle)
-    return u1, z1, xi
-
-
-def vector_substeps_needed(u, z, T, a, blk, limit):
-    """Substeps of a coupled block over the remaining interval T [s]: those of its part along z
-    (:func:`substeps_needed`) and those that bound the turn of z's direction
-    (:func:`rotation_pieces`, at most ``limit`` + 1)."""
-    K, alpha, c, A, beta, gamma, n = blk
+def vector_block_view(u, z, a, n):
+    """(e, s0, |s0|^n): a coupled block's frame (:func:`block_frame`), its force along it, and that
+    force's power n, which the substeps (:func:`vector_substeps_needed`) and the step
+    (:func:`vector_block_step`) share (a power is most of a step's cost)."""
     e = block_frame(z, u, a)
     s0 = vector_dot(z, e)
+    return e, s0, abs(s0) ** n
+
+
+def vector_block_step(u, z, h, a, blk, view):
+    """A coupled block (3-vectors u [mm/s], z [N], drive a [mm/s^2]; ``view`` its
+    :func:`vector_block_view`) advanced by h [s] in the frame of the mean of z's start and its
+    linear prediction at the end, z + g*xi_along*e + A*xi_across (the travels at the frozen rates:
+    the midpoint rule in the frame's turn, at the cost of two exponentials); returns (u, z, xi), xi
+    the relative displacement over the step."""
+    K, alpha, c, A, beta, gamma, n = blk
+    e, s0, zn = view
     u_along = vector_dot(u, e)
     a_along = vector_dot(a, e)
-    count = substeps_needed(u_along, s0, abs(s0) ** n, T, a_along, blk)
+    moving = u_along if u_along != 0.0 else a_along
+    sigma = 1.0 if moving * s0 >= 0.0 else -1.0
+    g0 = A - (gamma + beta * sigma) * zn
+    E, phi1, phi2 = decay_factors((K + alpha * g0) / c * h)
+    xi_along = h * (u_along * phi1 + a_along * h * phi2)
+    E, phi1, phi2 = decay_factors((K + alpha * A) / c * h)
+    xi_across = vector_axpy(h * phi1, vector_axpy(-u_along, e, u),
+                            vector_scale(h * h * phi2, vector_axpy(-a_along, e, a)))
+    predicted = vector_axpy(g0 * xi_along, e, vector_axpy(A, xi_across, z))
+    return vector_block_frame(u, z, h, a, blk, vector_direction(vector_axpy(1.0, z, predicted), e))
+
+
+def vector_substeps_needed(u, z, T, a, blk, limit, view):
+    """Substeps of a coupled block over the remaining interval T [s] (``view`` its
+    :func:`vector_block_view`): those of its part along z (:func:`substeps_needed`) and those that
+    bound the turn of z's direction (:func:`rotation_pieces`, at most ``limit`` + 1)."""
+    K, alpha, c, A, beta, gamma, n = blk
+    e, s0, zn = view
+    u_along = vector_dot(u, e)
+    a_along = vector_dot(a, e)
+    count = substeps_needed(u_along, s0, zn, T, a_along, blk)
     u_across = vector_axpy(-u_along, e, u)
     a_across = vector_axpy(-a_along, e, a)
     E, phi1, phi2 = decay_factors((K + alpha * A) / c * T)
@@ -458,10 +476,10 @@ def vector_substeps_needed(u, z, T, a, blk, limit):
         return count
     moving = u_along if u_along != 0.0 else a_along
     sigma = 1.0 if moving * s0 >= 0.0 else -1.0
-    g0 = A - (gamma + beta * sigma) * abs(s0) ** n
+    g0 = A - (gamma + beta * sigma) * zn
     E, phi1, phi2 = decay_factors((K + alpha * g0) / c * T)
     s_end = s0 + g0 * (T * (u_along * phi1 + a_along * T * phi2))
-    turn = rotation_pieces(s0, s_end, across, A, beta, gamma, n, sigma, limit)
+    turn = rotation_pieces(s0, zn, s_end, across, A, beta, gamma, n, sigma, limit)
     return turn if turn > count else count
 
 

@@ -28,8 +28,8 @@ import math
 
 from .bushing_params import DAMPING, EXPONENT, GAIN, SPRING, WEIGHT, Constraint, ParameterSpec
 from .integration import (DEFAULT_MAX_SUBSTEPS, HEUN_JUMP_LIMIT, NOT_FINITE, OK, THETA_JUMP, TOO_MANY_SUBSTEPS,
-                          block_gain, block_power, block_step, substeps_needed, vector_block_step, vector_dot,
-                          vector_gain, vector_substeps_needed, vector_walk, walk_along_xi)
+                          block_gain, block_power, block_step, substeps_needed, vector_block_step, vector_block_view,
+                          vector_dot, vector_gain, vector_substeps_needed, vector_walk, walk_along_xi)
 from .model_definition import BushingModel, CoupledKernels, SearchBox, SearchCoordinate, StateSpec
 
 IDENTIFIER = "BoucWenBushing"
@@ -213,14 +213,16 @@ def integrate_coupled(m, state, x, v, h, max_substeps):
         x_now = tuple(x[i] + v[i] * elapsed for i in range(3))
         u1 = tuple(-(k1 * (x_now[i] - y[i]) - k0 * y[i] + alpha1 * z1[i]) / c1 for i in range(3))
         u2 = tuple((c0 * v[i] - k2 * (x_now[i] - w[i]) - alpha2 * z2[i]) / C for i in range(3))
-        count = max(vector_substeps_needed(u1, z1, remaining, a1, blk1, max_substeps),
-                    vector_substeps_needed(u2, z2, remaining, (0.0, 0.0, 0.0), blk2, max_substeps))
+        view1 = vector_block_view(u1, z1, a1, blk1[6])
+        view2 = vector_block_view(u2, z2, (0.0, 0.0, 0.0), blk2[6])
+        count = max(vector_substeps_needed(u1, z1, remaining, a1, blk1, max_substeps, view1),
+                    vector_substeps_needed(u2, z2, remaining, (0.0, 0.0, 0.0), blk2, max_substeps, view2))
         if used + 1 > max_substeps or count > max_substeps:
             return (y[0], y[1], y[2], z1[0], z1[1], z1[2], w[0], w[1], w[2], z2[0], z2[1], z2[2]), used, \
                 TOO_MANY_SUBSTEPS
         sub = remaining if count == 1 else remaining / count
-        u1, z1, xi1 = vector_block_step(u1, z1, sub, a1, blk1)
-        u2, z2, xi2 = vector_block_step(u2, z2, sub, (0.0, 0.0, 0.0), blk2)
+        u1, z1, xi1 = vector_block_step(u1, z1, sub, a1, blk1, view1)
+        u2, z2, xi2 = vector_block_step(u2, z2, sub, (0.0, 0.0, 0.0), blk2, view2)
         elapsed = h if count == 1 else elapsed + sub
         x_now = tuple(x[i] + v[i] * elapsed for i in range(3))
         # as the one-axis step: the invariant keeps y consistent with u1

@@ -20,8 +20,8 @@ import math
 
 from .bushing_params import DAMPING, EXPONENT, GAIN, SPRING, WEIGHT, Constraint, ParameterSpec
 from .integration import (DEFAULT_MAX_SUBSTEPS, HEUN_JUMP_LIMIT, NOT_FINITE, OK, THETA_JUMP, TOO_MANY_SUBSTEPS,
-                          block_gain, block_power, block_step, substeps_needed, vector_block_step, vector_dot,
-                          vector_gain, vector_substeps_needed, vector_walk, walk_along_xi)
+                          block_gain, block_power, block_step, substeps_needed, vector_block_step, vector_block_view,
+                          vector_dot, vector_gain, vector_substeps_needed, vector_walk, walk_along_xi)
 from .model_definition import BushingModel, CoupledKernels, SearchBox, SearchCoordinate, StateSpec
 
 PARAMETER_SPECS = (
@@ -161,11 +161,12 @@ def integrate_coupled(m, state, x, v, h, max_substeps):
     while True:
         remaining = h - elapsed
         u = _relative_velocity_coupled(m, y, z, tuple(x[i] + v[i] * elapsed for i in range(3)), v)
-        count = vector_substeps_needed(u, z, remaining, (0.0, 0.0, 0.0), blk, max_substeps)
+        view = vector_block_view(u, z, (0.0, 0.0, 0.0), blk[6])
+        count = vector_substeps_needed(u, z, remaining, (0.0, 0.0, 0.0), blk, max_substeps, view)
         if used + 1 > max_substeps or count > max_substeps:
             return (y[0], y[1], y[2], z[0], z[1], z[2]), used, TOO_MANY_SUBSTEPS
         sub = remaining if count == 1 else remaining / count
-        u, z, xi = vector_block_step(u, z, sub, (0.0, 0.0, 0.0), blk)
+        u, z, xi = vector_block_step(u, z, sub, (0.0, 0.0, 0.0), blk, view)
         elapsed = h if count == 1 else elapsed + sub
         y = tuple(y[i] + v[i] * sub - xi[i] for i in range(3))
         used += 1
