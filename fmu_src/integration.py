@@ -261,10 +261,9 @@ def walk_along_xi(z, xi_total, A, beta, gamma, n, heun_limit, theta, max_pieces)
 # part across e is linear (rate (K + alpha*A)/c for a block, exact exponentials) and feeds z across
 # at A*u, while the nonlinear term shrinks (or, unloading, grows) that part at the rate
 # psi = (gamma + beta*sgn)*|z|^(n-2)*(z.u), whose integral over the step the parallel solve gives:
-# integral(psi*s dt) = A*xi_parallel - (s1 - s0). Then the same step again in the frame of the
-# mean of the start and the predicted end of z (the midpoint rule: second order in the frame's
-# turn). Substeps also bound that turn, weighted by the nonlinear share of the gain
-# (THETA_ROTATION). Measured against scipy's Radau on circles, ellipses and random plane paths:
+# integral(psi*s dt) = A*xi_parallel - (s1 - s0). The frame is that of the mean of z and its linear
+# prediction at the step's end (the midpoint rule: second order in the frame's turn). Substeps
+# also bound that turn, weighted by the nonlinear share of the gain (THETA_ROTATION). Measured against scipy's Radau on circles, ellipses and random plane paths:
 # tests/test_coupled_models.py.
 
 THETA_ROTATION = 0.1
@@ -361,8 +360,8 @@ def vector_walk(z, travel, A, beta, gamma, n, heun_limit, theta, max_pieces):
     """z (a 3-vector, N) after the straight relative displacement ``travel`` [mm] of a coupled
     Bouc-Wen element (``walk_along_xi`` across space: a displacement jump, or a step of an element
     driven by the displacement itself); returns (z, status). Pieces bound the turn of z's
-    direction (THETA_ROTATION), each stepped in the frame of z and again in the frame of the mean
-    of its start and predicted end."""
+    direction (THETA_ROTATION), each stepped in the frame of the mean of z and its linear
+    prediction at the piece's end."""
     remaining = travel
     used = 0
     while True:

@@ -102,7 +102,7 @@ def reference(name, path):
 PATHS = ["circle_0.5mm_9.7Hz", "circle_4mm_4.7Hz", "ellipse_2x0.8mm_9.7Hz", "random_3mm"]
 REFERENCE_TOLERANCE = 1e-3
 """max |F - F_ref| over max |F_ref| on a path: the issue's target. Observed 2026-11-26: proposed
-2.5e-4, Spencer 8.3e-5, single Bouc-Wen 3.0e-5, Berg and fractional 6.3e-12 (exact over a step but
+2.8e-4, Spencer 7.1e-5, single Bouc-Wen 2.9e-5, Berg and fractional 6.3e-12 (exact over a step but
 for the reference's own tolerance)."""
 
 
