@@ -1,12 +1,15 @@
 """Does a bushing fitted along one axis predict combined loading? Coupled against uncoupled (issue targets)
 
-    python benchmarks/bench_coupled_prediction.py [--model single_bouc_wen] [--seed 0]
+    python benchmarks/bench_coupled_prediction.py [--model single_bouc_wen] [--seed 0] [--training x|plane]
 
 The truth is a coupled single Bouc-Wen element in the plane with parameters of its own (TRUTH),
 solved by the equations typed independently in tests/references/generate_coupled_references.py
 (scipy's Radau on every straight piece between samples). From it, two sines along x alone, solved on
 pieces of 0.1 ms and sampled at 1 ms with 3 N of seeded force noise: 2 mm at 10 Hz and 0.7 mm at
-4 Hz, 1 s each (SYNTHETIC, written to a temporary folder). ``fit`` fits the model to them (default preset). The fitted set goes on x and y
+4 Hz, 1 s each (SYNTHETIC, written to a temporary folder). ``fit`` fits the model to them (default
+preset). With ``--training plane`` it fits the first sine and a multi-axis test instead, an ellipse
+of 1.5 x 1 mm at 7.3 Hz in the plane solved the same way, with the radial coupling
+(``fit(..., multiaxis=..., coupling="radial")``). The fitted set goes on x and y
 of two six-axis pythonfmu FMUs, one with the radial coupling and one without (z and the rotations
 rigid), and both run, through fmpy, paths in the plane that no fit saw: a line along x (the
 control), circles of 1 and 2.5 mm, an ellipse, a figure eight and a random path. Prints the NRMSE
@@ -36,6 +39,7 @@ from fmu_src.axes import SIX_AXES  # noqa: E402
 from fmu_src.parameter_files import save_six_axis  # noqa: E402
 from identification import fit, training_tests  # noqa: E402
 from identification.measurements import write_measurement  # noqa: E402
+from identification.multiaxis import write_multiaxis  # noqa: E402
 
 _spec = importlib.util.spec_from_file_location("coupled_references",
                                                REPO / "tests" / "references" / "generate_coupled_references.py")
@@ -48,6 +52,8 @@ TRUTH = {"c0": 0.6, "k0": 300.0, "alpha": 1.0, "A": 900.0, "beta": 0.045, "gamma
 """The truth's own single Bouc-Wen set (N-mm-s): z saturates near (A/(beta + gamma))^(1/n) = 600 N,
 reached after about 1 mm of travel; k0 and c0 carry the rest."""
 TRAINING = (("sine_2mm_10Hz", 2.0, 10.0), ("sine_0.7mm_4Hz", 0.7, 4.0))
+PLANE_TRAINING = (1.5, 1.0, 7.3)
+"""--training plane: the ellipse's half axes along x and y [mm] and its frequency [Hz]."""
 RIGID = ("kelvin_voigt", {"k": 1e7, "c": 0.0, "preload": 0.0})
 
 
@@ -135,26 +141,43 @@ def main() -> None:
     parser.add_argument("--model", default="single_bouc_wen", help="the model fitted along x (default single_bouc_wen)")
     parser.add_argument("--seed", type=int, default=0, help="the fit's seed and the noise's")
     parser.add_argument("--plot", type=Path, help="also draw the 2.5 mm circle's force vectors (PNG)")
+    parser.add_argument("--training", choices=("x", "plane"), default="x",
+                        help="x: two sines along x (default); plane: the first sine and an ellipse in the plane, "
+                             "fitted with the radial coupling")
     args = parser.parse_args()
     started = time.perf_counter()
     rng = np.random.default_rng(args.seed)
     with tempfile.TemporaryDirectory() as scratch:
         scratch = Path(scratch)
         files = []
-        for name, amplitude, frequency in TRAINING:
-            # the rig's sine is smooth: the truth runs it on pieces of a tenth of a sample
-            fine = np.arange(round(10.0 / STEP_S) + 1) * STEP_S / 10
+        # the rig's paths are smooth: the truth runs them on pieces of a tenth of a sample
+        fine = np.arange(round(10.0 / STEP_S) + 1) * STEP_S / 10
+        t = fine[::10]
+        for name, amplitude, frequency in TRAINING[:1] if args.training == "plane" else TRAINING:
             x_fine = amplitude * np.sin(2 * math.pi * frequency * fine)
-            force = np.concatenate([[0.0], references.solve_path(references.SingleBoucWen(TRUTH), fine,
-                                                                 np.column_stack([x_fine, 0 * fine]),
-                                                                 STEP_S / 10)[1:, 3]])[::10]
-            t, x = fine[::10], x_fine[::10]
+            force = references.solve_path(references.SingleBoucWen(TRUTH), fine, np.column_stack([x_fine, 0 * fine]),
+                                          STEP_S / 10)[::10, 3]
+            force[0] = TRUTH["c0"] * amplitude * 2 * math.pi * frequency    # at rest, moving: the dashpot's force
+            x = x_fine[::10]
             path = scratch / f"synthetic_coupled_truth_{name}.csv"
             write_measurement(path, t, x, force + NOISE_N * rng.standard_normal(t.size),
                               [f"SYNTHETIC: the coupled single Bouc-Wen truth {TRUTH} along x, {NOISE_N} N noise",
                                "made by benchmarks/bench_coupled_prediction.py"])
             files.append(path)
-        result = fit(training_tests(sine=files), model=args.model, seed=args.seed, progress=False)
+        multiaxis = []
+        if args.training == "plane":
+            a, b, frequency = PLANE_TRAINING
+            w = 2 * math.pi * frequency
+            xy_fine = np.stack([a * np.sin(w * fine), b * (1.0 - np.cos(w * fine))], axis=1)
+            forces = references.solve_path(references.SingleBoucWen(TRUTH), fine, xy_fine, STEP_S / 10)[::10, 3:5]
+            forces[0] = (TRUTH["c0"] * a * w, 0.0)        # at rest, moving along x: the dashpot's force
+            multiaxis.append(write_multiaxis(
+                scratch / "synthetic_coupled_truth_ellipse.csv", t, xy_fine[::10],
+                forces + NOISE_N * rng.standard_normal(forces.shape),
+                [f"SYNTHETIC: the coupled single Bouc-Wen truth {TRUTH} on an ellipse, {NOISE_N} N noise",
+                 "made by benchmarks/bench_coupled_prediction.py"]))
+        result = fit(training_tests(sine=files), model=args.model, seed=args.seed, progress=False,
+                     multiaxis=multiaxis, coupling="radial" if multiaxis else None)
         print(result.summary().splitlines()[0])
         print("training: " + ", ".join(f"{f.name} {f.ratio:.2f}x its noise" for f in result.tests)
               + f"; converged: {result.converged}")
@@ -167,7 +190,8 @@ def main() -> None:
         t = np.arange(round(1.0 / STEP_S) + 1) * STEP_S
         period = round(1.0 / 4.7 / STEP_S)
         print(f"\n{date.today()}, {platform.machine()}, Python {platform.python_version()}: "
-              f"python benchmarks/bench_coupled_prediction.py --model {args.model} --seed {args.seed}")
+              f"python benchmarks/bench_coupled_prediction.py --model {args.model} --seed {args.seed} "
+              f"--training {args.training}")
         print(f"{'path (unseen, 1 s)':24s} {'coupled FMU':>12s} {'uncoupled FMU':>14s}   NRMSE of the force vector")
         energies = []
         worst = 0.0

@@ -77,6 +77,9 @@ def main(argv: list[str] | None = None) -> int:
                             help=f"one of {', '.join(MODEL_NAMES)} (kelvin_voigt by linear least squares; "
                                  "`compare` recommends one); default: the manifest's, else proposed, the paper's")
     _add_training_arguments(fit_parser)
+    fit_parser.add_argument("--coupling", choices=("none", "radial", "spherical"), metavar="COUPLING",
+                            help="how the model runs on the --multiaxis tests (required with them): none (one "
+                                 "model per axis), radial (coupled in x, y; z alone) or spherical (x, y, z)")
     _add_search_arguments(fit_parser)
     fit_parser.add_argument("--out", type=Path, required=True, help="parameter file to write (JSON)")
     fit_parser.add_argument("--ssv", type=Path, help="also write an SSP 1.0 ParameterValues file")
@@ -129,9 +132,14 @@ def main(argv: list[str] | None = None) -> int:
     predict_parser.add_argument("--params", type=Path, required=True,
                                 help="parameter file (.json, .ssv) or ensemble file (fit --ensemble)")
     predict_parser.add_argument("--data", type=Path, required=True,
-                                help="CSV with time_s and displacement_* columns (a force column is not needed)")
+                                help="CSV with time_s and displacement_* columns, or a multi-axis path (time_s,dx_mm,"
+                                     "dy_mm[,dz_mm]); force columns are not needed")
+    predict_parser.add_argument("--coupling", choices=("none", "radial", "spherical"), metavar="COUPLING",
+                                help="for a multi-axis path (required there): none, radial (x, y coupled) or "
+                                     "spherical (x, y, z)")
     predict_parser.add_argument("--out", type=Path, required=True,
-                                help="CSV to write: time_s,displacement_mm,force_N[,force_min_N,force_max_N]")
+                                help="CSV to write: time_s,displacement_mm,force_N[,force_min_N,force_max_N]; for a "
+                                     "multi-axis path time_s,dx_mm,dy_mm,Fx_N,Fy_N[,Fx_min_N,Fx_max_N,...]")
     predict_parser.add_argument("--plot", type=Path, help="also plot the prediction (PNG)")
 
     design_parser = subcommands.add_parser("design", help="rank candidate next tests by how much the ensemble disagrees")
@@ -238,6 +246,9 @@ def _add_training_arguments(parser) -> None:
     group.add_argument("--kdyn", type=Path, metavar="TABLE",
                        help="dynamic-stiffness table (CSV amplitude_mm,frequency_hz,kdyn_N_per_mm,loss_angle_deg"
                             "[,preload_mm][,weight], as `characterise` writes), alone or with time series")
+    group.add_argument("--multiaxis", action="append", type=Path, default=[], metavar="FILE",
+                       help="multi-axis test (CSV time_s,dx_mm,dy_mm,Fx_N,Fy_N[,dz_mm,Fz_N][,vx_mm_s,...]), alone or "
+                            "with the one-axis tests; repeatable")
 
 
 def _add_search_arguments(parser) -> None:

@@ -25,9 +25,10 @@ from identification.rig_tests import load_manifest, training_tests
 
 def training_tests_of(args):
     """The tests of --sine/--step/--rise-time/--random or --tests, and the manifest's model
-    (no tests at all where a --kdyn table is given alone)."""
+    (no tests at all where a --kdyn table or --multiaxis tests are given alone)."""
     given = args.sine or args.step or args.random or args.rise_time
-    if not given and args.tests is None and getattr(args, "kdyn", None) is not None:
+    if not given and args.tests is None and (getattr(args, "kdyn", None) is not None
+                                             or getattr(args, "multiaxis", None)):
         return [], None
     if args.tests is not None:
         if given:
@@ -35,6 +36,20 @@ def training_tests_of(args):
         manifest = load_manifest(args.tests)
         return manifest.tests, manifest.model
     return training_tests(args.sine, args.step, args.rise_time, args.random), None
+
+
+def multiaxis_tests_of(args) -> list:
+    """The --multiaxis tests, read before any work (a bad file: one error line naming its line or
+    column), each checked against --coupling (required with them)."""
+    from identification.multiaxis import COUPLED_AXES, coupled_axes, load_multiaxis
+    multiaxis = [load_multiaxis(path) for path in getattr(args, "multiaxis", [])]
+    if multiaxis and args.coupling is None:
+        raise UsageError(f"--multiaxis needs --coupling: how the model runs on them, one of {', '.join(COUPLED_AXES)}")
+    if args.coupling is not None and not multiaxis:
+        raise UsageError(f"--coupling {args.coupling} says how the model runs on multi-axis tests: give --multiaxis FILE")
+    for m in multiaxis:
+        coupled_axes(args.coupling, m)
+    return multiaxis
 
 
 def check_output(path: Path | None, option: str, directory: bool = False, suffixes: tuple[str, ...] = ()) -> None:
@@ -88,7 +103,8 @@ def print_warning(message: str) -> None:
 
 def fit_command(args) -> int:
     from identification.fitting import fit
-    from identification.plots import plot_comparison, plot_waterfall
+    from identification.multiaxis import simulate_multiaxis
+    from identification.plots import plot_comparison, plot_multiaxis, plot_waterfall
     from identification.simulate import simulate
 
     # the parameter file and the ensemble carry the fit's provenance: JSON; SSP holds values only
@@ -108,16 +124,19 @@ def fit_command(args) -> int:
     if args.kdyn is not None:
         from identification.kdyn_table import load_kdyn_table
         table = load_kdyn_table(args.kdyn)
+    multiaxis = multiaxis_tests_of(args)
     counts = {kind: sum(t.kind == kind for t in tests) for kind in ("sine", "step", "random")}
     print(f"fitting the {model} model to {counts['sine']} sine, {counts['step']} step and {counts['random']} "
-          "random test(s)" + (f" and a dynamic-stiffness table of {len(table)} rows" if table else ""),
+          "random test(s)" + (f", {len(multiaxis)} multi-axis test(s) ({args.coupling} coupling)" if multiaxis else "")
+          + (f" and a dynamic-stiffness table of {len(table)} rows" if table else ""),
           file=sys.stderr)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", FitNotConvergedWarning)   # printed below as WARNING
         result = fit(tests, model=bushing, preset=args.preset, seed=args.seed, workers=args.workers,
                      scheduler=args.scheduler, progress=not args.quiet, screening=args.screening,
-                     starts=args.starts, kdyn=table, ensemble=not args.no_ensemble)
-    written = _save_or_rescue(result, args, [t.measurement.source for t in tests]
+                     starts=args.starts, kdyn=table, ensemble=not args.no_ensemble, multiaxis=multiaxis,
+                     coupling=args.coupling)
+    written = _save_or_rescue(result, args, [t.measurement.source for t in tests] + [m.source for m in multiaxis]
                               + ([str(args.kdyn)] if args.kdyn else []))
     print(result.summary())
     if args.plots:
@@ -128,6 +147,11 @@ def fit_command(args) -> int:
             m = test.measurement
             predicted = simulate(result.parameters, m.time_s, m.displacement_mm, m.measured_velocity_mm_s)
             written.append(plot_comparison(m, {model: predicted}, args.plots / f"fit_{measurement_name(m.source)}.png"))
+        for m in multiaxis:
+            predicted = simulate_multiaxis(result.parameters, m.time_s, m.displacement_mm, coupling=args.coupling,
+                                           velocity_mm_s=m.velocity_mm_s)
+            written.append(plot_multiaxis(m, {f"{bushing.title}, {args.coupling}": predicted},
+                                          args.plots / f"fit_{measurement_name(m.source)}.png"))
         if table is not None:
             written += _plot_table_fit(result, table, args.plots)
     print("wrote " + ", ".join(str(path) for path in written))
@@ -212,10 +236,16 @@ def report_command(args) -> int:
 
 def predict_command(args) -> int:
     from fmu_src.parameter_files import read_ensemble
+    from identification.multiaxis import is_multiaxis_file
     from identification.predict import predict
     check_output(args.out, "--out", suffixes=(".csv",))
     check_output(args.plot, "--plot", suffixes=(".png",))
     ensemble = read_ensemble(args.params)
+    if is_multiaxis_file(args.data):
+        return _predict_multiaxis(args, ensemble)
+    if args.coupling is not None:
+        raise UsageError(f"--coupling {args.coupling}: {args.data} is a one-axis test (time_s, displacement_*); a "
+                         "coupling says how the model runs on a multi-axis path (dx_mm, dy_mm[, dz_mm])")
     m = load_measurement(args.data, force_optional=True)
     prediction = predict(ensemble, m.time_s, m.displacement_mm, m.measured_velocity_mm_s)
     prediction.write_csv(args.out)
@@ -225,12 +255,38 @@ def predict_command(args) -> int:
         band = (prediction.lower_N, prediction.upper_N) if prediction.members > 1 else None
         written.append(plot_comparison(m, {ensemble.model.name: prediction.force_N}, args.plot, band,
                                        measured=m.has_force))
+    _print_prediction(prediction, written)
+    return 0
+
+
+def _predict_multiaxis(args, ensemble) -> int:
+    """``predict`` on a multi-axis path: force vectors with --coupling (required there)."""
+    from identification.multiaxis import COUPLED_AXES, load_multiaxis, vector_nrmse
+    from identification.predict import predict_multiaxis
+    if args.coupling is None:
+        raise UsageError(f"{args.data} is a multi-axis path: give --coupling, how the model runs on it "
+                         f"({', '.join(COUPLED_AXES)})")
+    m = load_multiaxis(args.data, force_optional=True)
+    prediction = predict_multiaxis(ensemble, m.time_s, m.displacement_mm, args.coupling, m.velocity_mm_s)
+    prediction.write_csv(args.out)
+    written = [args.out]
+    if args.plot:
+        from identification.plots import plot_multiaxis
+        written.append(plot_multiaxis(m, {f"{ensemble.model.title}, {args.coupling}": prediction.force_N},
+                                      args.plot, measured=m.has_force))
+    if m.has_force:
+        print(f"NRMSE of the force vector against {m.name}: {vector_nrmse(prediction.force_N, m.force_N):.2%}")
+    _print_prediction(prediction, written)
+    return 0
+
+
+def _print_prediction(prediction, written) -> None:
+    force = prediction.force_N.reshape(prediction.force_N.shape[0], -1)
     width = prediction.band_width_N
-    print(f"{prediction.members} parameter set(s); rms force {np.sqrt(np.mean(prediction.force_N ** 2)):.1f} N"
+    print(f"{prediction.members} parameter set(s); rms force {np.sqrt(np.mean(np.sum(force ** 2, axis=1))):.1f} N"
           + (f"; band width: mean {np.mean(width):.1f} N, largest {np.max(width):.1f} N" if prediction.members > 1
              else ""))
     print("wrote " + ", ".join(map(str, written)))
-    return 0
 
 
 def characterise_command(args) -> int:
@@ -326,6 +382,10 @@ def compare_command(args) -> int:
     if args.kdyn is not None:
         raise UsageError("--kdyn: compare fits on time series; give a table to predict as --validate-kdyn, or fit a "
                          "table with `fit --kdyn`")
+    if args.multiaxis:
+        raise UsageError("--multiaxis: compare fits on one-axis tests and weighs the couplings on held-out multi-axis "
+                         "files (--coupling none,radial --validate-multiaxis FILE); fit a model to multi-axis tests "
+                         "with `fit --multiaxis FILE --coupling radial`")
     from identification.kdyn_table import load_kdyn_table
     table = load_kdyn_table(args.validate_kdyn) if args.validate_kdyn is not None else None
     tests, _ = training_tests_of(args)

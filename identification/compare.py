@@ -40,7 +40,7 @@ import numpy as np
 
 from fmu_src.bushing_models import BushingModel, resolve_model
 from identification.engine import make_engine
-from identification.errors import FitNotConvergedWarning, IdentificationError
+from identification.errors import FitNotConvergedWarning
 from identification.fit_result import FLOOR_FACTOR, FitResult, TableFit, information_criterion
 from identification.fitting import fit, table_fit
 from identification.interrupt import writing
@@ -246,29 +246,18 @@ class CouplingChoice:
 
 def weigh_couplings(parameters: dict, bushings, multiaxis, couplings: Sequence[str], model: str,
                     tolerance: float = PREDICTION_TOLERANCE) -> CouplingChoice:
-    """Each model's predictions of the multi-axis files with each coupling (``multiaxis.simulate_multiaxis``:
-    none, its one-axis model on each axis; radial and spherical, its coupled form), and the coupling
-    for ``model`` (:class:`CouplingChoice`). A spherical coupling needs files of three axes, radial
-    of two or of three (then on x and y, z alone)."""
+    """Each model's predictions of the multi-axis files with each coupling (``multiaxis.simulate_multiaxis``,
+    ``multiaxis.COUPLED_AXES``: none, its one-axis model on each axis; radial, its coupled form on x and
+    y, z alone; spherical, on x, y and z, which needs files of three axes), and the coupling for
+    ``model`` (:class:`CouplingChoice`)."""
     from identification.multiaxis import simulate_multiaxis, vector_nrmse
     errors = {}
     for bushing in bushings:
         for coupling in couplings:
             values = []
             for m in multiaxis:
-                d = m.displacement_mm.shape[1]
-                if coupling == "spherical" and d != 3:
-                    raise IdentificationError(f"{m.source}: the spherical coupling needs three axes (dz_mm, Fz_N); "
-                                              "this file has two")
-                if coupling == "radial" and d == 3:     # x and y coupled, z on its own
-                    plane = simulate_multiaxis(parameters[bushing.name], m.time_s, m.displacement_mm[:, :2],
-                                               bushing, coupled=True)
-                    axial = simulate_multiaxis(parameters[bushing.name], m.time_s, m.displacement_mm, bushing,
-                                               coupled=False)[:, 2:]
-                    predicted = np.column_stack([plane, axial])
-                else:
-                    predicted = simulate_multiaxis(parameters[bushing.name], m.time_s, m.displacement_mm, bushing,
-                                                   coupled=coupling != "none")
+                predicted = simulate_multiaxis(parameters[bushing.name], m.time_s, m.displacement_mm, bushing,
+                                               coupling, m.velocity_mm_s)
                 values.append(vector_nrmse(predicted, m.force_N))
             errors[bushing.name, coupling] = values
     means = {coupling: float(np.mean(errors[model, coupling])) for coupling in couplings}

@@ -73,23 +73,29 @@ def _population_forces(matrix, t, x, v, out_index, out_velocity, max_substeps, s
     return forces
 
 
-def _coupled_population_forces(matrix, t, x, v, max_substeps):
-    """Force vectors (P, samples, 3) of every parameter set (rows of ``matrix``) on the path ``x``
-    (samples, 3) [mm], the model's coupled form under the FMU's input convention: over
-    [t_k, t_k+1] the displacement x_k + v_k*(t - t_k) with ``v`` (samples, 3) the step's velocity,
-    the force at t_k+1 with the velocity v_k; relaxed at x_0. NaN from where a candidate fails.
+def _coupled_population_forces(matrix, t, x, v, out_index, out_velocity, max_substeps):
+    """Force vectors (P, outputs, 3) of every parameter set (rows of ``matrix``) at the communication
+    points ``t[out_index]`` on the path ``x`` (points, 3) [mm], the model's coupled form under the
+    FMU's input convention: over [t_k, t_k+1] the displacement x_k + v_k*(t - t_k) with ``v``
+    (points, 3) the step's velocity; the force at an output point with the velocity ``out_velocity``
+    (outputs, 3) (the viscous feedthrough); relaxed at x_0. NaN from where a candidate fails.
 
     Written here, never called here: compiled in a coupled model's generated module, where
     ``initial_state_coupled``, ``step_coupled`` and ``force_coupled`` are its compiled kernels."""
-    count, samples = matrix.shape[0], t.size
-    forces = np.full((count, samples, 3), np.nan)
+    count, samples, outputs = matrix.shape[0], t.size, out_index.size
+    forces = np.full((count, outputs, 3), np.nan)
     for i in numba.prange(count):
         m = prepare(_VALUES(matrix[i]))
         state_x = (x[0, 0], x[0, 1], x[0, 2])
         state = initial_state_coupled(m, state_x)
-        f = force_coupled(m, state, state_x, (v[0, 0], v[0, 1], v[0, 2]))
-        forces[i, 0, 0], forces[i, 0, 1], forces[i, 0, 2] = f[0], f[1], f[2]
+        j = 0
+        if out_index[0] == 0:
+            f = force_coupled(m, state, state_x, (out_velocity[0, 0], out_velocity[0, 1], out_velocity[0, 2]))
+            forces[i, 0, 0], forces[i, 0, 1], forces[i, 0, 2] = f[0], f[1], f[2]
+            j = 1
         for k in range(samples - 1):
+            if j == outputs:
+                break
             h = t[k + 1] - t[k]
             position = (x[k, 0], x[k, 1], x[k, 2])
             velocity = (v[k, 0], v[k, 1], v[k, 2])
@@ -97,8 +103,10 @@ def _coupled_population_forces(matrix, t, x, v, max_substeps):
             if status != _OK:
                 break
             state_x = (position[0] + velocity[0] * h, position[1] + velocity[1] * h, position[2] + velocity[2] * h)
-            f = force_coupled(m, state, state_x, velocity)
-            forces[i, k + 1, 0], forces[i, k + 1, 1], forces[i, k + 1, 2] = f[0], f[1], f[2]
+            if out_index[j] == k + 1:
+                f = force_coupled(m, state, state_x, (out_velocity[j, 0], out_velocity[j, 1], out_velocity[j, 2]))
+                forces[i, j, 0], forces[i, j, 1], forces[i, j, 2] = f[0], f[1], f[2]
+                j += 1
     return forces
 
 
@@ -176,7 +184,20 @@ def simulate_coupled_held(parameter_sets, time_s, displacement_mm, velocity_mm_s
     """Force vectors [N], shape (P, samples, d), of P parameter sets of ``model``'s coupled form on
     the path ``displacement_mm`` (samples, d = 2 or 3) [mm] with the steps' velocities
     ``velocity_mm_s`` (samples, d) [mm/s], under the FMU's input convention (as
-    :func:`simulate_population_held` for one axis). Runs on all cores."""
+    :func:`simulate_population_held` for one axis: the force at t_k+1 with the velocity v_k). Runs
+    on all cores."""
+    v = np.atleast_2d(np.asarray(velocity_mm_s, dtype=float))
+    return simulate_coupled_at(parameter_sets, time_s, displacement_mm, v, np.arange(v.shape[0]),
+                               np.vstack([v[:1], v[:-1]]), max_substeps, model)
+
+
+def simulate_coupled_at(parameter_sets, time_s, displacement_mm, velocity_mm_s, output_index, output_velocity_mm_s,
+                        max_substeps: int = _MAX_SUBSTEPS, model: str | BushingModel = "proposed") -> np.ndarray:
+    """Force vectors [N], shape (P, outputs, d), of P parameter sets of ``model``'s coupled form at
+    the communication points ``time_s[output_index]`` (increasing) of the path ``displacement_mm``
+    (points, d = 2 or 3) [mm] with the steps' velocities ``velocity_mm_s`` (points, d) [mm/s], the
+    viscous feedthrough taken at ``output_velocity_mm_s`` (outputs, d): the coupled counterpart of
+    :func:`simulate_population_at`. Runs on all cores."""
     model = resolve_model(model)
     if model.coupled is None:
         raise ValueError(f"the {model.name} model has no coupled form")
@@ -185,11 +206,16 @@ def simulate_coupled_held(parameter_sets, time_s, displacement_mm, velocity_mm_s
     v = np.atleast_2d(np.asarray(velocity_mm_s, dtype=float))
     d = x.shape[1]
     if not (t.ndim == 1 and t.size >= 2 and x.shape == v.shape == (t.size, d) and d in (2, 3)):
-        raise ValueError(f"time (samples,) and displacement and velocity (samples, 2 or 3): got {t.shape}, {x.shape}, "
+        raise ValueError(f"time (points,) and displacement and velocity (points, 2 or 3): got {t.shape}, {x.shape}, "
                          f"{v.shape}")
-    pad = lambda a: np.ascontiguousarray(np.column_stack([a, np.zeros((t.size, 3 - d))]))   # noqa: E731
+    out_index = np.ascontiguousarray(output_index, dtype=np.int64)
+    out_velocity = np.atleast_2d(np.asarray(output_velocity_mm_s, dtype=float))
+    if not (out_index.ndim == 1 and out_index.size >= 1 and out_velocity.shape == (out_index.size, d)
+            and np.all(np.diff(out_index) > 0) and 0 <= out_index[0] and out_index[-1] < t.size):
+        raise ValueError("output_index must be increasing indices into time_s, one output velocity vector each")
+    pad = lambda a: np.ascontiguousarray(np.column_stack([a, np.zeros((a.shape[0], 3 - d))]))   # noqa: E731
     forces = compiled_model(model)._simulate_coupled_population(parameter_matrix(parameter_sets, model), t, pad(x),
-                                                                pad(v), max_substeps)
+                                                                pad(v), out_index, pad(out_velocity), max_substeps)
     return forces[:, :, :d]
 
 

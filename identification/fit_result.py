@@ -158,6 +158,7 @@ class FitResult:
     ensemble_sampled: bool = True          # False: fit(ensemble=False), the ensemble is the best fit alone
     residuals: int = 0                     # n, the residuals chi^2/n is over (0: not recorded)
     failed_starts: int = 0                 # starts and profiles whose residuals or Jacobian were not finite
+    coupling: str | None = None            # how the model ran on the multi-axis tests (None: there were none)
 
     @property
     def free_parameters(self) -> int:
@@ -235,6 +236,8 @@ class FitResult:
         out = {"method": self._method(), "preset": self.preset, "seed": self.seed,
                "converged": self.converged, "misfit_chi2_per_residual": round_for_file(self.misfit),
                "tests": [t.as_dict() for t in self.tests] + ([self.table.as_dict()] if self.table else [])}
+        if self.coupling is not None:
+            out["multiaxis_coupling"] = self.coupling
         if self.space is not None:
             out.update({"starts_agreeing": self.agreeing, "final_starts": self.final_starts,
                         "starts_added_for_agreement": self.added_starts,
@@ -289,6 +292,9 @@ class FitResult:
             if self.failed_starts:
                 lines.append(f"failed starts: {self.failed_starts} (their residuals or Jacobian were not finite: "
                              "skipped, each kept at its last finite point)")
+        if self.coupling is not None:
+            lines.append(f"multi-axis tests: the model runs with the {self.coupling} coupling on them "
+                         "(NRMSE of the force vector; noise: the rms of its axes')")
         if self.steps_per_sample:
             lines.append("forward model: " + ", ".join(f"{m} step{'s' if m > 1 else ''} per sample on {t.name}"
                                                        for m, t in zip(self.steps_per_sample, self.tests)))

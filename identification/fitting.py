@@ -25,12 +25,13 @@ optimum is exact, so only the floor is checked).
 from __future__ import annotations
 
 import contextlib
+import math
 import os
 import sys
 import threading
 import time
 import warnings
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -50,6 +51,8 @@ from identification.fit_result import (FLOOR_FACTOR, MIN_AGREEING, FitNotConverg
 from identification.kdyn_table import KdynTable, load_kdyn_table
 from identification.loop_start import LOOP_STARTS, anchored_coordinates, slow_loop_start
 from identification.measurements import Measurement
+from identification.multiaxis import COUPLED_AXES, MultiAxisMeasurement, coupled_axes, load_multiaxis, \
+    simulate_multiaxis, vector_nrmse
 from identification.multistart import (JACOBIANS, Problem, StartRecord, failed_starts, first_records, jacobian,
                                        run_stages, screen, simulations_per_jacobian)
 from identification.noise import NoiseEstimate, estimate_noise
@@ -86,16 +89,24 @@ def as_tests(measurements) -> list[RigTest]:
     return tests
 
 
+def as_multiaxis(multiaxis) -> list[MultiAxisMeasurement]:
+    """MultiAxisMeasurements from MultiAxisMeasurements or file paths (``multiaxis.load_multiaxis``)."""
+    if isinstance(multiaxis, (MultiAxisMeasurement, str, Path)):
+        multiaxis = [multiaxis]
+    return [m if isinstance(m, MultiAxisMeasurement) else load_multiaxis(m) for m in multiaxis or ()]
+
+
 def fit(measurements, model: str | BushingModel = "proposed", preset: str = "default", seed: int = 0,
         workers: int | None = None, scheduler=None, engine=None, progress: bool = True, screening: int | None = None,
-        starts: int | None = None, kdyn=None, ensemble: bool = True, jacobian: str = "exact") -> FitResult:
+        starts: int | None = None, kdyn=None, ensemble: bool = True, jacobian: str = "exact", multiaxis=(),
+        coupling: str | None = None) -> FitResult:
     """Identify a model's parameters from rig tests, and say how sure the fit is.
 
     Parameters
     ----------
     measurements : Manifest, sequence of RigTest, Measurement, str or Path
         The training tests (``training_tests``, ``load_manifest``); a Measurement or a CSV path
-        counts as a random-input test. May be empty when ``kdyn`` is given.
+        counts as a random-input test. May be empty when ``kdyn`` or ``multiaxis`` is given.
     model : str or BushingModel
         ``proposed`` (default), ``spencer``, ``single_bouc_wen``, ``berg``, ``fractional`` or
         ``kelvin_voigt`` (linear least squares), or the model itself
@@ -124,7 +135,17 @@ def fit(measurements, model: str | BushingModel = "proposed", preset: str = "def
     jacobian : str
         How the least squares and the identifiability get the residuals' Jacobian: ``exact``
         (default: the forces' sensitivities, computed with them; ``identification.fit_jacobian``)
-        or ``difference`` (forward differences, one simulation per coordinate).
+        or ``difference`` (forward differences, one simulation per coordinate). The multi-axis
+        tests' rows are differences either way (the coupled kernels have no sensitivities).
+    multiaxis : sequence of MultiAxisMeasurement, str or Path, optional
+        Multi-axis tests (CSV time_s,dx_mm,dy_mm,Fx_N,Fy_N[,dz_mm,Fz_N]: ``identification.multiaxis``)
+        fitted with the one-axis tests, or alone: each axis's force at each sample a residual in
+        that axis's noise units.
+    coupling : str, optional
+        How the model runs on the multi-axis tests (required with them): ``none`` (its one-axis
+        model on each axis alone), ``radial`` (its coupled form on x and y, z alone) or
+        ``spherical`` (on x, y and z). The fitted set is the one-axis set either way, which
+        ``assemble --coupling`` turns into a six-axis file.
 
     Returns
     -------
@@ -136,7 +157,8 @@ def fit(measurements, model: str | BushingModel = "proposed", preset: str = "def
     Raises
     ------
     IdentificationError
-        No tests, a bad seed or preset, or a test whose noise cannot be estimated.
+        No tests, a bad seed or preset, a test whose noise cannot be estimated, multi-axis tests
+        without a coupling or with one they cannot carry (spherical on a plane test).
     MissingExtraError
         The ``fit`` extra is not installed.
 
@@ -154,19 +176,22 @@ def fit(measurements, model: str | BushingModel = "proposed", preset: str = "def
     from threadpoolctl import threadpool_limits
     started = time.perf_counter()
     table = kdyn if kdyn is None or isinstance(kdyn, KdynTable) else load_kdyn_table(kdyn)
+    multi = as_multiaxis(multiaxis)
+    _check_coupling(multi, coupling)
     empty = measurements is None or (isinstance(measurements, (list, tuple)) and not measurements)
-    tests = [] if (empty and table is not None) else as_tests(measurements)
+    tests = [] if (empty and (table is not None or multi)) else as_tests(measurements)
     bushing = resolve_model(model)
     if seed < 0:
         raise IdentificationError(f"seed = {seed}: give an integer >= 0")
     if jacobian not in JACOBIANS:
         raise IdentificationError(f"jacobian = {jacobian!r}: choose one of {', '.join(JACOBIANS)}")
     noise = [_noise_of(t) for t in tests]
+    multi = MultiAxisTraining(multi, [_axis_noise_of(m) for m in multi], coupling or "none")
     # One BLAS thread here as in every task: a multi-threaded BLAS may sum in another order,
     # and the scales and the Jacobian's SVD computed here must not depend on the engine.
     with threadpool_limits(limits=1):
         if bushing.name == "kelvin_voigt":
-            result = _fit_kelvin_voigt(bushing, tests, noise, started, table)
+            result = _fit_kelvin_voigt(bushing, tests, noise, started, table, multi)
         else:
             if preset not in PRESETS:
                 raise IdentificationError(f"unknown preset {preset!r}; choose one of {', '.join(PRESETS)}")
@@ -177,7 +202,7 @@ def fit(measurements, model: str | BushingModel = "proposed", preset: str = "def
             # (Ctrl-C, SIGTERM): see identification.engine
             with engine if owned else contextlib.nullcontext():
                 result = _search(tests, noise, bushing, preset, settings, seed, engine, progress, started, table,
-                                 ensemble, jacobian)
+                                 ensemble, jacobian, multi)
     if not result.converged:
         warnings.warn(result.warning, FitNotConvergedWarning, stacklevel=2)
     return result
@@ -188,6 +213,51 @@ def _noise_of(test: RigTest) -> NoiseEstimate:
         return estimate_noise(test.measurement.force_N)
     except ValueError as exc:
         raise IdentificationError(f"{test.measurement.source}: {exc}") from None
+
+
+def _axis_noise_of(m: MultiAxisMeasurement) -> list[NoiseEstimate]:
+    try:
+        return [estimate_noise(m.force_N[:, c]) for c in range(m.force_N.shape[1])]
+    except ValueError as exc:
+        raise IdentificationError(f"{m.source}: {exc}") from None
+
+
+def _check_coupling(multi: list[MultiAxisMeasurement], coupling: str | None) -> None:
+    """Multi-axis tests need a coupling they can carry; a coupling needs multi-axis tests."""
+    if multi and coupling is None:
+        raise IdentificationError(f"the multi-axis tests {', '.join(m.name for m in multi)} need a coupling: "
+                                  f"{', '.join(COUPLED_AXES)} (--coupling)")
+    if coupling is not None and not multi:
+        raise IdentificationError(f"coupling {coupling!r} given without multi-axis tests: it says how the model runs "
+                                  "on them (--multiaxis FILE)")
+    for m in multi:
+        coupled_axes(coupling, m)
+
+
+@dataclass(frozen=True)
+class MultiAxisTraining:
+    """The multi-axis training tests, each axis's noise level and the coupling they are run with."""
+    measurements: list[MultiAxisMeasurement]
+    noise: list[list[NoiseEstimate]]
+    coupling: str
+
+    def objective_arguments(self) -> dict:
+        return {"multiaxis": self.measurements, "multiaxis_noise": self.noise, "coupling": self.coupling}
+
+    def components(self) -> list[Measurement]:
+        return [c for m in self.measurements for c in m.components()]
+
+    def fits(self, parameters: ParameterSet) -> list[RigTestFit]:
+        """Each test's vector NRMSE at ``parameters`` against its noise: the rms of the axes'
+        noise levels over the rms force vector (``multiaxis.vector_nrmse``'s units)."""
+        fits = []
+        for m, levels in zip(self.measurements, self.noise):
+            predicted = simulate_multiaxis(parameters, m.time_s, m.displacement_mm, coupling=self.coupling,
+                                           velocity_mm_s=m.velocity_mm_s)
+            noise = NoiseEstimate(math.sqrt(sum(level.sigma_N ** 2 for level in levels)),
+                                  math.sqrt(float(np.mean(np.sum(m.force_N ** 2, axis=1)))))
+            fits.append(RigTestFit(m.name, f"{len(m.axes)}-axis", noise, vector_nrmse(predicted, m.force_N)))
+        return fits
 
 
 def _settings(base: SearchSettings, screening: int | None, starts: int | None) -> SearchSettings:
@@ -239,17 +309,19 @@ def _exact_jacobian_or_why_not(tests, space: SearchSpace, progress: bool) -> tup
 
 
 def _search(tests, noise, model, preset, settings, seed, engine, progress, started, table=None,
-            sample_ensemble=True, jacobian_kind="exact") -> FitResult:
-    measurements = [t.measurement for t in tests]
-    space = SearchSpace.from_measurements(measurements, model, steps=[t.kind == "step" for t in tests], table=table)
+            sample_ensemble=True, jacobian_kind="exact", multi: MultiAxisTraining | None = None) -> FitResult:
+    multi = multi or MultiAxisTraining([], [], "none")
+    measurements = [t.measurement for t in tests] + multi.components()
+    space = SearchSpace.from_measurements(measurements, model, steps=[t.kind == "step" for t in tests]
+                                          + [False] * (len(measurements) - len(tests)), table=table)
     # with a table, the screening and the early stages run its coarser loop (kdyn_table)
     notes = []
     if jacobian_kind == "exact":
         jacobian_kind, note = _exact_jacobian_or_why_not(tests, space, progress)
         if note:
             notes.append(note)
-    problem = Problem(Objective(tests, noise, model=space.bushing, table=table, search=table is not None), space,
-                      jacobian_kind)
+    problem = Problem(Objective(tests, noise, model=space.bushing, table=table, search=table is not None,
+                                **multi.objective_arguments()), space, jacobian_kind)
     ga_evaluations = PAPER_GA["population"] * PAPER_GA["generations"]
     loop = slow_loop_start(tests, space) if preset != "paper" else None
     if loop is not None:
@@ -326,11 +398,14 @@ def _search(tests, noise, model, preset, settings, seed, engine, progress, start
     ensemble = [dict(zip(names, map(float, row))) for row in rows]
     parameters = ParameterSet(space.bushing, ensemble[0])
     steps = problem.objective.steps_per_sample
-    result = FitResult(parameters, float(best.misfit), _test_fits(tests, noise, parameters, steps), records, threshold,
+    fits = _test_fits(tests, noise, parameters, steps) + multi.fits(parameters)
+    steps = steps + [m.driven.steps_per_sample for m in problem.objective.multiaxis]
+    result = FitResult(parameters, float(best.misfit), fits, records, threshold,
                        ensemble, ident, preset, seed, evaluations, time.perf_counter() - started, engine.description,
                        space, final_starts=len(final), sampler=sampler, notes=notes, steps_per_sample=steps,
                        table=table_fit(table, parameters), added_starts=added, agreed_before_added=agreeing,
-                       ensemble_sampled=sample_ensemble, residuals=n, failed_starts=failed)
+                       ensemble_sampled=sample_ensemble, residuals=n, failed_starts=failed,
+                       coupling=multi.coupling if multi.measurements else None)
     result.parameters.provenance = result.provenance()
     return result
 
@@ -354,20 +429,23 @@ def _identifiability_jacobian(problem: Problem, theta: np.ndarray, notes: list[s
     return scaled_jacobian
 
 
-def _fit_kelvin_voigt(bushing: BushingModel, tests, noise, started, table=None) -> FitResult:
+def _fit_kelvin_voigt(bushing: BushingModel, tests, noise, started, table=None,
+                      multi: MultiAxisTraining | None = None) -> FitResult:
     """F = k*x + c*v by linear least squares with k, c >= 0 on the tests other than steps (a
-    linear spring cannot show the step's relaxation; all tests if there are only steps). With
-    a dynamic-stiffness table: scipy's bounded least squares on the whole objective (tests and
+    linear spring cannot show the step's relaxation; all tests if there are only steps) and on
+    every axis of the multi-axis tests (a Kelvin-Voigt bushing couples nothing). With a
+    dynamic-stiffness table: scipy's bounded least squares on the whole objective (tests and
     table), from that solution or, with a table alone, from the table's median K' and K''/omega."""
     from scipy.optimize import least_squares
-    if tests:
-        linear = KelvinVoigtFit.fit([t.measurement for t in tests if t.kind != "step"]
-                                    or [t.measurement for t in tests], nonnegative=True)
+    multi = multi or MultiAxisTraining([], [], "none")
+    if tests or multi.measurements:
+        linear = KelvinVoigtFit.fit(([t.measurement for t in tests if t.kind != "step"]
+                                     or [t.measurement for t in tests]) + multi.components(), nonnegative=True)
         values = {"k": linear.k, "c": linear.c, "preload": 0.0}
     else:
         scales = SearchSpace.from_table(table)
         values = {"k": scales.k_ref, "c": scales.c_ref, "preload": 0.0}
-    objective = Objective(tests, noise, model=bushing, table=table)
+    objective = Objective(tests, noise, model=bushing, table=table, **multi.objective_arguments())
     if table is not None:
         def residuals(kc):
             return objective.residual_matrix(parameter_matrix([{"k": kc[0], "c": kc[1], "preload": 0.0}],
@@ -377,9 +455,9 @@ def _fit_kelvin_voigt(bushing: BushingModel, tests, noise, started, table=None) 
         values = {"k": float(solution.x[0]), "c": float(solution.x[1]), "preload": 0.0}
     parameters = ParameterSet(bushing, values)
     misfit = float(objective(parameter_matrix([values], bushing))[0])
-    result = FitResult(parameters, misfit, _test_fits(tests, noise, parameters), [], 0.0, [values], None,
-                       "linear", 0, 1, time.perf_counter() - started, table=table_fit(table, parameters),
-                       residuals=objective.size)
+    result = FitResult(parameters, misfit, _test_fits(tests, noise, parameters) + multi.fits(parameters), [], 0.0,
+                       [values], None, "linear", 0, 1, time.perf_counter() - started, table=table_fit(table, parameters),
+                       residuals=objective.size, coupling=multi.coupling if multi.measurements else None)
     result.parameters.provenance = result.provenance()
     return result
 

@@ -143,3 +143,55 @@ def _held_samples_to_skip(x: np.ndarray) -> np.ndarray:
             skip[inner[(inner - first) % HOLD_DECIMATION != 0]] = True
         k = end + 1
     return skip
+
+
+@dataclass(frozen=True)
+class DrivenVectorInput:
+    """A sampled multi-axis test prepared for the compiled kernels: each axis's
+    :class:`DrivenInput` (``components``) on one common grid of communication points (the same
+    steps per sample for every axis, no decimated holds), and the same arrays stacked by axis:
+    ``displacement_mm``, ``velocity_mm_s`` (points, d), ``output_velocity_mm_s`` (outputs, d)."""
+    components: tuple[DrivenInput, ...]
+
+    @property
+    def time_s(self) -> np.ndarray:
+        return self.components[0].time_s
+
+    @property
+    def output_index(self) -> np.ndarray:
+        return self.components[0].output_index
+
+    @property
+    def sample_index(self) -> np.ndarray:
+        return self.components[0].sample_index
+
+    @property
+    def steps_per_sample(self) -> int:
+        return self.components[0].steps_per_sample
+
+    @property
+    def displacement_mm(self) -> np.ndarray:
+        return np.column_stack([c.displacement_mm for c in self.components])
+
+    @property
+    def velocity_mm_s(self) -> np.ndarray:
+        return np.column_stack([c.velocity_mm_s for c in self.components])
+
+    @property
+    def output_velocity_mm_s(self) -> np.ndarray:
+        return np.column_stack([c.output_velocity_mm_s for c in self.components])
+
+
+def prepare_vector_input(time_s, displacement_mm, velocity_mm_s=None, steps: int | None = None) -> DrivenVectorInput:
+    """The driven input of a sampled multi-axis test, ``displacement_mm`` (samples, d) [mm] (and
+    its measured ``velocity_mm_s`` (samples, d) [mm/s], if any): each axis as
+    :func:`prepare_input` drives it, with the steps per sample the most any axis's signal asks for
+    (or ``steps``), so that the axes share one grid. Every sample is an output (a hold is decimated
+    only where every axis holds, which the grid cannot share; it is not worth it here)."""
+    x = np.atleast_2d(np.asarray(displacement_mm, dtype=float))
+    v = None if velocity_mm_s is None else np.atleast_2d(np.asarray(velocity_mm_s, dtype=float))
+    axes = range(x.shape[1])
+    if steps is None:
+        steps = max(prepare_input(time_s, x[:, c], None if v is None else v[:, c]).steps_per_sample for c in axes)
+    return DrivenVectorInput(tuple(prepare_input(time_s, x[:, c], None if v is None else v[:, c], steps=steps)
+                                   for c in axes))

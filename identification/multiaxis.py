@@ -10,12 +10,19 @@ with, optionally, measured velocities ``vx_mm_s,vy_mm_s[,vz_mm_s]`` (every axis'
 s, increasing; displacements in mm, forces in N (the one-axis files' units). A file that cannot be
 used is refused with its name, the line or the column, and what is allowed.
 
-A model predicts a multi-axis test (:func:`simulate_multiaxis`) as the six-axis FMU runs it with
-the input the FMU guide advises: a communication point at every sample, the displacement straight
-between samples with the secant velocity (a measured velocity column is read and kept, not used:
-fed beside a sampled displacement it would make the dashpots carry a jump at every step), coupled
-(the model's coupled form on the displacement vector, ``model_definition.CoupledKernels``) or
-uncoupled (its one-axis model on each axis alone). Compiled with numba (``compiled_core``).
+A model predicts a multi-axis test (:func:`simulate_multiaxis`) as the fit's forward model drives a
+one-axis test (``identification.forward_model``): each axis's interpolant of its samples (the
+Hermite one where the velocity was measured), on one grid of communication points for every axis;
+coupled (the model's coupled form on the displacement vector, ``model_definition.CoupledKernels``)
+or not (its one-axis model on each axis alone): :data:`COUPLED_AXES`. Compiled with numba
+(``compiled_core``). The six-axis FMU, a co-simulation slave, holds the secant velocity over each
+communication step instead (``compiled_core.simulate_coupled_held``); at 1 kHz on a 10 Hz circle the
+two differ by a few 1e-3 of the force, and the interpolant's is closer to the continuous-time force
+(``tests/test_multiaxis.py``).
+
+Multi-axis tests train a fit (``fit(..., multiaxis=[...], coupling=...)``, ``fit --multiaxis FILE
+--coupling radial``) as one-axis tests do: every axis's force at every sample a residual in that
+axis's noise units (``identification.objectives``).
 """
 from __future__ import annotations
 
@@ -39,7 +46,8 @@ class MultiAxisMeasurement:
     time_s: np.ndarray              # (n,)
     displacement_mm: np.ndarray     # (n, d)
     force_N: np.ndarray             # (n, d)
-    velocity_mm_s: np.ndarray | None = None   # (n, d), measured; None: the secant velocity
+    velocity_mm_s: np.ndarray | None = None   # (n, d), measured; None: from the displacement's interpolant
+    has_force: bool = True      # False: a path without force columns (force_N is zeros)
 
     @property
     def axes(self) -> tuple[str, ...]:
@@ -49,22 +57,46 @@ class MultiAxisMeasurement:
     def name(self) -> str:
         return Path(self.source).name
 
+    def components(self) -> list:
+        """Each axis as a one-axis ``measurements.Measurement`` (its displacement, force and velocity,
+        measured or derived): what scales a fit's search and fits Kelvin-Voigt's linear law."""
+        from identification.measurements import Measurement, derive_velocity
+        return [Measurement(self.time_s, self.displacement_mm[:, c], self.force_N[:, c],
+                            self.velocity_mm_s[:, c] if self.velocity_mm_s is not None
+                            else derive_velocity(self.time_s, self.displacement_mm[:, c]),
+                            velocity_derived=self.velocity_mm_s is None, source=f"{self.source} ({axis})")
+                for c, axis in enumerate(self.axes)]
 
-def load_multiaxis(path: str | Path) -> MultiAxisMeasurement:
+
+def _data_lines(path: Path) -> list[tuple[int, str]]:
+    """(line number, text) of the lines that are neither blank nor ``#`` comments."""
+    with open(path, newline="", encoding="utf-8") as handle:
+        return [(number, line) for number, line in enumerate(handle, start=1) if line.strip()
+                and not line.lstrip().startswith("#")]
+
+
+def is_multiaxis_file(path: str | Path) -> bool:
+    """Whether a CSV's header names multi-axis columns (``dx_mm``), as opposed to a one-axis test's."""
+    lines = _data_lines(Path(path)) if Path(path).is_file() else []
+    return bool(lines) and "dx_mm" in [name.strip() for name in next(csv.reader([lines[0][1]]))]
+
+
+def load_multiaxis(path: str | Path, force_optional: bool = False) -> MultiAxisMeasurement:
     """Read a multi-axis test (module docstring); IdentificationError names the file, the line or
-    the column, and what is allowed."""
+    the column, and what is allowed. ``force_optional``: a path without force columns is read too
+    (``has_force`` False, forces 0), as ``predict`` takes one."""
     path = Path(path)
     if not path.is_file():
         raise IdentificationError(f"multi-axis file {path} does not exist")
-    with open(path, newline="", encoding="utf-8") as handle:
-        lines = [(number, line) for number, line in enumerate(handle, start=1) if line.strip()
-                 and not line.lstrip().startswith("#")]
+    lines = _data_lines(path)
     if not lines:
         raise IdentificationError(f"{path}: no header row (time_s,dx_mm,dy_mm,Fx_N,Fy_N ...)")
     header_line, header_text = lines[0]
     header = [name.strip() for name in next(csv.reader([header_text]))]
     axes = AXIS_NAMES[:3 if "dz_mm" in header or "Fz_N" in header else 2]
-    wanted = ["time_s"] + [f"d{a}_mm" for a in axes] + [f"F{a}_N" for a in axes]
+    forces = [f"F{a}_N" for a in axes]
+    has_force = not (force_optional and not any(name in header for name in forces))
+    wanted = ["time_s"] + [f"d{a}_mm" for a in axes] + (forces if has_force else [])
     missing = [name for name in wanted if name not in header]
     if missing:
         raise IdentificationError(f"{path}, line {header_line}: missing column{'s' if len(missing) > 1 else ''} "
@@ -103,8 +135,9 @@ def load_multiaxis(path: str | Path) -> MultiAxisMeasurement:
         raise IdentificationError(f"{path}, line {lines[1 + bad][0]}: time {t[bad]} s does not increase (after "
                                   f"{t[bad - 1]} s)")
     pick = lambda names: table[:, [columns[name] for name in names]]   # noqa: E731
-    return MultiAxisMeasurement(str(path), t, pick([f"d{a}_mm" for a in axes]), pick([f"F{a}_N" for a in axes]),
-                                pick(velocities) if given else None)
+    displacement = pick([f"d{a}_mm" for a in axes])
+    return MultiAxisMeasurement(str(path), t, displacement, pick(forces) if has_force else np.zeros_like(displacement),
+                                pick(velocities) if given else None, has_force)
 
 
 def write_multiaxis(path: str | Path, time_s, displacement_mm, force_N, comments=()) -> Path:
@@ -120,30 +153,50 @@ def write_multiaxis(path: str | Path, time_s, displacement_mm, force_N, comments
     return path
 
 
+COUPLED_AXES = {"none": 0, "radial": 2, "spherical": 3}
+"""The couplings a multi-axis test is run with, and how many of its leading axes each couples: none,
+one model per axis; radial, x and y (z, if the test has it, on its own); spherical, x, y and z."""
+
+
+def coupled_axes(coupling: str, measurement: MultiAxisMeasurement | int) -> int:
+    """The leading axes ``coupling`` (one of COUPLED_AXES) runs coupled on ``measurement`` (or on a
+    test of that many axes); IdentificationError for an unknown coupling, or spherical on a plane test."""
+    if coupling not in COUPLED_AXES:
+        raise IdentificationError(f"unknown coupling {coupling!r} for a multi-axis test; allowed: "
+                                  f"{', '.join(COUPLED_AXES)}")
+    axes = measurement if isinstance(measurement, int) else measurement.displacement_mm.shape[1]
+    if COUPLED_AXES[coupling] > axes:
+        where = "" if isinstance(measurement, int) else f"{measurement.source}: "
+        raise IdentificationError(f"{where}the {coupling} coupling needs {COUPLED_AXES[coupling]} axes (dz_mm, Fz_N); "
+                                  f"this test has {axes} (x, y): use radial or none")
+    return COUPLED_AXES[coupling]
+
+
 def simulate_multiaxis(parameters, time_s, displacement_mm, model: str | BushingModel | None = None,
-                       coupled: bool = True) -> np.ndarray:
+                       coupling: str | None = None, velocity_mm_s=None, steps_per_sample: int | None = None
+                       ) -> np.ndarray:
     """The force vectors [N], (samples, d), of a parameter set on a multi-axis path ``displacement_mm``
-    (samples, d = 2 or 3) at the times ``time_s``, as the six-axis FMU gives them (module docstring):
-    ``coupled`` the model's coupled form on the displacement vector, else its one-axis model on each
-    axis alone. The bushing starts relaxed at the first sample. ``parameters``: any form
-    ``parameter_input`` takes (a mounting's offset and preload apply to every axis alike)."""
-    from identification.compiled_core import simulate_coupled_held, simulate_population_held
+    (samples, d = 2 or 3) [mm] at the times ``time_s`` [s] (and its measured ``velocity_mm_s``, if
+    any), driven as the fit drives a test (module docstring), with ``coupling`` (COUPLED_AXES;
+    default: every axis of the path coupled, radial on a plane, spherical in 3-space). The bushing
+    starts relaxed at the first sample. ``parameters``: any form ``parameter_input`` takes (a
+    mounting's offset [mm] and preload [N] apply to every axis alike)."""
+    from identification.compiled_core import parameter_matrix
+    from identification.forward_model import prepare_vector_input
     from identification.parameter_input import parameter_sets
+    from identification.simulate import simulate_driven_vector
     bushing, sets = parameter_sets(parameters, model)
     values = sets[0]
-    t = np.ascontiguousarray(time_s, dtype=float)
+    t = np.asarray(time_s, dtype=float)
     x = np.atleast_2d(np.asarray(displacement_mm, dtype=float))
     if x.ndim != 2 or x.shape[0] != t.size or x.shape[1] not in (2, 3):
         raise ValueError(f"displacement_mm must be (samples, 2 or 3) with one row per time, got {x.shape} for "
                          f"{t.size} times")
+    coupled = coupled_axes(coupling, x.shape[1]) if coupling is not None else x.shape[1]
     offset, preload = bushing.mounting(values)
-    x = x - offset
-    secant = np.vstack([np.diff(x, axis=0) / np.diff(t)[:, None], np.zeros((1, x.shape[1]))])
-    if coupled and bushing.coupled is not None:
-        return simulate_coupled_held([values], t, x, secant, model=bushing)[0] + preload
-    # uncoupled, or Kelvin-Voigt, whose linear elements couple nothing
-    return np.column_stack([simulate_population_held([values], t, x[:, c], secant[:, c], model=bushing)[0]
-                            for c in range(x.shape[1])]) + preload
+    driven = prepare_vector_input(t, x - offset, velocity_mm_s, steps=steps_per_sample)
+    return simulate_driven_vector(parameter_matrix([values], bushing), driven, model=bushing,
+                                  coupled_axes=coupled)[0] + preload
 
 
 def vector_nrmse(predicted: np.ndarray, measured: np.ndarray) -> float:

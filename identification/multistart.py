@@ -72,16 +72,16 @@ class Problem:
     def residuals_and_jacobian(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The residuals (n,) at one point ``theta`` (d,), the same bits as :meth:`residuals`, and
         their exact Jacobian (n, d) with respect to the coordinates: the parameters' derivatives
-        (``SearchSpace.to_parameters_and_seeds``) carried through the simulation. A table's rows
-        by forward differences (one table simulation per coordinate)."""
+        (``SearchSpace.to_parameters_and_seeds``) carried through the simulation. The multi-axis
+        tests' and a table's rows by forward differences (one simulation of them per coordinate)."""
         theta = np.asarray(theta, dtype=float)
         matrix, seeds = self.space.to_parameters_and_seeds(theta[None, :])
         residual, derivative = self.objective.residual_jacobian(matrix, seeds)
         residual, derivative = residual[0], derivative[0]
-        if self.objective.table is not None:
-            rows = slice(residual.size - self.objective.table.size, residual.size)
+        if self.objective.difference_size:
+            rows = slice(residual.size - self.objective.difference_size, residual.size)
             steps = difference_steps(self.space, theta)
-            shifted = self.objective.table_residuals(self.space.to_parameters(theta + np.diag(steps)))
+            shifted = self.objective.difference_residuals(self.space.to_parameters(theta + np.diag(steps)))
             difference = ((shifted - residual[rows]) / steps[:, None]).T
             derivative[rows] = np.where(np.isnan(derivative[rows]), difference, derivative[rows])
         return residual, derivative

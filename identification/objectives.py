@@ -31,12 +31,13 @@ from typing import Sequence
 import numpy as np
 
 from fmu_src.bushing_models import BushingModel, resolve_model
-from identification.forward_model import DrivenInput, prepare_input
+from identification.forward_model import DrivenInput, DrivenVectorInput, prepare_input, prepare_vector_input
 from identification.kdyn_table import (FIT_CYCLES, FIT_STEPS_PER_CYCLE, KDYN_UNCERTAINTY, LOSS_ANGLE_UNCERTAINTY_DEG,
                                        SEARCH_CYCLES, SEARCH_STEPS_PER_CYCLE, KdynTable)
+from identification.multiaxis import MultiAxisMeasurement, coupled_axes
 from identification.noise import NoiseEstimate, estimate_noise
 from identification.rig_tests import RigTest
-from identification.simulate import simulate_driven
+from identification.simulate import simulate_driven, simulate_driven_vector
 
 FIT_MAX_SUBSTEPS = 100
 """Substeps per communication step after which a candidate counts as failed: a plausible
@@ -54,6 +55,38 @@ class PreparedTest:
     driven: DrivenInput
     measured_N: np.ndarray      # the measured force at driven.sample_index
     sigma_N: float              # the noise level the residuals are divided by
+
+
+@dataclass(frozen=True)
+class PreparedMultiAxis:
+    """What the objective keeps of one multi-axis training test (``identification.multiaxis``):
+    its driven input, the measured force vectors at the samples (samples, d), each axis's noise
+    level (d,) and how many of its leading axes the model runs coupled (its coupled form on their
+    displacement vector; the others one model per axis: ``multiaxis.coupled_axes``)."""
+    name: str
+    driven: DrivenVectorInput
+    measured_N: np.ndarray
+    sigma_N: np.ndarray
+    coupled_axes: int
+
+    @classmethod
+    def of(cls, measurement: MultiAxisMeasurement, noise: Sequence[NoiseEstimate], coupling: str,
+           steps: int | None = None) -> "PreparedMultiAxis":
+        driven = prepare_vector_input(measurement.time_s, measurement.displacement_mm, measurement.velocity_mm_s,
+                                      steps=steps)
+        sigma = np.array([max(level.sigma_N, MIN_NOISE_FRACTION * level.rms_force_N) for level in noise])
+        return cls(measurement.name, driven, measurement.force_N[driven.sample_index], sigma,
+                   coupled_axes(coupling, measurement))
+
+    @property
+    def size(self) -> int:
+        return self.measured_N.size
+
+    def residuals(self, matrix: np.ndarray, model: BushingModel) -> np.ndarray:
+        """(P, samples x d): each sample's force vector error, axis by axis, in its axis's noise
+        units (NaN from where a candidate fails)."""
+        predicted = simulate_driven_vector(matrix, self.driven, FIT_MAX_SUBSTEPS, model, self.coupled_axes)
+        return ((predicted - self.measured_N) / self.sigma_N).reshape(matrix.shape[0], -1)
 
 
 @dataclass(frozen=True)
@@ -100,16 +133,23 @@ class Objective:
 
     def __init__(self, tests: Sequence[RigTest], noise: Sequence[NoiseEstimate] | None = None,
                  steps: Sequence[int | None] | None = None, model: str | BushingModel = "proposed",
-                 table: KdynTable | None = None, search: bool = False):
+                 table: KdynTable | None = None, search: bool = False,
+                 multiaxis: Sequence[MultiAxisMeasurement] = (),
+                 multiaxis_noise: Sequence[Sequence[NoiseEstimate]] | None = None, coupling: str = "none"):
         """``steps``: communication steps per sample of each test (None: chosen from the
         signal, ``forward_model.steps_per_sample``); ``identification.refinement`` raises them
         where a candidate's response needs it. ``table``: a dynamic-stiffness table whose rows
         add two residuals each (``identification.kdyn_table``), with the search's coarser loop
         if ``search``. Candidates are (P, m) matrices of ``model``'s parameters in its order
         (``compiled_core.parameter_matrix``). ``model``: the model or its name, resolved here
-        (``bushing``; ``model`` is its name); a worker receives the name and resolves it once."""
-        if not tests and table is None:
-            raise ValueError("the objective needs at least one training test or a dynamic-stiffness table")
+        (``bushing``; ``model`` is its name); a worker receives the name and resolves it once.
+        ``multiaxis``: multi-axis tests (``identification.multiaxis``), each axis's force a residual
+        in that axis's noise units (``multiaxis_noise``: per test, per axis; default: estimated),
+        the model run on them with ``coupling`` (none, radial, spherical: ``multiaxis.coupled_axes``);
+        their steps per sample are the signal's (the refinement does not change them)."""
+        if not tests and table is None and not multiaxis:
+            raise ValueError("the objective needs at least one training test, multi-axis test or dynamic-stiffness "
+                             "table")
         noise = list(noise) if noise is not None else [estimate_noise(t.measurement.force_N) for t in tests]
         if len(noise) != len(tests):
             raise ValueError(f"{len(noise)} noise levels for {len(tests)} tests")
@@ -129,19 +169,28 @@ class Objective:
         self._source_table = table
         self.search = search and table is not None
         self.table = PreparedTable.of(table, search) if table is not None else None
-        self.size = sum(t.measured_N.size for t in self.tests) + (self.table.size if self.table else 0)
+        self._source_multiaxis = tuple(multiaxis)
+        self.coupling = coupling
+        self.multiaxis_noise = [list(levels) for levels in multiaxis_noise] if multiaxis_noise is not None else \
+            [[estimate_noise(m.force_N[:, c]) for c in range(m.force_N.shape[1])] for m in multiaxis]
+        self.multiaxis = [PreparedMultiAxis.of(m, levels, coupling)
+                          for m, levels in zip(self._source_multiaxis, self.multiaxis_noise)]
+        self.size = (sum(t.measured_N.size for t in self.tests) + sum(m.size for m in self.multiaxis)
+                     + (self.table.size if self.table else 0))
 
     def with_steps(self, tests: Sequence[RigTest], steps: Sequence[int]) -> "Objective":
         """The same objective (of ``tests``, the ones it was made of) with other steps per
         sample (the table's loop as it is)."""
-        return Objective(tests, self.noise, steps, self.bushing, self._source_table, self.search)
+        return Objective(tests, self.noise, steps, self.bushing, self._source_table, self.search,
+                         self._source_multiaxis, self.multiaxis_noise, self.coupling)
 
     def with_fit_loop(self, tests: Sequence[RigTest]) -> "Objective":
         """The same objective with the table's fit loop instead of its search loop (itself if it
         has none)."""
         if not self.search:
             return self
-        return Objective(tests, self.noise, self.steps_per_sample, self.bushing, self._source_table, False)
+        return Objective(tests, self.noise, self.steps_per_sample, self.bushing, self._source_table, False,
+                         self._source_multiaxis, self.multiaxis_noise, self.coupling)
 
     def __getstate__(self):
         """Everything but the model, which does not pickle: a worker resolves its name."""
@@ -163,10 +212,22 @@ class Objective:
         for test in self.tests:
             predicted = simulate_driven(matrix, test.driven, FIT_MAX_SUBSTEPS, self.bushing)
             parts.append((predicted - test.measured_N) * (scale / test.sigma_N))
+        residual = np.concatenate(parts + [self._difference_part(matrix)], axis=1)
+        return np.where(np.isfinite(residual), residual, FAILED_RESIDUAL * scale)
+
+    @property
+    def difference_size(self) -> int:
+        """The last residuals, the multi-axis tests' and the table's, which have no sensitivities:
+        a Jacobian takes them by differences (:meth:`difference_residuals`)."""
+        return sum(m.size for m in self.multiaxis) + (self.table.size if self.table else 0)
+
+    def _difference_part(self, matrix: np.ndarray) -> np.ndarray:
+        """The multi-axis tests' and the table's residuals, scaled, NaN where a candidate fails."""
+        scale = 1.0 / math.sqrt(self.size)
+        parts = [m.residuals(matrix, self.bushing) * scale for m in self.multiaxis]
         if self.table is not None:
             parts.append(self.table.residuals(matrix, self.bushing) * scale)
-        residual = np.concatenate(parts, axis=1)
-        return np.where(np.isfinite(residual), residual, FAILED_RESIDUAL * scale)
+        return np.concatenate(parts, axis=1) if parts else np.empty((matrix.shape[0], 0))
 
     def residual_jacobian(self, matrix: np.ndarray, seeds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Residuals of P candidates (P, n), the same bits as :meth:`residual_matrix`, and their
@@ -174,8 +235,9 @@ class Objective:
         of the m parameters), computed with them (``identification.fit_jacobian``). A failed
         candidate's residuals are the constant FAILED_RESIDUAL from where it fails: derivative 0
         there, and so is a derivative that overflows where the force does not. A table's rows get
-        NaN derivatives: the caller takes those by differences (:meth:`table_residuals`), the
-        table's steady-state loop has no sensitivities."""
+        NaN derivatives, and so do the multi-axis tests' (``difference_size``): the caller takes those
+        by differences (:meth:`difference_residuals`); the coupled kernels and the table's steady-state
+        loop have no sensitivities."""
         from identification.fit_jacobian import population_sensitivities
         scale = 1.0 / math.sqrt(self.size)
         parts, derivatives = [], []
@@ -186,9 +248,8 @@ class Objective:
                                                               FIT_MAX_SUBSTEPS, self.bushing)
             parts.append((predicted - test.measured_N) * (scale / test.sigma_N))
             derivatives.append(sensitivity * (scale / test.sigma_N))
-        if self.table is not None:
-            parts.append(self.table.residuals(matrix, self.bushing) * scale)
-            derivatives.append(np.full((matrix.shape[0], self.table.size, seeds.shape[2]), np.nan))
+        parts.append(self._difference_part(matrix))
+        derivatives.append(np.full((matrix.shape[0], self.difference_size, seeds.shape[2]), np.nan))
         residual = np.concatenate(parts, axis=1)
         failed = ~np.isfinite(residual)
         # a failed residual is a constant (derivative 0); a derivative that overflows where the
@@ -196,16 +257,15 @@ class Objective:
         # step from there stays finite
         derivative = np.concatenate(derivatives, axis=1)
         derivative = np.where(failed[:, :, None] | ~np.isfinite(derivative), 0.0, derivative)
-        if self.table is not None:
-            rows = slice(residual.shape[1] - self.table.size, residual.shape[1])
-            derivative[:, rows] = np.where(failed[:, rows, None], 0.0, np.nan)
+        rows = slice(residual.shape[1] - self.difference_size, residual.shape[1])
+        derivative[:, rows] = np.where(failed[:, rows, None], 0.0, np.nan)
         return np.where(failed, FAILED_RESIDUAL * scale, residual), derivative
 
-    def table_residuals(self, matrix: np.ndarray) -> np.ndarray:
-        """The table's rows of :meth:`residual_matrix` alone, shape (P, table rows x 2)."""
-        scale = 1.0 / math.sqrt(self.size)      # as residual_matrix scales them: the same bits
-        residual = self.table.residuals(matrix, self.bushing) * scale
-        return np.where(np.isfinite(residual), residual, FAILED_RESIDUAL * scale)
+    def difference_residuals(self, matrix: np.ndarray) -> np.ndarray:
+        """The last ``difference_size`` residuals of :meth:`residual_matrix` alone (the multi-axis
+        tests', then the table's), shape (P, difference_size): the same bits."""
+        residual = self._difference_part(matrix)
+        return np.where(np.isfinite(residual), residual, FAILED_RESIDUAL / math.sqrt(self.size))
 
     def __call__(self, matrix: np.ndarray) -> np.ndarray:
         """Misfit of each of P candidates, shape (P,)."""
@@ -213,9 +273,11 @@ class Objective:
 
     def test_misfits(self, matrix: np.ndarray) -> np.ndarray:
         """(NRMSE_i/noise_i)^2 on the residual samples of each test, shape (P, tests); with a
-        table, a last column: its mean squared residual (in uncertainty units)."""
+        table, a last column: its mean squared residual (in uncertainty units); multi-axis tests'
+        columns come between, each the mean over its samples and axes."""
         residual = self.residual_matrix(np.atleast_2d(matrix)) * math.sqrt(self.size)
-        bounds = np.cumsum([0] + [t.measured_N.size for t in self.tests] + ([self.table.size] if self.table else []))
+        bounds = np.cumsum([0] + [t.measured_N.size for t in self.tests] + [m.size for m in self.multiaxis]
+                           + ([self.table.size] if self.table else []))
         return np.column_stack([np.mean(residual[:, a:b] ** 2, axis=1) for a, b in zip(bounds[:-1], bounds[1:])])
 
 

@@ -61,6 +61,40 @@ def plot_comparison(measurement: Measurement, predictions: dict, path: Path, ban
     return _save(figure, path)
 
 
+def plot_multiaxis(measurement, predictions: dict, path: Path, measured: bool = True) -> Path:
+    """A multi-axis test (``multiaxis.MultiAxisMeasurement``): each axis's measured and predicted force
+    over time, and the force vector's path (Fy against Fx) beside the displacement's (dy against dx).
+    ``predictions``: {label: force vectors (samples, d) [N]}, drawn in the order given."""
+    from identification.multiaxis import vector_nrmse
+    plt = _pyplot()
+    m = measurement
+    figure, (in_time, force_path, motion) = plt.subplots(1, 3, figsize=(15, 4.4))
+    styles = ("-", "--", ":")
+    if measured:
+        for c, axis in enumerate(m.axes):
+            in_time.plot(m.time_s, m.force_N[:, c] / 1e3, color="0.55", lw=1.4, ls=styles[c],
+                         label=f"measured F{axis}")
+        force_path.plot(m.force_N[:, 0] / 1e3, m.force_N[:, 1] / 1e3, color="0.55", lw=1.2, label="measured")
+    for i, (label, predicted) in enumerate(predictions.items()):
+        text = label + (f" (NRMSE {vector_nrmse(predicted, m.force_N):.1%})" if measured else "")
+        for c, axis in enumerate(m.axes):
+            in_time.plot(m.time_s, predicted[:, c] / 1e3, color=f"C{i}", lw=1.0, ls=styles[c],
+                         label=f"{text}: F{axis}" if measured or c == 0 else f"F{axis}")
+        force_path.plot(predicted[:, 0] / 1e3, predicted[:, 1] / 1e3, color=f"C{i}", lw=1.0, label=text)
+    motion.plot(m.displacement_mm[:, 0], m.displacement_mm[:, 1], color="0.3", lw=1.0)
+    in_time.set(xlabel="time [s]", ylabel="force [kN]", title=m.name)
+    force_path.set(xlabel="Fx [kN]", ylabel="Fy [kN]", title="force vector")
+    motion.set(xlabel="dx [mm]", ylabel="dy [mm]", title="displacement path")
+    in_time.legend(loc="best", fontsize=7)
+    force_path.legend(loc="best", fontsize=7)
+    for axes in (in_time, force_path, motion):
+        axes.grid(alpha=0.3)
+    for axes in (force_path, motion):
+        axes.set_aspect("equal", adjustable="datalim")
+    figure.tight_layout()
+    return _save(figure, path)
+
+
 def plot_waterfall(misfits: Sequence[float], stages: Sequence[int], best: float, threshold: float,
                    path: Path) -> Path:
     """pyPESTO's waterfall: every start's final misfit, sorted, coloured by the last stage it

@@ -2,7 +2,8 @@
 
 ``predict(parameters, time_s, displacement_mm, velocity_mm_s=None, model=None)`` simulates (the forward
 model, ``identification.simulate``) the best parameter set and, for an ensemble, every
-member, in one compiled population call. The band is the members' envelope (min, max) at
+member, in one compiled population call, each with its mounting (offset, preload);
+``predict_multiaxis`` does the same on a multi-axis path with a coupling. The band is the members' envelope (min, max) at
 every sample: the spread of the parameter sets the training tests cannot tell apart (a
 confidence band). Add the noise level for where a measurement may fall (a prediction band).
 
@@ -98,12 +99,92 @@ def predict(parameters, time_s, displacement_mm, velocity_mm_s=None,
         The best set's simulation fails (overflow), with the time it fails from.
     """
     bushing, sets = parameter_sets(parameters, model)
-    driven = prepare_input(time_s, displacement_mm, velocity_mm_s)
-    forces = simulate_driven(parameter_matrix(sets, bushing), driven, model=bushing)
-    failed = ~np.isfinite(forces[0])
+    x = np.asarray(displacement_mm, dtype=float)
+    forces = _mounted_population(bushing, sets, lambda matrix, offset: simulate_driven(
+        matrix, prepare_input(time_s, x - offset, velocity_mm_s), model=bushing))
+    _refuse_failed(forces[0], time_s)
+    return Prediction(np.asarray(time_s, dtype=float), x, forces[0], np.nanmin(forces, axis=0),
+                      np.nanmax(forces, axis=0), len(sets))
+
+
+@dataclass
+class MultiAxisPrediction:
+    """What ``predict_multiaxis`` returns: as :class:`Prediction`, with displacement and force
+    vectors (samples, d) [mm, N] and the coupling they were simulated with."""
+    time_s: np.ndarray
+    displacement_mm: np.ndarray
+    force_N: np.ndarray
+    lower_N: np.ndarray
+    upper_N: np.ndarray
+    members: int
+    coupling: str
+
+    @property
+    def band_width_N(self) -> np.ndarray:
+        return self.upper_N - self.lower_N
+
+    def write_csv(self, path: str | Path) -> Path:
+        """A multi-axis file (``multiaxis.write_multiaxis``: ``time_s,dx_mm,dy_mm,Fx_N,Fy_N``...) and,
+        for an ensemble, ``Fx_min_N,Fx_max_N``... of each axis."""
+        from identification.multiaxis import AXIS_NAMES
+        axes = AXIS_NAMES[:self.force_N.shape[1]]
+        columns = [self.time_s[:, None], self.displacement_mm, self.force_N]
+        header = ["time_s"] + [f"d{a}_mm" for a in axes] + [f"F{a}_N" for a in axes]
+        if self.members > 1:
+            for c, a in enumerate(axes):
+                columns += [self.lower_N[:, c:c + 1], self.upper_N[:, c:c + 1]]
+                header += [f"F{a}_min_N", f"F{a}_max_N"]
+        table = np.hstack(columns)
+        path = Path(path)
+        with open(path, "w", newline="", encoding="utf-8") as stream:
+            stream.write(f"# predicted by identification.predict from {self.members} parameter set(s), "
+                         f"{self.coupling} coupling\n" + ",".join(header) + "\n")
+            d = len(axes)
+            np.savetxt(stream, table, delimiter=",", fmt=["%.6f"] * (1 + d) + ["%.4f"] * (table.shape[1] - 1 - d))
+        return path
+
+
+def predict_multiaxis(parameters, time_s, displacement_mm, coupling: str, velocity_mm_s=None,
+                      model: str | BushingModel | None = None) -> MultiAxisPrediction:
+    """Predict a multi-axis path (``displacement_mm`` (samples, d = 2 or 3) [mm]) as :func:`predict`
+    does one axis, with ``coupling`` (``multiaxis.COUPLED_AXES``: none, radial, spherical):
+    ``multiaxis.simulate_multiaxis`` of every member in one population call. Raises
+    IdentificationError for a coupling the path cannot carry or a best set whose simulation fails."""
+    from identification.forward_model import prepare_vector_input
+    from identification.multiaxis import coupled_axes
+    from identification.simulate import simulate_driven_vector
+    bushing, sets = parameter_sets(parameters, model)
+    x = np.atleast_2d(np.asarray(displacement_mm, dtype=float))
+    t = np.asarray(time_s, dtype=float)
+    if x.ndim != 2 or x.shape[0] != t.size or x.shape[1] not in (2, 3):
+        raise IdentificationError(f"a multi-axis path has 2 or 3 displacement columns, one row per time: got "
+                                  f"{x.shape} for {t.size} times")
+    coupled = coupled_axes(coupling, x.shape[1])
+    forces = _mounted_population(bushing, sets, lambda matrix, offset: simulate_driven_vector(
+        matrix, prepare_vector_input(t, x - offset, velocity_mm_s), model=bushing, coupled_axes=coupled))
+    _refuse_failed(forces[0], t)
+    return MultiAxisPrediction(t, x, forces[0], np.nanmin(forces, axis=0), np.nanmax(forces, axis=0), len(sets),
+                               coupling)
+
+
+def _mounted_population(bushing: BushingModel, sets, simulate_at) -> np.ndarray:
+    """Forces (P, ...) of the parameter sets, each with its mounting (F = model(x - offset) +
+    preload, ``BushingModel.mounting``): ``simulate_at(matrix, offset)`` once for each mounting
+    the sets carry (a fit's members share one)."""
+    mountings = [bushing.mounting(values) for values in sets]
+    forces = [None] * len(sets)
+    for offset, preload in dict.fromkeys(mountings):
+        members = [i for i, mounting in enumerate(mountings) if mounting == (offset, preload)]
+        result = simulate_at(parameter_matrix([sets[i] for i in members], bushing), offset) + preload
+        for row, i in zip(result, members):
+            forces[i] = row
+    return np.array(forces)
+
+
+def _refuse_failed(force: np.ndarray, time_s) -> None:
+    failed = ~np.isfinite(force)
     if failed.any():
+        first = np.argmax(failed.reshape(failed.shape[0], -1).any(axis=1))
         raise IdentificationError(f"the simulation of the best parameter set fails from t = "
-                         f"{np.asarray(time_s)[np.argmax(failed)]:g} s (overflow or too many substeps): "
-                         "check the units of the displacement (mm) and the amplitude")
-    return Prediction(np.asarray(time_s, dtype=float), np.asarray(displacement_mm, dtype=float), forces[0],
-                      np.nanmin(forces, axis=0), np.nanmax(forces, axis=0), len(sets))
+                                  f"{np.asarray(time_s)[first]:g} s (overflow or too many substeps): "
+                                  "check the units of the displacement (mm) and the amplitude")

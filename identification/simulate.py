@@ -1,12 +1,13 @@
 """Simulate any of the project's models on a sampled test: the identification's forward model.
 
 ``simulate(parameters, time_s, displacement_mm, velocity_mm_s=None, model=None, steps_per_sample=None)``
-returns the force [N] at every sample of a parameter set of the proposed model, Spencer's,
-the single Bouc-Wen or Kelvin-Voigt (``fmu_src.bushing_models``), driven by a smooth
+returns the force [N] at every sample of a parameter set of any of the models
+(``fmu_src.bushing_models``), driven by a smooth
 interpolant of the sampled displacement (``identification.forward_model``): the
 continuous-time model, which the fit compares with measurements. The FMU, a co-simulation
 slave, sees its inputs held over each communication step instead
-(``compiled_core.simulate_population_held``).
+(``compiled_core.simulate_population_held``). ``simulate_driven_vector`` drives a multi-axis path
+(``identification.multiaxis.simulate_multiaxis``), coupled or one model per axis.
 
 Units: time in s, displacement in mm, velocity in mm/s, force in N, parameters in the
 paper's N-mm-s units. The bushing starts in relaxed equilibrium at the first displacement.
@@ -15,9 +16,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from fmu_src.bushing_models import BushingModel
-from identification.compiled_core import parameter_matrix, simulate_population_at
-from identification.forward_model import DrivenInput, prepare_input
+from fmu_src.bushing_models import BushingModel, resolve_model
+from identification.compiled_core import parameter_matrix, simulate_coupled_at, simulate_population_at
+from identification.forward_model import DrivenInput, DrivenVectorInput, prepare_input
 from identification.parameter_input import parameter_sets
 
 
@@ -72,6 +73,25 @@ def simulate_driven(matrix: np.ndarray, driven: DrivenInput, max_substeps: int |
     kwargs = {} if max_substeps is None else {"max_substeps": max_substeps}
     return simulate_population_at(matrix, driven.time_s, driven.displacement_mm, driven.velocity_mm_s,
                                   driven.output_index, driven.output_velocity_mm_s, model=model, **kwargs)
+
+
+def simulate_driven_vector(matrix: np.ndarray, driven: DrivenVectorInput, max_substeps: int | None = None,
+                           model: str | BushingModel = "proposed", coupled_axes: int = 0) -> np.ndarray:
+    """Force vectors [N], shape (P, outputs, d), of a (P, m) matrix of ``model``'s parameters on a
+    prepared multi-axis input, at its output samples: the first ``coupled_axes`` axes (2 or 3) run
+    the model's coupled form on their displacement vector (``model_definition.CoupledKernels``),
+    every other axis its one-axis model alone (0: every axis alone; so does Kelvin-Voigt, whose
+    linear elements couple nothing). NaN from where a candidate fails."""
+    bushing = resolve_model(model)
+    kwargs = {} if max_substeps is None else {"max_substeps": max_substeps}
+    parts = []
+    if coupled_axes and bushing.coupled is not None:
+        group = DrivenVectorInput(driven.components[:coupled_axes])
+        parts.append(simulate_coupled_at(matrix, group.time_s, group.displacement_mm, group.velocity_mm_s,
+                                         group.output_index, group.output_velocity_mm_s, model=bushing, **kwargs))
+    alone = driven.components[coupled_axes if bushing.coupled is not None else 0:]
+    parts += [simulate_driven(matrix, c, max_substeps, bushing)[:, :, None] for c in alone]
+    return np.concatenate(parts, axis=2)
 
 
 def _parameters_and_model(parameters, model):

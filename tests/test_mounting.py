@@ -1,6 +1,6 @@
 """Every axis mounts its model with an offset and a preload, as MSC Adams' BUSHING does:
 F = model(x - offset) + preload (model_definition.MOUNTING_SPECS), in the pythonfmu and the native
-FMUs, one axis and six, and in the identification's simulate. 0 and 0 give the model's forces as
+FMUs, one axis and six, and in the identification's simulate and predict. 0 and 0 give the model's forces as
 its kernels compute them, bit for bit."""
 import math
 
@@ -123,6 +123,17 @@ def test_simulate_takes_the_mounting_of_a_parameter_set(name):
     mounted = simulate(dict(params, offset=OFFSET_MM, preload=PRELOAD_N), t, PATH_MM + OFFSET_MM, model=name)
     assert np.max(np.abs(mounted - PRELOAD_N - plain)) <= 1e-12 * np.max(np.abs(plain))
     assert np.array_equal(simulate(dict(params, offset=0.0, preload=0.0), t, PATH_MM, model=name), plain)
+
+
+def test_predict_takes_each_members_mounting():
+    from identification.predict import predict
+    params = read_parameter_set(DATA / "params_table5_combined.json").parameters
+    plain = simulate(params, t, PATH_MM)
+    members = [dict(params, offset=OFFSET_MM, preload=PRELOAD_N), dict(params, offset=0.0, preload=0.0)]
+    prediction = predict(members, t, PATH_MM + OFFSET_MM)
+    assert np.max(np.abs(prediction.force_N - PRELOAD_N - plain)) <= 1e-12 * np.max(np.abs(plain))
+    # the second member, unmounted, sees the path OFFSET_MM further out: the band holds both
+    assert np.array_equal(np.minimum(prediction.force_N, simulate(params, t, PATH_MM + OFFSET_MM)), prediction.lower_N)
 
 
 def test_a_mounting_that_is_not_a_finite_number_is_refused_by_name():
