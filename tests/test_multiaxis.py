@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scipy.integrate import solve_ivp
 
 from fmu_src.bushing_models import get_model
 from identification.__main__ import main
@@ -29,36 +30,35 @@ TRUTH = {"c0": 0.6, "k0": 300.0, "alpha": 1.0, "A": 900.0, "beta": 0.045, "gamma
 """The test's own single Bouc-Wen bushing (N-mm-s), as bench_coupled_prediction.py's."""
 
 
-def fine_truth(parameters, path, t, coupled=True, refine=4):
-    """The displacements [mm] and the scipy reference's force vectors [N] at the samples ``t``
-    (STEP_S apart) on the analytic ``path`` sampled ``refine`` times finer: the continuous-time force
-    to a few 1e-4 of the peak (the held input's error falls with the step), which the fit's forward
-    model approximates."""
-    h = STEP_S / refine
-    fine = np.arange(0.0, t[-1] + h / 2, h)
-    # with two points about t = 0 for the velocity there; evaluated together, as the random path
-    # scales itself by its largest radius over the times it is given
-    xy, ends = np.split(path(np.concatenate([fine, [-1e-7, 1e-7]])), [fine.size])
-    if coupled:
-        forces = references.solve_path(references.SingleBoucWen(parameters), fine, xy, h)[:, 3:5]
-    else:
-        forces = np.column_stack([references.solve_path(references.SingleBoucWen(parameters), fine,
-                                                        np.column_stack([xy[:, c], 0 * fine]), h)[:, 3]
-                                  for c in range(2)])
-    # at t = 0 the reference writes 0; the bushing at rest moving at the path's velocity there
-    # carries its dashpot's force
+def continuous_truth(parameters, path, t, coupled=True):
+    """The displacements [mm] and force vectors [N] at the times ``t`` of a single Bouc-Wen bushing
+    (the reference's equations) driven along the analytic ``path`` in continuous time: scipy's Radau
+    on the whole path at once (rtol 1e-8; 1e-10 changes the forces by 8e-10 of the peak), the
+    velocity the path's own. What a rig's smooth motion makes, and what the fit's forward model
+    approximates. ``coupled``: in the plane, else each axis on its own."""
     bushing = references.SingleBoucWen(parameters)
-    forces[0] = bushing.force(bushing.initial(), xy[0], (ends[1] - ends[0]) / 2e-7)[:2]
-    return xy[::refine][:t.size], forces[::refine][:t.size]
+    h = 1e-6
+
+    def position(s, axes):
+        return path(np.array([s]))[0] * axes
+
+    def velocity(s, axes):
+        return (path(np.array([s + h]))[0] - path(np.array([s - h]))[0]) / (2 * h) * axes
+
+    def run(axes):
+        solution = solve_ivp(lambda s, y: bushing.rates(y, position(s, axes), velocity(s, axes)), (t[0], t[-1]),
+                             bushing.initial(), method="Radau", t_eval=t, rtol=1e-8, atol=1e-10)
+        return np.array([bushing.force(y, position(s, axes), velocity(s, axes))[:2]
+                         for s, y in zip(t, solution.y.T)])
+    forces = run(np.ones(2)) if coupled else np.column_stack([run(np.eye(2)[c])[:, c] for c in range(2)])
+    return path(t), forces
 
 
-def truth(t, xy, coupled=True):
-    """The truth's force vectors at every sample [N]: coupled in the plane, or each axis on its own."""
-    if coupled:
-        return references.solve_path(references.SingleBoucWen(TRUTH), t, xy, STEP_S)[:, 3:5]
-    along = [references.solve_path(references.SingleBoucWen(TRUTH), t, np.column_stack([xy[:, c], 0 * t]),
-                                   STEP_S)[:, 3] for c in range(2)]
-    return np.column_stack(along)
+def scaled_random_path(t_range):
+    """The references' random path with its scale fixed over ``t_range`` (so that it is one function
+    of time, evaluated a point at a time)."""
+    scale = 3.0 / np.max(np.hypot(*references.random_walk(t_range).T))
+    return lambda s: scale * references.random_walk(s)
 
 
 def test_a_file_round_trips_and_a_model_predicts_it_as_the_reference_does(tmp_path):
@@ -71,12 +71,13 @@ def test_a_file_round_trips_and_a_model_predicts_it_as_the_reference_does(tmp_pa
     np.testing.assert_allclose(m.displacement_mm, xy, atol=1e-6)
     model = get_model("single_bouc_wen")
     coupled = simulate_multiaxis(TRUTH, t, xy, model)
-    # the scipy reference on the path sampled 4x finer
-    _, fine = fine_truth(TRUTH, path, t)
+    # the scipy reference in continuous time
+    _, fine = continuous_truth(TRUTH, path, t)
     peak = np.max(np.abs(fine))
     assert np.max(np.abs(coupled - fine)) <= 1e-3 * peak
     # the FMU's held input at the same samples is further from it: the forward model earns its keep
-    assert np.max(np.abs(truth(t, xy) - fine)[1:]) > 3 * np.max(np.abs(coupled - fine)[1:])
+    held = references.solve_path(references.SingleBoucWen(TRUTH), t, xy, STEP_S)[:, 3:5]
+    assert np.max(np.abs(held - fine)[1:]) > 3 * np.max(np.abs(coupled - fine)[1:])
     uncoupled = simulate_multiaxis(TRUTH, t, xy, model, coupling="none")
     assert vector_nrmse(uncoupled, coupled) > 0.01                       # the plane path tells them apart
     line = np.column_stack([xy[:, 0], 0 * t])
@@ -121,24 +122,25 @@ def test_a_multiaxis_file_that_cannot_be_used_is_refused_naming_the_line_or_colu
 @pytest.fixture(scope="module")
 def rig(tmp_path_factory):
     """Two sines along x alone (3 N noise) and an ellipse in the plane held out, of the coupled truth
-    and of the uncoupled one (each axis on its own): SYNTHETIC files made here."""
+    and of the uncoupled one (each axis on its own), from the scipy reference in continuous time:
+    SYNTHETIC files made here."""
     folder = tmp_path_factory.mktemp("multiaxis_rig")
     rng = np.random.default_rng(5)
     t = np.arange(0.0, 1.0 + STEP_S / 2, STEP_S)
     sines = []
     for amplitude, frequency in ((2.0, 10.0), (0.7, 4.0)):
-        x = amplitude * np.sin(2 * math.pi * frequency * t)
-        force = truth(t, np.column_stack([x, 0 * t]))[:, 0] + 3.0 * rng.standard_normal(t.size)
+        line, force = continuous_truth(TRUTH, lambda s: np.column_stack([amplitude * np.sin(2 * math.pi * frequency * s),
+                                                                  0 * s]), t)
         path = folder / f"synthetic_sine_{amplitude}mm_{frequency}Hz.csv"
-        write_measurement(path, t, x, force, ["SYNTHETIC: tests/test_multiaxis.py"])
+        write_measurement(path, t, line[:, 0], force[:, 0] + 3.0 * rng.standard_normal(t.size),
+                          ["SYNTHETIC: tests/test_multiaxis.py"])
         sines.append(path)
-    w = 2 * math.pi * 4.7
-    xy = np.stack([2.0 * np.sin(w * t), 1.2 * (1.0 - np.cos(w * t))], axis=1)
     held = {}
     for coupled in (True, False):
-        force = truth(t, xy, coupled) + 3.0 * rng.standard_normal(xy.shape)
+        xy, force = continuous_truth(TRUTH, references.ellipse(2.0, 1.2, 4.7), t, coupled)
         held[coupled] = write_multiaxis(folder / f"synthetic_ellipse_{'coupled' if coupled else 'uncoupled'}.csv",
-                                        t, xy, force, ["SYNTHETIC: tests/test_multiaxis.py"])
+                                        t, xy, force + 3.0 * rng.standard_normal(xy.shape),
+                                        ["SYNTHETIC: tests/test_multiaxis.py"])
     return folder, sines, held
 
 
@@ -175,23 +177,23 @@ NOISE_N = 3.0
 
 @pytest.fixture(scope="module")
 def fit_rig(tmp_path_factory):
-    """SYNTHETIC files of FIT_TRUTH, coupled, 3 N noise, from the scipy reference on 4x finer
-    samples: a sine along x alone and an ellipse in the plane to train on, and two plane paths the
-    fits never see (a circle and the references' random path)."""
+    """SYNTHETIC files of FIT_TRUTH, coupled, 3 N noise, from the scipy reference in continuous time:
+    a sine along x alone and an ellipse in the plane to train on, and two plane paths the fits never
+    see (a circle and the references' random path)."""
     folder = tmp_path_factory.mktemp("multiaxis_fit")
     rng = np.random.default_rng(11)
     t = np.arange(0.0, 1.0 + STEP_S / 2, STEP_S)
     x = lambda s: np.column_stack([2.0 * np.sin(2 * math.pi * 10.0 * s), 0 * s])   # noqa: E731
     sine = folder / "synthetic_sine_2mm_10Hz.csv"
-    line, force = fine_truth(FIT_TRUTH, x, t)
+    line, force = continuous_truth(FIT_TRUTH, x, t)
     write_measurement(sine, t, line[:, 0], force[:, 0] + NOISE_N * rng.standard_normal(t.size),
                       ["SYNTHETIC: tests/test_multiaxis.py"])
     files = {}
     for name, path, duration in (("ellipse", references.ellipse(2.0, 1.2, 4.7), 1.0),
                                  ("circle", references.circle(1.0, 9.7), 0.5),
-                                 ("random", references.random_path, 1.0)):
+                                 ("random", scaled_random_path(t), 1.0)):
         s = t[t <= duration + STEP_S / 2]
-        xy, force = fine_truth(FIT_TRUTH, path, s)
+        xy, force = continuous_truth(FIT_TRUTH, path, s)
         files[name] = write_multiaxis(folder / f"synthetic_{name}.csv", s, xy,
                                       force + NOISE_N * rng.standard_normal((s.size, 2)),
                                       ["SYNTHETIC: tests/test_multiaxis.py"])

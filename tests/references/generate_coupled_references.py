@@ -52,14 +52,20 @@ MODELS = {
 }
 
 
-def random_path(t: np.ndarray) -> np.ndarray:
-    """A seeded sum of 12 sines per axis, 0.5-20 Hz, from 0, scaled to a peak radius of 3 mm."""
+def random_walk(t: np.ndarray) -> np.ndarray:
+    """A seeded sum of 12 sines per axis, 0.5-20 Hz, from 0 [mm], unscaled."""
     rng = np.random.default_rng(41)
     frequencies = rng.uniform(0.5, 20.0, (12, 2))
     phases = rng.uniform(0.0, 2.0 * math.pi, (12, 2))
     amplitudes = rng.normal(size=(12, 2)) / frequencies      # a falling spectrum, as a road's
-    xy = np.stack([np.sum(amplitudes[:, j, None] * (np.sin(2 * math.pi * frequencies[:, j, None] * t + phases[:, j, None])
-                                                    - np.sin(phases[:, j, None])), axis=0) for j in range(2)], axis=1)
+    return np.stack([np.sum(amplitudes[:, j, None] * (np.sin(2 * math.pi * frequencies[:, j, None] * t
+                                                             + phases[:, j, None]) - np.sin(phases[:, j, None])),
+                            axis=0) for j in range(2)], axis=1)
+
+
+def random_path(t: np.ndarray) -> np.ndarray:
+    """:func:`random_walk` scaled to a peak radius of 3 mm over the times ``t``."""
+    xy = random_walk(t)
     return 3.0 * xy / np.max(np.hypot(xy[:, 0], xy[:, 1]))
 
 
