@@ -22,6 +22,7 @@ from identification.dynamic_stiffness import DEFAULT_AMPLITUDES_MM, DEFAULT_FREQ
 from identification.errors import EngineError, IdentificationError, MissingExtraError, UsageError
 from identification.extras import require
 from identification.interrupt import Interrupted, interrupted_message, signals_raise
+from identification.multiaxis import COUPLED_AXES
 from identification.presets import PRESETS, describe
 from identification.progress import close_open_bars
 
@@ -77,7 +78,7 @@ def main(argv: list[str] | None = None) -> int:
                             help=f"one of {', '.join(MODEL_NAMES)} (kelvin_voigt by linear least squares; "
                                  "`compare` recommends one); default: the manifest's, else proposed, the paper's")
     _add_training_arguments(fit_parser)
-    fit_parser.add_argument("--coupling", choices=("none", "radial", "spherical"), metavar="COUPLING",
+    fit_parser.add_argument("--coupling", choices=tuple(COUPLED_AXES), metavar="COUPLING",
                             help="how the model runs on the --multiaxis tests (required with them): none (one "
                                  "model per axis), radial (coupled in x, y; z alone) or spherical (x, y, z)")
     _add_search_arguments(fit_parser)
@@ -134,7 +135,7 @@ def main(argv: list[str] | None = None) -> int:
     predict_parser.add_argument("--data", type=Path, required=True,
                                 help="CSV with time_s and displacement_* columns, or a multi-axis path (time_s,dx_mm,"
                                      "dy_mm[,dz_mm]); force columns are not needed")
-    predict_parser.add_argument("--coupling", choices=("none", "radial", "spherical"), metavar="COUPLING",
+    predict_parser.add_argument("--coupling", choices=tuple(COUPLED_AXES), metavar="COUPLING",
                                 help="for a multi-axis path (required there): none, radial (x, y coupled) or "
                                      "spherical (x, y, z)")
     predict_parser.add_argument("--out", type=Path, required=True,
