@@ -79,6 +79,7 @@ import math
 import types
 from typing import Callable
 
+from . import kernel_language
 from .unrolling import UnrollError, kernel_definition, kernel_global, kernel_statements
 
 SLOPE_CAP = 1e100
@@ -161,9 +162,6 @@ def _copy(node):
     return ast.parse(ast.unparse(node), mode="eval").body if isinstance(node, ast.expr) else node
 
 
-MATH_SAME = ("exp", "log", "sqrt", "sin", "cos", "fabs", "copysign")
-MATH_CONSTANT = ("ceil", "floor", "isfinite", "isnan", "isinf", "trunc")
-BUILTIN_CONSTANT = ("int", "len", "bool")
 
 
 class _Spec:
@@ -277,12 +275,12 @@ class _Spec:
         f = e.func
         if isinstance(f, ast.Attribute) and isinstance(f.value, ast.Name) and f.value.id not in self.locals \
                 and self.global_value(f.value.id, f) is math:
-            if f.attr in MATH_SAME or f.attr in MATH_CONSTANT or f.attr == "pow":
+            if f.attr in kernel_language.MATH:
                 return "math", f.attr
-            raise self.error(e, f"math.{f.attr} is not differentiated")
+            raise self.error(e, f"math.{f.attr} is not differentiated; only {kernel_language.describe_calls()}")
         if isinstance(f, ast.Name) and f.id not in self.locals:
             value = self.global_value(f.id, e)
-            if getattr(builtins, f.id, None) is value and f.id in ("abs", "min", "max", "float", *BUILTIN_CONSTANT):
+            if getattr(builtins, f.id, None) is value and f.id in kernel_language.BUILTINS:
                 return "builtin", f.id
             value = getattr(value, "py_func", value)
             if isinstance(value, types.FunctionType):
@@ -299,6 +297,10 @@ class _Spec:
             self.global_value(e.id, e)
             return False
         if isinstance(e, ast.Attribute):
+            if not (isinstance(e.value, ast.Name) and e.value.id not in self.locals
+                    and self.global_value(e.value.id, e) is math and e.attr in kernel_language.MATH_CONSTANTS):
+                raise self.error(e, f"attribute {ast.unparse(e)}: only "
+                                    + " and ".join(f"math.{name}" for name in kernel_language.MATH_CONSTANTS))
             return False
         if isinstance(e, ast.Tuple):
             for element in e.elts:
@@ -336,16 +338,13 @@ class _Spec:
             arguments = [self.activity(a) for a in e.args]
             if kind == "kernel":
                 return self.generator.analyse(what, tuple(arguments), self, e)
-            if kind == "math" and what in MATH_CONSTANT or kind == "builtin" and what in BUILTIN_CONSTANT:
+            call = (kernel_language.MATH if kind == "math" else kernel_language.BUILTINS)[what]
+            if len(arguments) != call.arguments:
+                raise self.error(e, f"{call.written} takes {call.arguments} argument{'s' if call.arguments > 1 else ''}")
+            if call.tangent == "zero":
                 return False
-            if kind == "builtin" and what in ("min", "max") and len(arguments) != 2:
-                raise self.error(e, f"{what}() of two arguments only")
-            if kind == "math" and what in ("copysign", "pow"):
-                if len(arguments) != 2:
-                    raise self.error(e, f"math.{what} takes two arguments")
-                return self.scalar(arguments[0] if what == "copysign" else join(*arguments), e)
-            if len(arguments) != (2 if what in ("min", "max") else 1):
-                raise self.error(e, f"{what} takes one argument")
+            if what == "copysign":
+                return self.scalar(arguments[0], e)
             return self.scalar(join(*arguments) if len(arguments) == 2 else arguments[0], e)
         raise self.error(e, f"expression {type(e).__name__} is not differentiated")
 

@@ -240,15 +240,15 @@ static void print_int(int i) { printf("i %d\\n", i); }
 """
 
 
-@pytest.fixture(scope="module")
-def c_results(tmp_path_factory):
+def run_in_c(cases, folder) -> dict:
     """{(case name, argument index): (the lines the compiled C printed, the C function's return
-    type)}: every supported case in one program, one compiler call."""
+    type)} of ``cases`` [(function, [arguments, ...]), ...]: every case in one program, one compiler
+    call in ``folder``; skips where there is no C compiler."""
     if shutil.which(COMPILER) is None:
         pytest.skip(f"no C compiler: {COMPILER} is not installed (set CC to one)")
     translation = Translation(prefix="bw")
     calls, return_types = [], {}
-    for function, argument_sets in SUPPORTED:
+    for function, argument_sets in cases:
         for index, arguments in enumerate(argument_sets):
             types_ = tuple(value_type(a) for a in arguments)
             translated = translation.function(function, types_)
@@ -258,7 +258,6 @@ def c_results(tmp_path_factory):
             calls += [f'    printf("case {function.__name__} {index}\\n");', "    {",
                       f"        {translation.c_type(result_type)} r = {translated.name}({literals});",
                       *[f"        {line}" for line in c_prints("r", result_type)], "    }"]
-    folder = tmp_path_factory.mktemp("python_to_c")
     program = folder / "cases.c"
     program.write_text(DRIVER_HEAD + translation.source() + "\nint main(void) {\n" + "\n".join(calls)
                        + "\n    return 0;\n}\n")
@@ -275,6 +274,12 @@ def c_results(tmp_path_factory):
         else:
             current.append(line)
     return {key: (lines, return_types[key]) for key, lines in results.items()}
+
+
+@pytest.fixture(scope="module")
+def c_results(tmp_path_factory):
+    """:func:`run_in_c` of every supported case."""
+    return run_in_c(SUPPORTED, tmp_path_factory.mktemp("python_to_c"))
 
 
 @pytest.mark.parametrize("function, argument_sets", SUPPORTED, ids=[f.__name__ for f, _ in SUPPORTED])

@@ -14,10 +14,9 @@ native FMU (``fmu_src/native``):
   with ``else``, ``break``, ``continue``, ``return``; expressions with ``+ - * / **`` (``**``
   with a float operand), comparisons ``< <= > >= == !=`` (chained too), ``not``, ``and``/``or``
   (see below), conditional expressions, constant tuple indices, int constants within C's int,
-  calls of other kernels (Python functions, not recursive) and of ``abs``, ``min``, ``max`` (two
-  arguments), ``int``, ``float``, ``math.exp``/``log``/``sqrt``/``sin``/``cos``/``ceil``/
-  ``isfinite`` (written ``math.<name>``, the module imported as ``import math``) and the
-  constants ``math.inf``, ``math.pi``; ``tuple(...)`` and ``sum(...)`` of a generator over a
+  calls of other kernels (Python functions, not recursive) and of the calls of
+  ``fmu_src/kernel_language.py`` (``math.<name>`` written so, the module imported as
+  ``import math``) and the constants ``math.inf``, ``math.pi``; ``tuple(...)`` and ``sum(...)`` of a generator over a
   constant range, written out term by term first (``fmu_src/unrolling.py``).
 - Python's semantics where C's differ: ``/`` of two ints is a float division; ``int(x)`` of a
   NaN or of a value beyond C's int gives the largest int (Python would raise: the kernels'
@@ -44,29 +43,27 @@ bitwise where it can).
 from __future__ import annotations
 
 import ast
+import builtins
 import math
 import types
 from dataclasses import dataclass, field
 from typing import Callable, Union
 
+from .. import kernel_language
 from ..unrolling import UnrollError, kernel_definition, kernel_global, kernel_statements
 
 DOUBLE, INT = "double", "int"
 Type = Union[str, tuple]
 """A kernel value's type: DOUBLE, INT, or a tuple of types."""
 
-MATH_FUNCTIONS = {"exp": "exp", "log": "log", "sqrt": "sqrt", "sin": "sin", "cos": "cos"}
-MATH_INT_FUNCTIONS = ("ceil", "isfinite")
-"""math functions whose Python result is an int (ceil) or a bool (isfinite)."""
-BUILTINS = {"abs": abs, "min": min, "max": max, "int": int, "float": float}
 C_INT_MIN, C_INT_MAX = -2 ** 31, 2 ** 31 - 1
 """The range of C's int (32 bits on every platform the native FMU is built for)."""
-SUPPORTED_CALLS = ("other kernels (Python functions), abs, min, max, int, float and "
-                   + ", ".join(f"math.{name}" for name in (*MATH_FUNCTIONS, *MATH_INT_FUNCTIONS)))
+SUPPORTED_CALLS = kernel_language.describe_calls()
 MATH_CONSTANTS = {"inf": "HUGE_VAL", "pi": "3.141592653589793"}
+assert set(MATH_CONSTANTS) == set(kernel_language.MATH_CONSTANTS)
 C_RESERVED = frozenset("""auto break case char const continue default do double else enum extern float for goto if
 inline int long register restrict return short signed sizeof static struct switch typedef union unsigned void volatile
-while abs fabs pow exp log sqrt sin cos ceil floor isfinite bw_int main errno""".split())
+while abs fabs pow exp log sqrt sin cos ceil floor trunc copysign isfinite isnan isinf bw_int main errno""".split())
 
 PRELUDE = "#include <limits.h>\n#include <math.h>\n#include <stdlib.h>\n"
 HELPERS = {
@@ -92,7 +89,8 @@ def live_reads(tree: ast.AST) -> set[str]:
     """The names a function's C reads: every name loaded but in the value of an assignment to a
     name that nothing reads (the translation drops such an assignment, so what only it read would
     be set and never used, which C warns of), to a fixpoint: a tangent computed for a value that
-    feeds only a count (``d_g0`` of a gain that sets the substeps) drops with what it alone read."""
+    feeds only a count (``d_g0`` of a gain that sets the substeps) drops with what it alone read. A
+    name whose only use is ``len(name)`` is not read either (the C writes the tuple's length)."""
     assignments = [node for node in ast.walk(tree) if isinstance(node, (ast.Assign, ast.AugAssign))
                    and isinstance(node.targets[0] if isinstance(node, ast.Assign) else node.target, ast.Name)
                    and (not isinstance(node, ast.Assign) or len(node.targets) == 1)]
@@ -101,7 +99,11 @@ def live_reads(tree: ast.AST) -> set[str]:
         target = (node.targets[0] if isinstance(node, ast.Assign) else node.target).id
         for child in ast.walk(node.value):
             owner[id(child)] = target
-    loads = [n for n in ast.walk(tree) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)]
+    # len(t) of a tuple is a constant of its type in C, which reads nothing of t
+    lengths = {id(argument) for node in ast.walk(tree) if isinstance(node, ast.Call)
+               and isinstance(node.func, ast.Name) and node.func.id == "len" for argument in node.args}
+    loads = [n for n in ast.walk(tree) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)
+             and id(n) not in lengths]
     read = {n.id for n in loads}
     while True:
         live = {n.id for n in loads if id(n) not in owner or owner[id(n)] in read}
@@ -267,8 +269,10 @@ class _Function:
             return isinstance(e.value, bool)
         if isinstance(e, ast.BoolOp):
             return all(self.is_boolean(value) for value in e.values)
-        if isinstance(e, ast.Call) and isinstance(e.func, ast.Attribute) and e.func.attr == "isfinite":
-            return self.callee(e) == ("math", "isfinite")
+        if isinstance(e, ast.Call):
+            kind, what = self.callee(e)
+            return kind != "kernel" and (kernel_language.MATH if kind == "math"
+                                         else kernel_language.BUILTINS)[what].result == "bool"
         return False
 
     def check_truth_value(self, e):
@@ -488,12 +492,12 @@ class _Function:
             raise self.error(e, "keyword arguments")
         f = e.func
         if isinstance(f, ast.Attribute) and self.math_module(f.value):
-            if f.attr in MATH_FUNCTIONS or f.attr in MATH_INT_FUNCTIONS:
+            if f.attr in kernel_language.MATH:
                 return "math", f.attr
             raise self.error(e, f"math.{f.attr} is not translated; only {SUPPORTED_CALLS}")
         if isinstance(f, ast.Name) and f.id not in self.locals:
             value = self.global_value(f.id, e)
-            if f.id in BUILTINS and value is BUILTINS[f.id]:
+            if f.id in kernel_language.BUILTINS and value is getattr(builtins, f.id):
                 return "builtin", f.id
             if any(value is member for member in vars(math).values()):
                 raise self.error(e, f"{f.id} is math.{getattr(value, '__name__', f.id)} imported by name; write "
@@ -506,24 +510,19 @@ class _Function:
     def call_type(self, e: ast.Call) -> Type:
         kind, what = self.callee(e)
         arguments = [self.type_of(a) for a in e.args]
-        if any(isinstance(a, tuple) for a in arguments) and kind != "kernel":
-            raise self.error(e, f"{what}() of a tuple")
-        if kind == "math":
-            if len(arguments) != 1:
-                raise self.error(e, f"math.{what} takes one argument")
-            return INT if what in ("ceil", "isfinite") else DOUBLE
-        if kind == "builtin":
-            if what in ("int", "float", "abs") and len(arguments) != 1:
-                raise self.error(e, f"{what}() takes one argument")
-            if what in ("min", "max") and len(arguments) != 2:
-                raise self.error(e, f"{what}() of two arguments only")
-            if what == "int":
+        if kind != "kernel":
+            call = (kernel_language.MATH if kind == "math" else kernel_language.BUILTINS)[what]
+            if len(arguments) != call.arguments:
+                raise self.error(e, f"{call.written} takes {call.arguments} argument{'s' if call.arguments > 1 else ''}")
+            if what == "len":
+                if not isinstance(arguments[0], tuple):
+                    raise self.error(e, f"len() of a number: {ast.unparse(e)}")
                 return INT
-            if what == "float":
-                return DOUBLE
-            if what == "abs":
-                return arguments[0]
-            return INT if arguments == [INT, INT] else DOUBLE
+            if any(isinstance(a, tuple) for a in arguments):
+                raise self.error(e, f"{what}() of a tuple")
+            if call.result == "same":
+                return arguments[0] if len(arguments) == 1 else INT if arguments == [INT, INT] else DOUBLE
+            return DOUBLE if call.result == "float" else INT
         callee = self.translation.function(what, tuple(arguments))
         if callee.return_type is None:
             raise self.error(e, f"{what.__name__} calls itself (recursion is not translated)")
@@ -729,14 +728,15 @@ class _Function:
         arguments = [self.expression(a) for a in e.args]
         types_ = [self.type_of(a) for a in e.args]
         if kind == "math":
-            argument = self.as_double(e.args[0], arguments[0])
-            if what == "ceil":
+            form = kernel_language.MATH[what].c
+            if "bw_int" in form:
                 self.translation.helpers.add("bw_int")
-                return f"bw_int(ceil({argument}))"
-            if what == "isfinite":
-                return f"(isfinite({argument}) != 0)"
-            return f"{MATH_FUNCTIONS[what]}({argument})"
+            return form.format(*(self.as_double(a, c) for a, c in zip(e.args, arguments)))
         if kind == "builtin":
+            if what == "len":
+                return str(len(types_[0]))
+            if what == "bool":
+                return f"({arguments[0]} != 0)"
             if what == "int":
                 if types_[0] == INT:
                     return arguments[0]
