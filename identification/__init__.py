@@ -29,12 +29,13 @@ resolved once at the front door, the model object is what the modules below pass
 The modules, in the order of the workflow:
 
 - reading the tests: ``measurements`` (CSV files), ``rig_tests`` (which file is which test, the
-  manifest), ``kdyn_table`` (the dynamic-stiffness table's CSV file, read and written), ``noise`` (each test's noise
+  manifest), ``multiaxis`` (tests along two or three axes at once, and their coupling), ``kdyn_table`` (the dynamic-stiffness table's CSV file, read and written), ``noise`` (each test's noise
   level), ``protocols`` (the paper's test signals);
 - the forward model: ``simulate`` (the front door), ``parameter_input`` (what counts as
   parameters), ``forward_model`` (the input between samples), ``compiled_core`` and
   ``steady_state`` (the models' kernels, compiled per model), ``refinement`` (finer steps where
-  needed);
+  needed), ``fit_jacobian`` (the forces' sensitivities to the parameters, computed with them) and
+  ``vector_tangents`` (the tangents of every parameter direction at once, for it);
 - fitting: ``fitting`` (``fit``), ``fit_result`` (what it returns), ``presets``, ``search_space``
   (the box), ``loop_start`` (starts from a slow loop), ``objectives`` (the misfit), ``multistart``
   (screening and least-squares stages),

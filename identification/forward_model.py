@@ -1,4 +1,8 @@
-"""The identification's forward model: eqs. 1-5 driven by a smooth interpolant of a sampled test.
+"""The forward model's input: a sampled test turned into the path the kernels are driven along.
+
+The identification's forward model is eqs. 1-5 (any model's equations) driven by a smooth
+interpolant of a sampled test; this module prepares that input (``prepare_input``, and
+``prepare_vector_input`` for a multi-axis test), ``identification.simulate`` runs it.
 
 A measured test gives the displacement at the sample instants only. The FMU, as a
 co-simulation slave, holds the velocity set by the master over each communication step

@@ -1,4 +1,5 @@
-"""Simulate any of the project's models on a sampled test: the identification's forward model.
+"""Simulate any of the project's models on a sampled test: the forward model's front door (the input
+it drives the kernels with is ``identification.forward_model``'s).
 
 ``simulate(parameters, time_s, displacement_mm, velocity_mm_s=None, model=None, steps_per_sample=None)``
 returns the force [N] at every sample of a parameter set of any of the models

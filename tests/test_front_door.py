@@ -186,3 +186,12 @@ def test_the_cosimulation_examples_name_the_extra_they_lack(script, tmp_path):
     assert done.stderr.strip() == (f"error: {script} needs the 'cosim' extra (libcosimpy is not installed): "
                                    "pip install 'boucwen-bushing[cosim]'")
     assert not (tmp_path / "out").exists()
+
+
+def test_the_package_docstrings_module_map_names_every_module():
+    import pkgutil
+
+    import identification
+    modules = [m.name for m in pkgutil.iter_modules(identification.__path__) if m.name != "__main__"]
+    missing = [name for name in modules if f"``{name}``" not in identification.__doc__]
+    assert not missing, f"identification/__init__.py's module map does not name {missing}"
