@@ -31,7 +31,8 @@ from .bushing_params import SPRING, ParameterSpec
 from .integration import (NOT_FINITE, OK, friction_force, friction_jump_turn, friction_turn, maxwell_decay,
                           maxwell_step, vector_dot, vector_friction_force, vector_friction_jump_turn,
                           vector_friction_turn)
-from .model_definition import BushingModel, CoupledKernels, SearchBox, SearchCoordinate, StateSpec
+from .model_definition import BushingModel, CoupledKernels, SearchBox, SearchCoordinate, SlowLoop, StateSpec
+from .search_coordinates import KIND
 
 FRICTION_LIMIT = dict(minimum=0.0, why="a friction force limit is a magnitude", bound_powers=(0, 0))
 HALF_TRAVEL = dict(minimum=0.0, exclusive=True, why="it divides the friction law: the travel to half the limit")
@@ -195,13 +196,13 @@ fractional model shares."""
 
 
 SEARCH = SearchBox(
-    (SearchCoordinate("k0", "stiffness", -3.0, 1.0), SearchCoordinate("k3", "cubic", 0.0, 2.0),
-     SearchCoordinate("Ff_max", "force", -3.0, 0.5), SearchCoordinate("x2", "travel", -4.0, 0.5),
-     SearchCoordinate("k1", "stiffness", -4.0, 1.0), SearchCoordinate("c1", "time_constant", -math.inf, 4.0,
+    (SearchCoordinate("k0", KIND.stiffness, -3.0, 1.0), SearchCoordinate("k3", KIND.cubic, 0.0, 2.0),
+     SearchCoordinate("Ff_max", KIND.force, -3.0, 0.5), SearchCoordinate("x2", KIND.travel, -4.0, 0.5),
+     SearchCoordinate("k1", KIND.stiffness, -4.0, 1.0), SearchCoordinate("c1", KIND.time_constant, -math.inf, 4.0,
                                                                        over=("k1",)),
-     SearchCoordinate("k2", "stiffness", -4.0, 1.0), SearchCoordinate("c2", "slower", 0.0, 6.0, over=("k2",),
+     SearchCoordinate("k2", KIND.stiffness, -4.0, 1.0), SearchCoordinate("c2", KIND.slower, 0.0, 6.0, over=("k2",),
                                                                        partner="c1")),
-    loop_start=("k0", "k3", "Ff_max", "x2"))
+    loop_start=SlowLoop(("k0", "k3"), "Ff_max", "x2", (("k1", 0.0), ("c1", 1.0), ("k2", 0.0), ("c2", 1.0))))
 """The fit's box: the friction's limit scaled by the peak force and its x2 by the largest
 amplitude, the cubic term as k3*X^2/k_ref (0 to 2: up to twice k_ref's force added at the largest
 amplitude X); the second Maxwell element is the slower one (its time constant c2/k2 is

@@ -47,6 +47,11 @@ ALIASES = {"bouc_wen": "single_bouc_wen"}
 """Older names still accepted: ``bouc_wen`` read as the proposed model's block, so it was renamed."""
 MODEL_CHOICES = MODEL_NAMES + tuple(ALIASES)
 """Every name a user may give (the command line's choices)."""
+DEFAULT_MODEL = "proposed"
+"""The model a command, a file or a call that names none is for: the paper's."""
+LINEAR_BASELINE = MODELS["kelvin_voigt"]
+"""The linear bushing the paper's figures and the reports compare against (a least-squares fit
+of F = k*x + c*v), and the rigid spring ``assemble --rigid-missing`` puts on a missing axis."""
 
 
 def get_model(name: str) -> BushingModel:

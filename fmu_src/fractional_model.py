@@ -38,7 +38,8 @@ from .bushing_params import SPRING, ParameterSpec
 from .integration import (NOT_FINITE, OK, friction_force, friction_jump_turn, friction_turn, maxwell_decay,
                           maxwell_step, vector_dot, vector_friction_force, vector_friction_jump_turn,
                           vector_friction_turn)
-from .model_definition import BushingModel, CoupledKernels, SearchBox, SearchCoordinate, StateSpec
+from .model_definition import BushingModel, CoupledKernels, SearchBox, SearchCoordinate, SlowLoop, StateSpec
+from .search_coordinates import KIND
 
 MODES = 19
 """Maxwell elements on the grid of rates, 10^-4 ... 10^5 1/s, two per decade."""
@@ -216,11 +217,11 @@ def switches_coupled(m, state, x, v):
 
 
 SEARCH = SearchBox(
-    (SearchCoordinate("k0", "stiffness", -3.0, 1.0), SearchCoordinate("k3", "cubic", 0.0, 2.0),
-     SearchCoordinate("Ff_max", "force", -3.0, 0.5), SearchCoordinate("x2", "travel", -4.0, 0.5),
-     SearchCoordinate("alpha", "exponent", 0.02, 0.98), SearchCoordinate("b", "fractional", -4.0, 3.0,
+    (SearchCoordinate("k0", KIND.stiffness, -3.0, 1.0), SearchCoordinate("k3", KIND.cubic, 0.0, 2.0),
+     SearchCoordinate("Ff_max", KIND.force, -3.0, 0.5), SearchCoordinate("x2", KIND.travel, -4.0, 0.5),
+     SearchCoordinate("alpha", KIND.exponent, 0.02, 0.98), SearchCoordinate("b", KIND.power_law, -4.0, 3.0,
                                                                          exponent="alpha")),
-    loop_start=("k0", "k3", "Ff_max", "x2"))
+    loop_start=SlowLoop(("k0", "k3"), "Ff_max", "x2", (("b", 0.0), ("alpha", 0.5))))
 """The fit's box: as Berg's for the spring and the friction; alpha within (0.02, 0.98) and b as
 log10(b/(k_ref*tau_ref^alpha)), the element's |K*| at the data's own time scale in units of k_ref;
 the spring and the friction have starts from the data's slowest loop (identification/loop_start.py)."""

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from .bushing_params import DAMPING, SPRING, ParameterSpec
 from .integration import OK
-from .model_definition import BushingModel
+from .model_definition import BushingModel, LinearForce
 
 PARAMETER_SPECS = (
     ParameterSpec("k", "N/mm", "stiffness", **SPRING),
@@ -51,4 +51,5 @@ def switches(m, state, x, v):
 MODEL = BushingModel(
     "kelvin_voigt", "KelvinVoigtBushing", "Kelvin-Voigt (linear)", PARAMETER_SPECS, (),
     "params_kelvin_voigt_fit_synthetic_table5.json", prepare, initial_state, jump, integrate, force,
-    derivatives, switches, plot_style=("C3", "--"), rank=90)
+    derivatives, switches, plot_style=("C3", "--"), rank=90,
+    linear=LinearForce((("k", "displacement"), ("c", "velocity")), held=(("preload", 0.0),)))

@@ -42,6 +42,7 @@ from dataclasses import dataclass, field, replace
 from typing import Callable, Mapping
 
 from . import integration
+from .search_coordinates import CoordinateKind
 from .bushing_params import (Constraint, ParameterError, ParameterSpec, constraint_messages, number_errors,
                              range_errors)
 
@@ -100,47 +101,66 @@ class StateSpec:
 
 @dataclass(frozen=True)
 class SearchCoordinate:
-    """One coordinate of the box the fit searches (``identification.search_space`` maps it to the
-    parameter): ``kind`` says how, scaled by the data's reference stiffness k_ref [N/mm],
-    damping c_ref [N.s/mm] and force F_ref [N] (tau_ref = c_ref/k_ref):
-
-    - ``stiffness``, ``gain``: log10(value/k_ref) (a gain also >= 1 N/mm, the paper's constraint);
-    - ``damping``: log10(value/c_ref);
-    - ``time_constant``: log10(tau/tau_ref) of a dashpot over the stiffnesses it works against
-      (``over``), tau = value/sum(over);
-    - ``shape``: value*F_ref^n/k_ref, n the block's exponent (``exponent``);
-    - ``shape_sum``: partner' + sign*value' of a block (value' = value*F_ref^n/k_ref);
-    - ``exponent``: the value itself;
-    - ``force``: log10(value/F_ref); ``travel``: log10(value/x_ref), x_ref [mm] the tests' largest
-      amplitude; ``cubic``: value*x_ref^2/k_ref;
-    - ``slower``: log10(tau/tau_partner), a dashpot's time constant (value over the stiffnesses
-      ``over``) over that of the dashpot ``partner`` (a ``time_constant`` coordinate);
-    - ``fractional``: log10(value/(k_ref*tau_ref^alpha)), alpha the parameter ``exponent``.
-
-    ``low`` and ``high`` bound the coordinate."""
+    """One coordinate of the box the fit searches: ``kind`` (a ``search_coordinates.CoordinateKind``,
+    such as ``STIFFNESS`` or ``TIME_CONSTANT``, or a model's own) maps it to the parameter, scaled
+    by the data's reference stiffness k_ref [N/mm], damping c_ref [N.s/mm], force F_ref [N] and
+    amplitude x_ref [mm]; ``low`` and ``high`` bound the coordinate (a kind may tighten them from
+    the data). The other fields are what some kinds read."""
     parameter: str
-    kind: str
+    kind: CoordinateKind
     low: float
     high: float
-    exponent: str = ""                  # shape, shape_sum: the block's n; fractional: its alpha
+    exponent: str = ""                  # shape, shape_sum: the block's n; a fractional coefficient: its alpha
     over: tuple[str, ...] = ()          # time_constant, slower: the stiffnesses the dashpot works against
     partner: str = ""                   # shape_sum: the block's beta-like parameter; slower: the faster dashpot
     sign: float = 1.0                   # shape_sum: coordinate = partner' + sign*parameter'
 
 
 @dataclass(frozen=True)
+class SlowLoop:
+    """A progressive spring k0*x + k3*x^3 and Berg's friction (limit Ff_max, half-travel x2) in
+    parallel with a model's rate-dependent part, which the fit estimates from the data's slowest
+    sine loop for some of its starts (``identification.loop_start``). ``spring``: the names of
+    the spring's linear and cubic stiffness; ``friction_limit``, ``travel``: the friction's;
+    ``friction_alone``: (name, value) of every other parameter at a value that leaves the model's
+    force the friction alone (its limit 1 N and the spring 0 are set by the loop), so that the
+    model itself computes the friction's shape."""
+    spring: tuple[str, str]
+    friction_limit: str
+    travel: str
+    friction_alone: tuple[tuple[str, float], ...]
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """The parameters the loop gives starts for."""
+        return (*self.spring, self.friction_limit, self.travel)
+
+    def friction_only(self, travel_mm: float) -> dict[str, float]:
+        """The model's parameters for the friction alone, of limit 1 N and half-travel ``travel_mm``."""
+        return {**dict(self.friction_alone), self.spring[0]: 0.0, self.spring[1]: 0.0, self.friction_limit: 1.0,
+                self.travel: float(travel_mm)}
+
+
+@dataclass(frozen=True)
+class LinearForce:
+    """A model whose force is linear in its parameters: F = sum of parameter * regressor over
+    ``regressors`` ((parameter, "displacement" [mm] or "velocity" [mm/s]) pairs), with the
+    parameters of ``held`` ((name, value) pairs) at their values. The fit takes it by linear least
+    squares within the parameters' ranges, not by a search."""
+    regressors: tuple[tuple[str, str], ...]
+    held: tuple[tuple[str, float], ...] = ()
+
+
+@dataclass(frozen=True)
 class SearchBox:
     """Where the fit searches a model: its ``coordinates`` (one per free parameter), the
     Bouc-Wen weights held at 1 (``unit_weights``: each block's alpha, which the force does not
-    identify apart from its A, beta and gamma), the parameters held at 0 (``zeros``) and those a
-    slow loop gives a start for (``loop_start``)."""
+    identify apart from its A, beta and gamma), the parameters held at 0 (``zeros``) and the
+    spring and friction a slow loop gives starts for (``loop_start``, a :class:`SlowLoop`, or None)."""
     coordinates: tuple[SearchCoordinate, ...]
     unit_weights: tuple[str, ...] = ()
     zeros: tuple[str, ...] = ()
-    loop_start: tuple[str, ...] = ()
-    """The parameters of a progressive spring k0*x + k3*x^3 and Berg's friction (Ff_max, x2) that
-    the fit estimates from the data's slowest sine loop for some of its starts
-    (``identification.loop_start``); empty: none."""
+    loop_start: SlowLoop | None = None
 
 
 @dataclass(frozen=True)
@@ -229,7 +249,12 @@ class BushingModel:
     changes there, such as a friction element reversing where v has changed sign; None: an event
     changes nothing. ``integrate`` and ``jump`` make the same change themselves, in co-simulation."""
     search: SearchBox | None = None
-    """Where the fit searches (None: fitted otherwise, Kelvin-Voigt by linear least squares)."""
+    """Where the fit searches (None: the model is fitted by linear least squares, ``linear``)."""
+    linear: LinearForce | None = None
+    """For a model whose force is linear in its parameters (Kelvin-Voigt): which, against what;
+    the fit solves for them by linear least squares instead of searching."""
+    description: str = ""
+    """The one-axis FMU's description (its modelDescription's); empty: one made from the title."""
     plot_style: tuple[str, str] = ("k", "-")
     """(matplotlib colour, line style) of the model in comparison plots."""
     rank: int = 100

@@ -29,7 +29,7 @@ from typing import Mapping
 from xml.etree import ElementTree as ET
 
 from .axes import ONE_AXIS, SIX_AXES, SIX_AXIS_IDENTIFIER, SIX_AXIS_NAMES, Coupling, model_on_axis
-from .bushing_models import BushingModel, MODELS, get_model
+from .bushing_models import BushingModel, DEFAULT_MODEL, MODELS, get_model
 from .bushing_params import UNIT_DEFINITIONS, UNIT_SYSTEM, ParameterError
 
 SSV_NAMESPACES = {"ssv": "http://ssp-standard.org/SSP1/SystemStructureParameterValues",
@@ -139,7 +139,7 @@ def read_ensemble(path: str | Path, model: str | None = None) -> ParameterEnsemb
     return ParameterEnsemble(best.model, checked, best.provenance)
 
 
-def save_ensemble(path: str | Path, members, model: str = "proposed", provenance: Mapping | None = None) -> Path:
+def save_ensemble(path: str | Path, members, model: str = DEFAULT_MODEL, provenance: Mapping | None = None) -> Path:
     """Write an ensemble as JSON: the best member as the file's parameter set, all members after.
 
     Parameters
@@ -192,7 +192,7 @@ def _read_json(path: Path):
     units = document.get("units", UNIT_SYSTEM)
     if units != UNIT_SYSTEM:
         raise ParameterError(f"parameter file {path} declares units {units!r}; only {UNIT_SYSTEM!r} is supported")
-    model = get_model(document.get("model", MODELS["proposed"].identifier))
+    model = get_model(document.get("model", MODELS[DEFAULT_MODEL].identifier))
     return model, document["parameters"], dict(document.get("fit", {}))
 
 
@@ -208,7 +208,7 @@ def _read_ssv(path: Path, expected: BushingModel | None):
         if real is None:
             raise ParameterError(f"{path}: parameter {name!r} is not an ssv:Real")
         raw[name] = (real.get("value"), real.get("unit"))
-    model = _model_of_ssv(root.get("name"), set(raw)) or expected or MODELS["proposed"]
+    model = _model_of_ssv(root.get("name"), set(raw)) or expected or MODELS[DEFAULT_MODEL]
     return model, _ssv_values(raw, model, f"{path}", " (the paper's N-mm-s units)"), {}
 
 
@@ -241,7 +241,7 @@ def _model_of_ssv(set_name: str | None, names: set[str]) -> BushingModel | None:
     return None
 
 
-def parameter_document(params: Mapping[str, float], model: str = "proposed",
+def parameter_document(params: Mapping[str, float], model: str = DEFAULT_MODEL,
                        provenance: Mapping | None = None) -> dict:
     """The JSON document :func:`save_parameters` writes (validated)."""
     bushing = get_model(model)
@@ -249,7 +249,7 @@ def parameter_document(params: Mapping[str, float], model: str = "proposed",
             "fit": dict(provenance or {})}
 
 
-def save_parameters(path: str | Path, params: Mapping[str, float], model: str = "proposed",
+def save_parameters(path: str | Path, params: Mapping[str, float], model: str = DEFAULT_MODEL,
                     provenance: Mapping | None = None) -> Path:
     """Write a validated parameter set, which ``build_fmu.py --params`` and every reader take.
 

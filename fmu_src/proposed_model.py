@@ -31,6 +31,7 @@ from .integration import (DEFAULT_MAX_SUBSTEPS, HEUN_JUMP_LIMIT, NOT_FINITE, OK,
                           block_gain, block_power, block_step, substeps_needed, vector_block_step, vector_block_view,
                           vector_dot, vector_gain, vector_substeps_needed, vector_walk, walk_along_xi)
 from .model_definition import BushingModel, CoupledKernels, SearchBox, SearchCoordinate, StateSpec
+from .search_coordinates import KIND
 
 IDENTIFIER = "BoucWenBushing"
 
@@ -260,16 +261,16 @@ def switches_coupled(m, state, x, v):
 
 
 SEARCH = SearchBox(
-    (SearchCoordinate("k0", "stiffness", -3.0, 1.0), SearchCoordinate("k1", "stiffness", -3.0, 1.0),
-     SearchCoordinate("k2", "stiffness", -5.0, 0.0),
-     SearchCoordinate("c0", "time_constant", -math.inf, 6.0, over=("k2", "A2")),
-     SearchCoordinate("c1", "time_constant", -math.inf, 4.0, over=("k0", "k1", "A1")),
-     SearchCoordinate("c2", "damping", -4.0, 2.0),
-     SearchCoordinate("A1", "gain", -4.0, 1.0), SearchCoordinate("A2", "gain", -4.0, 1.0),
-     SearchCoordinate("beta1", "shape", 0.0, 20.0, "n1"), SearchCoordinate("beta2", "shape", 0.0, 20.0, "n2"),
-     SearchCoordinate("gamma1", "shape_sum", 0.0, 40.0, "n1", partner="beta1", sign=1.0),
-     SearchCoordinate("gamma2", "shape_sum", 0.0, 40.0, "n2", partner="beta2", sign=-1.0),
-     SearchCoordinate("n1", "exponent", 0.1, 1.5), SearchCoordinate("n2", "exponent", 0.1, 1.5)),
+    (SearchCoordinate("k0", KIND.stiffness, -3.0, 1.0), SearchCoordinate("k1", KIND.stiffness, -3.0, 1.0),
+     SearchCoordinate("k2", KIND.stiffness, -5.0, 0.0),
+     SearchCoordinate("c0", KIND.time_constant, -math.inf, 6.0, over=("k2", "A2")),
+     SearchCoordinate("c1", KIND.time_constant, -math.inf, 4.0, over=("k0", "k1", "A1")),
+     SearchCoordinate("c2", KIND.damping, -4.0, 2.0),
+     SearchCoordinate("A1", KIND.gain, -4.0, 1.0), SearchCoordinate("A2", KIND.gain, -4.0, 1.0),
+     SearchCoordinate("beta1", KIND.shape, 0.0, 20.0, "n1"), SearchCoordinate("beta2", KIND.shape, 0.0, 20.0, "n2"),
+     SearchCoordinate("gamma1", KIND.shape_sum, 0.0, 40.0, "n1", partner="beta1", sign=1.0),
+     SearchCoordinate("gamma2", KIND.shape_sum, 0.0, 40.0, "n2", partner="beta2", sign=-1.0),
+     SearchCoordinate("n1", KIND.exponent, 0.1, 1.5), SearchCoordinate("n2", KIND.exponent, 0.1, 1.5)),
     unit_weights=("alpha1", "alpha2"))
 """The fit's box: the paper's constraints A >= 1 N/mm, beta >= 0, beta1 + gamma1 > 0 and
 beta2 - gamma2 > 0 are bounds of its coordinates; each block's alpha is held at 1."""
@@ -288,6 +289,9 @@ MODEL = BushingModel(
                   StateSpec("u2", 2, "m/s", "relative velocity of block 2, v - dw/dt"),
                   StateSpec("z2", 3, "N", "hysteretic force of block 2")),
     constraints=CONSTRAINTS, search=SEARCH, plot_style=("C0", "-"), rank=0,
+    description=("Nonlinear rubber bushing, one axis: the modified Spencer/Bouc-Wen model of 'New nonlinear bushing "
+                 "model for general excitations using Bouc-Wen hysteretic model' (eqs. 1-5). Ports in SI, "
+                 "parameters in the paper's N-mm-s units."),
     coupled=CoupledKernels(
         (StateSpec("y", 0, "m", "displacement of the left plate (eq. 3)"),
          StateSpec("z1", 1, "N", "hysteretic force of the left block (eq. 1)"),

@@ -17,6 +17,7 @@ from .bushing_params import DAMPING, EXPONENT, GAIN, SPRING, WEIGHT, ParameterSp
 from .integration import (DEFAULT_MAX_SUBSTEPS, HEUN_JUMP_LIMIT, NOT_FINITE, OK, THETA, THETA_JUMP, block_gain,
                           vector_dot, vector_gain, vector_walk, walk_along_xi)
 from .model_definition import BushingModel, CoupledKernels, SearchBox, SearchCoordinate, StateSpec
+from .search_coordinates import KIND
 from .spencer_model import SINGLE_BLOCK_CONSTRAINTS
 
 PARAMETER_SPECS = (
@@ -118,10 +119,10 @@ def switches_coupled(m, state, x, v):
 
 
 SEARCH = SearchBox(
-    (SearchCoordinate("k0", "stiffness", -3.0, 1.0), SearchCoordinate("c0", "damping", -4.0, 2.0),
-     SearchCoordinate("A", "gain", -4.0, 1.0), SearchCoordinate("beta", "shape", 0.0, 20.0, "n"),
-     SearchCoordinate("gamma", "shape_sum", 0.0, 40.0, "n", partner="beta", sign=1.0),
-     SearchCoordinate("n", "exponent", 0.1, 1.5)),
+    (SearchCoordinate("k0", KIND.stiffness, -3.0, 1.0), SearchCoordinate("c0", KIND.damping, -4.0, 2.0),
+     SearchCoordinate("A", KIND.gain, -4.0, 1.0), SearchCoordinate("beta", KIND.shape, 0.0, 20.0, "n"),
+     SearchCoordinate("gamma", KIND.shape_sum, 0.0, 40.0, "n", partner="beta", sign=1.0),
+     SearchCoordinate("n", KIND.exponent, 0.1, 1.5)),
     unit_weights=("alpha",))
 """The fit's box (alpha held at 1)."""
 

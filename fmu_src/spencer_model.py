@@ -23,6 +23,7 @@ from .integration import (DEFAULT_MAX_SUBSTEPS, HEUN_JUMP_LIMIT, NOT_FINITE, OK,
                           block_gain, block_power, block_step, substeps_needed, vector_block_step, vector_block_view,
                           vector_dot, vector_gain, vector_substeps_needed, vector_walk, walk_along_xi)
 from .model_definition import BushingModel, CoupledKernels, SearchBox, SearchCoordinate, StateSpec
+from .search_coordinates import KIND
 
 PARAMETER_SPECS = (
     ParameterSpec("c0", "N.s/mm", "viscous damping in parallel with the Bouc-Wen element (large velocities)",
@@ -193,12 +194,12 @@ def switches_coupled(m, state, x, v):
 
 
 SEARCH = SearchBox(
-    (SearchCoordinate("k0", "stiffness", -5.0, 1.0), SearchCoordinate("k1", "stiffness", -3.0, 1.0),
-     SearchCoordinate("c0", "damping", -4.0, 2.0),
-     SearchCoordinate("c1", "time_constant", -math.inf, 6.0, over=("k0", "A")),
-     SearchCoordinate("A", "gain", -4.0, 1.0), SearchCoordinate("gamma", "shape", 0.0, 20.0, "n"),
-     SearchCoordinate("beta", "shape_sum", 0.0, 40.0, "n", partner="gamma", sign=1.0),
-     SearchCoordinate("n", "exponent", 0.1, 1.5)),
+    (SearchCoordinate("k0", KIND.stiffness, -5.0, 1.0), SearchCoordinate("k1", KIND.stiffness, -3.0, 1.0),
+     SearchCoordinate("c0", KIND.damping, -4.0, 2.0),
+     SearchCoordinate("c1", KIND.time_constant, -math.inf, 6.0, over=("k0", "A")),
+     SearchCoordinate("A", KIND.gain, -4.0, 1.0), SearchCoordinate("gamma", KIND.shape, 0.0, 20.0, "n"),
+     SearchCoordinate("beta", KIND.shape_sum, 0.0, 40.0, "n", partner="gamma", sign=1.0),
+     SearchCoordinate("n", KIND.exponent, 0.1, 1.5)),
     unit_weights=("alpha",), zeros=("x0",))
 """The fit's box. Spencer's gamma sits where eq. 1 has beta: gamma >= 0, gamma + beta > 0; its
 dashpot to ground c1 works against k0 and the Bouc-Wen element; x0 (a constant force) is held at 0."""

@@ -13,6 +13,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from .bushing_models import DEFAULT_MODEL, get_model
+
 
 @dataclass(frozen=True)
 class FmuVariable:
@@ -103,13 +105,10 @@ def indicator_variables(first_reference: int, axis_models, groups=()) -> list[Fm
 
 def fmu_description(axis_models) -> str:
     """The FMU's description (its modelDescription's), for ``axis_models`` as above (None: not built)."""
-    if axis_models is None or (len(axis_models) == 1 and axis_models[0][1].name == "proposed"):
-        return ("Nonlinear rubber bushing, one axis: the modified Spencer/Bouc-Wen model of "
-                "'New nonlinear bushing model for general excitations using Bouc-Wen hysteretic "
-                "model' (eqs. 1-5). Ports in SI, parameters in the paper's N-mm-s units.")
-    if len(axis_models) == 1:
-        return (f"Bushing, one axis: the {axis_models[0][1].title} baseline model of the Bouc-Wen bushing project. "
-                "Ports in SI, parameters in N-mm-s units.")
+    if axis_models is None or len(axis_models) == 1:
+        model = get_model(DEFAULT_MODEL) if axis_models is None else axis_models[0][1]
+        return model.description or (f"Bushing, one axis: the {model.title} baseline model of the Bouc-Wen bushing "
+                                     "project. Ports in SI, parameters in N-mm-s units.")
     return ("Six-axis rubber bushing between markers I and J (uncoupled axes, small rotations; "
             "inputs and outputs in J's axes): " + ", ".join(f"{axis.name} {model.title}" for axis, model, _ in axis_models)
             + ". Ports in SI; translational parameters in N-mm-s units, rotational in N.mm, rad, s.")

@@ -15,7 +15,7 @@ import warnings
 from pathlib import Path
 
 from fmu_src import __version__, jit
-from fmu_src.bushing_models import MODEL_CHOICES, MODEL_NAMES
+from fmu_src.bushing_models import DEFAULT_MODEL, MODEL_CHOICES, MODEL_NAMES, MODELS
 from fmu_src.bushing_params import ParameterError
 from identification import commands
 from identification.dynamic_stiffness import DEFAULT_AMPLITUDES_MM, DEFAULT_FREQUENCIES_HZ
@@ -26,6 +26,11 @@ from identification.multiaxis import COUPLED_AXES
 from identification.presets import PRESETS, describe
 from identification.progress import close_open_bars
 
+
+
+def _linear_models() -> str:
+    """The models fitted by linear least squares (``BushingModel.linear``), for the help."""
+    return ", ".join(name for name, model in MODELS.items() if model.linear is not None)
 
 def positive_int(text: str) -> int:
     value = int(text)
@@ -75,8 +80,9 @@ def main(argv: list[str] | None = None) -> int:
 
     fit_parser = subcommands.add_parser("fit", help="fit a model's parameters to rig tests, with convergence evidence")
     fit_parser.add_argument("--model", choices=MODEL_CHOICES, metavar="MODEL",
-                            help=f"one of {', '.join(MODEL_NAMES)} (kelvin_voigt by linear least squares; "
-                                 "`compare` recommends one); default: the manifest's, else proposed, the paper's")
+                            help=f"one of {', '.join(MODEL_NAMES)} ({_linear_models()} by linear least squares; "
+                                 f"`compare` recommends one); default: the manifest's, else {DEFAULT_MODEL}, the "
+                                 "paper's")
     _add_training_arguments(fit_parser)
     fit_parser.add_argument("--coupling", choices=tuple(COUPLED_AXES), metavar="COUPLING",
                             help="how the model runs on the --multiaxis tests (required with them): none (one "

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fmu_src.bushing_models import MODEL_CHOICES, MODEL_NAMES, get_model
+from fmu_src.bushing_models import DEFAULT_MODEL, MODEL_CHOICES, MODEL_NAMES, get_model
 from fmu_src.parameter_files import read_parameter_set
 from identification.errors import FitNotConvergedWarning, UsageError
 from identification.measurements import load_measurement, measurement_name
@@ -115,7 +115,7 @@ def fit_command(args) -> int:
     if args.no_ensemble and args.ensemble is not None:
         raise UsageError(f"--ensemble {args.ensemble} needs the ensemble that --no-ensemble skips: give one of them")
     tests, manifest_model = training_tests_of(args)
-    model = args.model or manifest_model or "proposed"
+    model = args.model or manifest_model or DEFAULT_MODEL
     if model not in MODEL_CHOICES:
         raise UsageError(f"the manifest's model {model!r} is not one of {', '.join(MODEL_NAMES)}")
     bushing = get_model(model)             # resolved once; an alias (bouc_wen) under its name
@@ -199,7 +199,7 @@ def sensitivity_command(args) -> int:
     from fmu_src.parameter_files import load_parameters
     from identification.sensitivity import sensitivity
     check_output(args.csv, "--csv", suffixes=(".csv",))
-    table = sensitivity(load_parameters(args.params, model="proposed"), delta=args.delta)
+    table = sensitivity(load_parameters(args.params, model=DEFAULT_MODEL), delta=args.delta)
     print(table.format())
     if args.csv:
         table.write_csv(args.csv)

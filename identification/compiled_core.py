@@ -22,7 +22,7 @@ from fmu_src.jit import numba
 import numpy as np
 
 from fmu_src import compiled_kernels as _kernels, integration
-from fmu_src.bushing_models import BushingModel, resolve_model
+from fmu_src.bushing_models import BushingModel, DEFAULT_MODEL, resolve_model
 from fmu_src.proposed_model import PARAMETER_NAMES  # noqa: F401  (the proposed model's order, for callers)
 from identification import steady_state
 
@@ -132,7 +132,7 @@ def _population_appendix(model) -> str:
 _compiled_models: dict[str, types.ModuleType] = {}
 
 
-def compiled_model(model: str | BushingModel = "proposed") -> types.ModuleType:
+def compiled_model(model: str | BushingModel = DEFAULT_MODEL) -> types.ModuleType:
     """The generated, compiled module of ``model`` with the population loop (loaded on first use)."""
     bushing = resolve_model(model)
     if bushing.name not in _compiled_models:
@@ -141,7 +141,8 @@ def compiled_model(model: str | BushingModel = "proposed") -> types.ModuleType:
 
 
 def simulate_population_held(parameter_sets, time_s, displacement_mm, velocity_mm_s,
-                             max_substeps: int = _MAX_SUBSTEPS, model: str | BushingModel = "proposed") -> np.ndarray:
+                             max_substeps: int = _MAX_SUBSTEPS,
+                             model: str | BushingModel = DEFAULT_MODEL) -> np.ndarray:
     """Forces [N], shape (P, samples), of P parameter sets of ``model`` under the FMU's input
     convention.
 
@@ -164,7 +165,7 @@ def simulate_population_held(parameter_sets, time_s, displacement_mm, velocity_m
 
 def simulate_population_at(parameter_sets, time_s, displacement_mm, velocity_mm_s, output_index,
                            output_velocity_mm_s, max_substeps: int = _MAX_SUBSTEPS,
-                           model: str | BushingModel = "proposed") -> np.ndarray:
+                           model: str | BushingModel = DEFAULT_MODEL) -> np.ndarray:
     """Forces [N], shape (P, outputs), at the communication points ``time_s[output_index]``
     (increasing), with the force's viscous feedthrough taken at ``output_velocity_mm_s``; the
     input between communication points as in :func:`simulate_population_held`."""
@@ -180,7 +181,7 @@ def simulate_population_at(parameter_sets, time_s, displacement_mm, velocity_mm_
 
 
 def simulate_coupled_held(parameter_sets, time_s, displacement_mm, velocity_mm_s,
-                          max_substeps: int = _MAX_SUBSTEPS, model: str | BushingModel = "proposed") -> np.ndarray:
+                          max_substeps: int = _MAX_SUBSTEPS, model: str | BushingModel = DEFAULT_MODEL) -> np.ndarray:
     """Force vectors [N], shape (P, samples, d), of P parameter sets of ``model``'s coupled form on
     the path ``displacement_mm`` (samples, d = 2 or 3) [mm] with the steps' velocities
     ``velocity_mm_s`` (samples, d) [mm/s], under the FMU's input convention (as
@@ -192,7 +193,7 @@ def simulate_coupled_held(parameter_sets, time_s, displacement_mm, velocity_mm_s
 
 
 def simulate_coupled_at(parameter_sets, time_s, displacement_mm, velocity_mm_s, output_index, output_velocity_mm_s,
-                        max_substeps: int = _MAX_SUBSTEPS, model: str | BushingModel = "proposed") -> np.ndarray:
+                        max_substeps: int = _MAX_SUBSTEPS, model: str | BushingModel = DEFAULT_MODEL) -> np.ndarray:
     """Force vectors [N], shape (P, outputs, d), of P parameter sets of ``model``'s coupled form at
     the communication points ``time_s[output_index]`` (increasing) of the path ``displacement_mm``
     (points, d = 2 or 3) [mm] with the steps' velocities ``velocity_mm_s`` (points, d) [mm/s], the
@@ -243,7 +244,7 @@ def _input_arrays(time_s, displacement_mm, velocity_mm_s):
     return t, x, v
 
 
-def parameter_matrix(parameter_sets, model: str | BushingModel = "proposed") -> np.ndarray:
+def parameter_matrix(parameter_sets, model: str | BushingModel = DEFAULT_MODEL) -> np.ndarray:
     """(P, m) float array of P parameter sets of ``model`` in its parameter order (its specs'),
     from a sequence of mappings or an array."""
     bushing = resolve_model(model)

@@ -32,7 +32,7 @@ from typing import Sequence
 
 import numpy as np
 
-from fmu_src.bushing_models import BushingModel
+from fmu_src.bushing_models import BushingModel, DEFAULT_MODEL
 from identification.errors import CharacterisationWarning, IdentificationError
 from identification.kdyn_table import (PLAUSIBLE_AMPLITUDE_MM, PLAUSIBLE_FREQUENCY_HZ, SHEET_COLUMNS,
                                        SHEET_RESULT_COLUMNS, ensemble_columns, write_kdyn_table)
@@ -67,7 +67,7 @@ class DynamicStiffness:
     cycles: np.ndarray                      # cycles simulated per case
     converged: np.ndarray                   # steady state reached per case
     loop_force_N: np.ndarray                # (cases, steps_per_cycle): the last cycle's force
-    model: str = "proposed"
+    model: str = DEFAULT_MODEL
     members: int = 1
     minimum: dict[str, np.ndarray] = field(default_factory=dict)
     maximum: dict[str, np.ndarray] = field(default_factory=dict)

@@ -40,7 +40,7 @@ from typing import Callable
 import numpy as np
 
 from fmu_src import compiled_kernels as _kernels, integration, tangents
-from fmu_src.bushing_models import BushingModel, resolve_model
+from fmu_src.bushing_models import BushingModel, DEFAULT_MODEL, resolve_model
 from fmu_src.jit import numba
 from identification.vector_tangents import vectorize
 from identification.compiled_core import _input_arrays, _step_sizes, parameter_matrix
@@ -248,7 +248,7 @@ def python_sensitivities(model: str | BushingModel, lanes: int) -> Callable:
 
 def population_sensitivities(parameter_sets, seeds, time_s, displacement_mm, velocity_mm_s, output_index,
                              output_velocity_mm_s, max_substeps: int = _MAX_SUBSTEPS,
-                             model: str | BushingModel = "proposed") -> tuple[np.ndarray, np.ndarray]:
+                             model: str | BushingModel = DEFAULT_MODEL) -> tuple[np.ndarray, np.ndarray]:
     """Forces [N], shape (P, outputs), as ``compiled_core.simulate_population_at`` gives them (the
     same bits), and their derivatives, shape (P, outputs, K), in the K directions ``seeds`` (P, m,
     K): the derivatives of each row's m parameters (in the model's order) along each direction.

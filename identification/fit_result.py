@@ -226,7 +226,7 @@ class FitResult:
         edges = []
         for c, value, (low, high) in zip(self.space.coordinates, theta, self.space.bounds()):
             margin = tolerance * (high - low)
-            if value >= high - margin or (value <= low + margin and c.kind in ("time_constant", "exponent")):
+            if value >= high - margin or (value <= low + margin and c.kind.floor_is_search_limit):
                 edges.append(c.parameter)
         return edges
 

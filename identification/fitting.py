@@ -1,6 +1,6 @@
 """Fit a model's parameters to training tests, and say how sure the fit is.
 
-``fit(tests, model="proposed", preset="default", seed=0, workers=None, scheduler=None)``:
+``fit(tests, model=DEFAULT_MODEL, preset="default", seed=0, workers=None, scheduler=None)``:
 
 1. the noise level of every test from its own data (``identification.noise``);
 2. the search (``identification.multistart``): screened Sobol starts (for a model with a
@@ -36,7 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fmu_src.bushing_models import BushingModel, resolve_model
+from fmu_src.bushing_models import BushingModel, DEFAULT_MODEL, resolve_model
 from fmu_src.compiled_kernels import cache_directory
 from fmu_src.parameter_files import ParameterSet
 from identification.compiled_core import parameter_matrix
@@ -61,7 +61,7 @@ from identification.presets import PAPER_GA, PRESETS, SearchSettings
 from identification.progress import SearchProgress
 from identification.refinement import refine_steps
 from identification.rig_tests import Manifest, RigTest
-from identification.search_space import KelvinVoigtFit, SearchSpace
+from identification.search_space import SearchSpace
 from identification.simulate import simulate
 
 MIN_FINAL_STARTS = 3
@@ -96,7 +96,7 @@ def as_multiaxis(multiaxis) -> list[MultiAxisMeasurement]:
     return [m if isinstance(m, MultiAxisMeasurement) else load_multiaxis(m) for m in multiaxis or ()]
 
 
-def fit(measurements, model: str | BushingModel = "proposed", preset: str = "default", seed: int = 0,
+def fit(measurements, model: str | BushingModel = DEFAULT_MODEL, preset: str = "default", seed: int = 0,
         workers: int | None = None, scheduler=None, engine=None, progress: bool = True, screening: int | None = None,
         starts: int | None = None, kdyn=None, ensemble: bool = True, jacobian: str = "exact", multiaxis=(),
         coupling: str | None = None) -> FitResult:
@@ -108,9 +108,10 @@ def fit(measurements, model: str | BushingModel = "proposed", preset: str = "def
         The training tests (``training_tests``, ``load_manifest``); a Measurement or a CSV path
         counts as a random-input test. May be empty when ``kdyn`` or ``multiaxis`` is given.
     model : str or BushingModel
-        ``proposed`` (default), ``spencer``, ``single_bouc_wen``, ``berg``, ``fractional`` or
-        ``kelvin_voigt`` (linear least squares), or the model itself
-        (``fmu_src.bushing_models.get_model``); resolved once and passed on.
+        A model's name (``fmu_src.bushing_models.MODEL_NAMES``; default ``DEFAULT_MODEL``, the
+        paper's), or the model itself; resolved once and passed on. A model whose force is linear
+        in its parameters (``BushingModel.linear``: Kelvin-Voigt) is fitted by linear least
+        squares, every other by the search.
     preset : str
         ``default`` (Sobol screening) or ``paper`` (the paper's GA); see ``presets``.
     seed : int
@@ -190,8 +191,8 @@ def fit(measurements, model: str | BushingModel = "proposed", preset: str = "def
     # One BLAS thread here as in every task: a multi-threaded BLAS may sum in another order,
     # and the scales and the Jacobian's SVD computed here must not depend on the engine.
     with threadpool_limits(limits=1):
-        if bushing.name == "kelvin_voigt":
-            result = _fit_kelvin_voigt(bushing, tests, noise, started, table, multi)
+        if bushing.linear is not None:
+            result = _fit_linear(bushing, tests, noise, started, table, multi)
         else:
             if preset not in PRESETS:
                 raise IdentificationError(f"unknown preset {preset!r}; choose one of {', '.join(PRESETS)}")
@@ -429,30 +430,53 @@ def _identifiability_jacobian(problem: Problem, theta: np.ndarray, notes: list[s
     return scaled_jacobian
 
 
-def _fit_kelvin_voigt(bushing: BushingModel, tests, noise, started, table=None,
-                      multi: MultiAxisTraining | None = None) -> FitResult:
-    """F = k*x + c*v by linear least squares with k, c >= 0 on the tests other than steps (a
-    linear spring cannot show the step's relaxation; all tests if there are only steps) and on
-    every axis of the multi-axis tests (a Kelvin-Voigt bushing couples nothing). With a
-    dynamic-stiffness table: scipy's bounded least squares on the whole objective (tests and
-    table), from that solution or, with a table alone, from the table's median K' and K''/omega."""
+def linear_solution(bushing: BushingModel, measurements) -> dict[str, float]:
+    """The parameters of a model whose force is linear in them (``bushing.linear``) by linear
+    least squares on ``measurements`` (scipy's lsq_linear, within each parameter's range), the
+    held ones at their values."""
+    from scipy.optimize import lsq_linear
+    names = [name for name, _ in bushing.linear.regressors]
+    signal = {"displacement": "displacement_mm", "velocity": "velocity_mm_s"}
+    design = np.column_stack([np.concatenate([getattr(m, signal[regressor]) for m in measurements])
+                              for _, regressor in bushing.linear.regressors])
+    force = np.concatenate([m.force_N for m in measurements])
+    solution = lsq_linear(design, force, bounds=_ranges(bushing, names)).x
+    return {**{name: float(value) for name, value in zip(names, solution)}, **dict(bushing.linear.held)}
+
+
+def _ranges(bushing: BushingModel, names) -> tuple[list[float], list[float]]:
+    """(lower, upper) bounds of the parameters ``names``: their allowed ranges (open ends +-inf)."""
+    specs = {spec.name: spec for spec in bushing.specs}
+    return ([-np.inf if specs[name].minimum is None else specs[name].minimum for name in names],
+            [np.inf if specs[name].maximum is None else specs[name].maximum for name in names])
+
+
+def _fit_linear(bushing: BushingModel, tests, noise, started, table=None,
+                multi: MultiAxisTraining | None = None) -> FitResult:
+    """A model whose force is linear in its parameters (``bushing.linear``) by linear least
+    squares (:func:`linear_solution`) on the tests other than steps (a linear spring cannot show
+    the step's relaxation; all tests if there are only steps) and on every axis of the
+    multi-axis tests (such a bushing couples nothing). With a dynamic-stiffness table: scipy's
+    bounded least squares on the whole objective (tests and table), from that solution or, with
+    a table alone, from the table's scales (k_ref for a stiffness, c_ref for a damping)."""
     from scipy.optimize import least_squares
     multi = multi or MultiAxisTraining([], [], "none")
+    free = [name for name, _ in bushing.linear.regressors]
+    held = dict(bushing.linear.held)
     if tests or multi.measurements:
-        linear = KelvinVoigtFit.fit(([t.measurement for t in tests if t.kind != "step"]
-                                     or [t.measurement for t in tests]) + multi.components(), nonnegative=True)
-        values = {"k": linear.k, "c": linear.c, "preload": 0.0}
+        values = linear_solution(bushing, ([t.measurement for t in tests if t.kind != "step"]
+                                           or [t.measurement for t in tests]) + multi.components())
     else:
         scales = SearchSpace.from_table(table)
-        values = {"k": scales.k_ref, "c": scales.c_ref, "preload": 0.0}
+        scale = {"displacement": scales.k_ref, "velocity": scales.c_ref}
+        values = {**{name: scale[regressor] for name, regressor in bushing.linear.regressors}, **held}
     objective = Objective(tests, noise, model=bushing, table=table, **multi.objective_arguments())
     if table is not None:
-        def residuals(kc):
-            return objective.residual_matrix(parameter_matrix([{"k": kc[0], "c": kc[1], "preload": 0.0}],
-                                                              bushing))[0]
-        solution = least_squares(residuals, [values["k"], values["c"]], bounds=([0.0, 0.0], [np.inf, np.inf]),
+        def residuals(solved):
+            return objective.residual_matrix(parameter_matrix([{**dict(zip(free, solved)), **held}], bushing))[0]
+        solution = least_squares(residuals, [values[name] for name in free], bounds=_ranges(bushing, free),
                                  x_scale="jac")
-        values = {"k": float(solution.x[0]), "c": float(solution.x[1]), "preload": 0.0}
+        values = {**{name: float(value) for name, value in zip(free, solution.x)}, **held}
     parameters = ParameterSet(bushing, values)
     misfit = float(objective(parameter_matrix([values], bushing))[0])
     result = FitResult(parameters, misfit, _test_fits(tests, noise, parameters) + multi.fits(parameters), [], 0.0,

@@ -26,7 +26,7 @@ import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from fmu_src.bushing_models import MODEL_CHOICES
+from fmu_src.bushing_models import DEFAULT_MODEL, MODEL_CHOICES
 from fmu_src.bushing_params import ParameterError
 from fmu_src.parameter_files import parameter_document
 from identification.engine import make_engine
@@ -99,7 +99,7 @@ def fit_many(folder: str | Path, out_dir: str | Path, workers: int | None = None
     for path in bushings:
         try:
             manifest = load_manifest(path / MANIFEST)
-            model = manifest.model or "proposed"
+            model = manifest.model or DEFAULT_MODEL
             if model not in MODEL_CHOICES:
                 raise MeasurementError(f"{path / MANIFEST}: model {model!r} is not one of {', '.join(MODEL_CHOICES)}")
             labels = [_label(t.measurement.source, path) for t in manifest.tests]

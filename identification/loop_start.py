@@ -1,18 +1,20 @@
 """Starts from the data: the spring and the friction of a filled-rubber model from a slow loop.
 
-A model whose box declares ``SearchBox.loop_start`` (berg, fractional: ``k0``, ``k3``,
-``Ff_max``, ``x2``) has a progressive spring k0*x + k3*x^3 and Berg's friction in parallel with
-its rate-dependent part. On the training test whose loop is slowest (the sine of lowest
-frequency) that rate-dependent part is smallest, and the rest is nearly linear in the
-parameters: for a given x2, Berg's friction is Ff_max times its shape g(x; x2) (the law is
-homogeneous of degree one in Ff_max and the reversal forces), so
+A model whose box declares ``SearchBox.loop_start`` (a ``model_definition.SlowLoop``: the
+names of its spring's k0, k3, its friction's Ff_max and x2) has a progressive spring
+k0*x + k3*x^3 and Berg's friction in parallel with its rate-dependent part. On the training
+test whose loop is slowest (the sine of lowest frequency) that rate-dependent part is
+smallest, and the rest is nearly linear in the parameters: for a given x2, Berg's friction is
+Ff_max times its shape g(x; x2) (the law is homogeneous of degree one in Ff_max and the
+reversal forces), so
 
     F ~ k0*x + k3*x^3 + Ff_max*g(x; x2)
 
 is a linear least-squares problem with k0, k3, Ff_max >= 0 for each x2 (scipy's lsq_linear).
 The shapes for a grid of LOOP_TRAVELS values of x2 over the box come from one compiled call of
-the Berg model itself (friction only, Ff_max = 1); the x2 with the smallest residual is then
-refined between its grid neighbours (Brent's bounded search in log10 x2).
+the model itself, its parameters set to leave the friction alone (``SlowLoop.friction_only``,
+Ff_max = 1); the x2 with the smallest residual is then refined between its grid neighbours
+(Brent's bounded search in log10 x2).
 The fit's screening then adds LOOP_STARTS candidates that take these four values and the
 Sobol points' other coordinates (``multistart.screen``).
 
@@ -54,11 +56,6 @@ class LoopStart:
                 f"({self.unexplained:.1%} of its rms force left to the rest of the model)")
 
 
-def friction_only(x2: float) -> dict[str, float]:
-    """The Berg model with nothing but its friction, of limit 1 N: the friction's shape g(x; x2)."""
-    return {"k0": 0.0, "k3": 0.0, "Ff_max": 1.0, "x2": float(x2), "k1": 0.0, "c1": 1.0, "k2": 0.0, "c2": 1.0}
-
-
 def dominant_frequency_hz(test: RigTest) -> float:
     """The test's displacement frequency [Hz] from its mean-crossings (one cycle each two)."""
     x = test.measurement.displacement_mm - np.mean(test.measurement.displacement_mm)
@@ -70,9 +67,9 @@ def dominant_frequency_hz(test: RigTest) -> float:
 def slow_loop_start(tests: Sequence[RigTest], space: SearchSpace) -> LoopStart | None:
     """The spring and friction of the slowest sine test's loop (module docstring), or None if the
     model declares no loop start or no sine test has two cycles."""
-    names = space.bushing.search.loop_start
+    loop = space.bushing.search.loop_start
     sines = [t for t in tests if t.kind == "sine" and dominant_frequency_hz(t) > 0]
-    if not names or not sines:
+    if loop is None or not sines:
         return None
     test = min(sines, key=dominant_frequency_hz)
     frequency = dominant_frequency_hz(test)
@@ -81,16 +78,17 @@ def slow_loop_start(tests: Sequence[RigTest], space: SearchSpace) -> LoopStart |
         return None
     t, x, force = m.time_s, m.displacement_mm, m.force_N
     velocity = np.append(np.diff(x) / np.diff(t), 0.0)       # the secant path through the samples
-    low, high = next((c.low, c.high) for c in space.coordinates if c.parameter == "x2")
+    low, high = next((c.low, c.high) for c in space.coordinates if c.parameter == loop.travel)
     travels = space.x_ref * 10.0 ** np.linspace(low, high, LOOP_TRAVELS)
-    shapes = simulate_population_held([friction_only(x2) for x2 in travels], t, x, velocity, model="berg")
+    shapes = simulate_population_held([loop.friction_only(x2) for x2 in travels], t, x, velocity,
+                                      model=space.bushing)
     kept = t >= t[0] + SETTLING_CYCLES / frequency
 
     def least_squares(shape):
         return lsq_linear(np.column_stack([x, x ** 3, shape])[kept], force[kept], bounds=(0.0, np.inf))
 
     def shape_of(x2):
-        return simulate_population_held([friction_only(x2)], t, x, velocity, model="berg")[0]
+        return simulate_population_held([loop.friction_only(x2)], t, x, velocity, model=space.bushing)[0]
 
     costs = [least_squares(shape).cost for shape in shapes]
     best = int(np.argmin(costs))
@@ -103,8 +101,8 @@ def slow_loop_start(tests: Sequence[RigTest], space: SearchSpace) -> LoopStart |
     solution = least_squares(shape_of(x2))
     cost, (k0, k3, limit) = solution.cost, solution.x
     unexplained = math.sqrt(2.0 * cost / np.count_nonzero(kept)) / math.sqrt(float(np.mean(force[kept] ** 2)))
-    values = {"k0": float(k0), "k3": float(k3), "Ff_max": float(limit), "x2": float(x2)}
-    return LoopStart({name: values[name] for name in names}, test.name, unexplained)
+    values = dict(zip(loop.names, (float(k0), float(k3), float(limit), float(x2))))
+    return LoopStart(values, test.name, unexplained)
 
 
 def anchored_coordinates(start: LoopStart, space: SearchSpace) -> dict[int, float]:

@@ -30,7 +30,7 @@ from typing import Sequence
 
 import numpy as np
 
-from fmu_src.bushing_models import BushingModel, resolve_model
+from fmu_src.bushing_models import BushingModel, DEFAULT_MODEL, resolve_model
 from identification.forward_model import DrivenInput, DrivenVectorInput, prepare_input, prepare_vector_input
 from identification.kdyn_table import (FIT_CYCLES, FIT_STEPS_PER_CYCLE, KDYN_UNCERTAINTY, LOSS_ANGLE_UNCERTAINTY_DEG,
                                        SEARCH_CYCLES, SEARCH_STEPS_PER_CYCLE, KdynTable)
@@ -132,7 +132,7 @@ class Objective:
     """Misfit (chi^2/n) of candidate parameter sets of ``model``; see the module docstring."""
 
     def __init__(self, tests: Sequence[RigTest], noise: Sequence[NoiseEstimate] | None = None,
-                 steps: Sequence[int | None] | None = None, model: str | BushingModel = "proposed",
+                 steps: Sequence[int | None] | None = None, model: str | BushingModel = DEFAULT_MODEL,
                  table: KdynTable | None = None, search: bool = False,
                  multiaxis: Sequence[MultiAxisMeasurement] = (),
                  multiaxis_noise: Sequence[Sequence[NoiseEstimate]] | None = None, coupling: str = "none"):

@@ -14,6 +14,7 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
+from fmu_src.bushing_models import DEFAULT_MODEL, LINEAR_BASELINE
 from identification.measurements import Measurement
 from identification.objectives import nrmse, rms_level_error
 from identification.protocols import Random, Sine, Step, sample_times
@@ -56,7 +57,7 @@ def _case(name: str, prediction, expected) -> CaseError:
 
 
 def grid_errors(parameters, truth: Mapping[str, float], model: str | None = None,
-                truth_model: str = "proposed") -> list[CaseError]:
+                truth_model: str = DEFAULT_MODEL) -> list[CaseError]:
     """Errors of ``parameters`` (a set or an ensemble, anything ``predict`` takes; its best
     member) against the forces of ``truth`` (of ``truth_model``, noise-free) over the §5
     grid, with the ensemble's band width."""
@@ -123,6 +124,6 @@ def plot_measurement(parameters, measurement: Measurement, path: Path,
     bushing, _ = parameter_sets(parameters, model)
     predictions = {bushing.name: prediction.force_N}
     if kelvin_voigt is not None:
-        predictions["kelvin_voigt"] = kelvin_voigt.force(m.displacement_mm, m.velocity_mm_s)
+        predictions[LINEAR_BASELINE.name] = kelvin_voigt.force(m.displacement_mm, m.velocity_mm_s)
     band = (prediction.lower_N, prediction.upper_N) if prediction.members > 1 else None
     return plot_comparison(m, predictions, path, band)

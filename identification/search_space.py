@@ -13,25 +13,13 @@ F = k*x + c*v of the tests other than steps (of the steps if there are no others
 their peak force, tau_ref = c_ref/k_ref [s].
 
 Coordinates, each with bounds (the box; each model declares its own in its module,
-``BushingModel.search``, a ``model_definition.SearchBox``):
-
-- stiffness: log10(k/k_ref); gain: log10(A/k_ref), with A >= 1 N/mm (the paper's constraint);
-- damping: log10(c/c_ref);
-- time constant: log10(tau/tau_ref) of a dashpot over the stiffness it works against,
-  tau = c/(sum of those stiffnesses) (c1 over k0 + k1 + A1, c0 over k2 + A2 in the proposed
-  model). Its lower bound is TIME_CONSTANT_FLOOR times the sample interval: faster modes are
-  invisible in the samples and made fits drift to stiff corners (c1 -> 0.002 N*s/mm, a time
-  constant near 1e-7 s at 1 kHz) that no data support and that make every solver stiff;
-- shape: beta*F_ref^n/k_ref (beta >= 0, the paper's constraint);
-- shape sum: beta' + sign*gamma' of a block (gamma' = gamma*F_ref^n/k_ref), >= 0, which is the
-  paper's constraint beta1 + gamma1 > 0 (sign +1) and beta2 - gamma2 > 0 (sign -1) as a bound;
-- exponent: n (or a fractional derivative's order alpha);
-- force: log10(F/F_ref), a friction force limit; travel: log10(x/x_ref), x_ref [mm] the tests'
-  largest displacement amplitude (the friction's x2); cubic: k3*x_ref^2/k_ref, a cubic spring's
-  share of the force at x_ref, from 0;
-- slower: log10(tau/tau_partner) of a second dashpot's time constant over the first's (a Maxwell
-  element slower than its partner, so that two elements never swap places between fits);
-- fractional: log10(b/(k_ref*tau_ref^alpha)), a fractional element's coefficient.
+``BushingModel.search``, a ``model_definition.SearchBox``): each coordinate's kind
+(``fmu_src.search_coordinates``: stiffness, gain, damping, time constant, slower, shape, shape
+sum, exponent, force, travel, cubic, power law) holds its map to the parameter, its inverse and
+its bounds; this module scales them by the data and runs them in order. The time constants'
+lower bound is TIME_CONSTANT_FLOOR times the sample interval: faster modes are invisible in the
+samples and made fits drift to stiff corners (c1 -> 0.002 N*s/mm, a time constant near 1e-7 s
+at 1 kHz) that no data support and that make every solver stiff.
 
 Every constraint is a bound, so bounded least squares and any box optimizer can search
 the space as it is. ``tests/test_search_space.py`` checks that the paper's Tables 2, 4, 5,
@@ -46,8 +34,9 @@ from typing import Mapping, Sequence
 import numpy as np
 from scipy.optimize import lsq_linear
 
-from fmu_src.bushing_models import MODELS, BushingModel, resolve_model
+from fmu_src.bushing_models import BushingModel, DEFAULT_MODEL, MODELS, resolve_model
 from fmu_src.model_definition import SearchCoordinate
+from fmu_src.search_coordinates import evaluation_order
 from identification.errors import IdentificationError
 from identification.measurements import Measurement
 
@@ -82,13 +71,6 @@ class KelvinVoigtFit:
         return self.k * np.asarray(displacement_mm) + self.c * np.asarray(velocity_mm_s)
 
 
-SCALED_KINDS = ("stiffness", "gain", "damping", "exponent", "force", "travel", "cubic")
-"""The kinds whose coordinate is the parameter's value on its own, scaled by the data."""
-_ORDER = ("stiffness", "gain", "damping", "exponent", "force", "travel", "cubic", "time_constant", "slower", "shape",
-          "shape_sum", "fractional")
-"""The order in which coordinates are mapped to parameters: each kind needs only earlier ones."""
-
-
 @dataclass(frozen=True)
 class SearchSpace:
     """The box of one model scaled by the data. ``model``: the model's name, or the model (a
@@ -98,7 +80,7 @@ class SearchSpace:
     c_ref: float                  # N*s/mm
     F_ref: float                  # N
     sample_interval_s: float      # the shortest median sample interval of the tests
-    model: str = "proposed"
+    model: str = DEFAULT_MODEL
     x_ref: float = 1.0            # mm: the tests' largest displacement amplitude
 
     def __post_init__(self):
@@ -116,7 +98,7 @@ class SearchSpace:
         object.__setattr__(self, "_bushing", resolve_model(self.model))
 
     @classmethod
-    def from_measurements(cls, measurements: Sequence[Measurement], model: str | BushingModel = "proposed",
+    def from_measurements(cls, measurements: Sequence[Measurement], model: str | BushingModel = DEFAULT_MODEL,
                           steps: Sequence[bool] = (), table=None) -> "SearchSpace":
         """The space for these tests; ``steps`` marks which are step tests (left out of the
         scales unless all are). ``table``: a dynamic-stiffness table (``kdyn_table.KdynTable``),
@@ -124,8 +106,9 @@ class SearchSpace:
         model = resolve_model(model)
         if model.search is None:
             searched = [name for name, bushing in MODELS.items() if bushing.search is not None]
-            raise ValueError(f"no search space for the {model.name!r} model; choose one of {', '.join(searched)} "
-                             "(kelvin_voigt is fitted by linear least squares)")
+            linear = f" ({model.name} is fitted by linear least squares: fitting.fit)" if model.linear else ""
+            raise ValueError(f"no search space for the {model.name!r} model; choose one of {', '.join(searched)}"
+                             + linear)
         steps = list(steps) or [False] * len(measurements)
         scaling = [m for m, is_step in zip(measurements, steps) if not is_step]
         if table is not None:
@@ -153,7 +136,7 @@ class SearchSpace:
         return cls(k_ref, c_ref, peak, interval, model, amplitude)
 
     @classmethod
-    def from_table(cls, table, model: str | BushingModel = "proposed") -> "SearchSpace":
+    def from_table(cls, table, model: str | BushingModel = DEFAULT_MODEL) -> "SearchSpace":
         """Scales from a dynamic-stiffness table's rows of weight > 0: k_ref the median storage
         stiffness K', c_ref the median K''/omega (the Kelvin-Voigt c of each row), F_ref the
         largest |K*|*X, the interval that of the fit's sine loop at the highest frequency."""
@@ -191,21 +174,14 @@ class SearchSpace:
         return TIME_CONSTANT_FLOOR * self.sample_interval_s
 
     def bounds(self) -> np.ndarray:
-        """(d, 2) lower and upper bounds of the coordinates (d = 14 for the proposed model)."""
-        log_A_low = max(math.log10(1.0 / self.k_ref), -4.0)  # A >= 1 N/mm (paper)
-        log_tau_low = math.log10(self.shortest_time_constant_s / self.tau_ref)
-        rows = []
-        for c in self.coordinates:
-            if c.kind == "gain":
-                rows.append((max(c.low, log_A_low), c.high))
-            elif c.kind == "time_constant":
-                rows.append((max(c.low, log_tau_low), c.high))
-            else:
-                rows.append((c.low, c.high))
-        return np.array(rows)
+        """(d, 2) lower and upper bounds of the coordinates (d = 14 for the proposed model): each
+        kind's (``search_coordinates``), some tightened by the data (A >= 1 N/mm, the time
+        constants' floor)."""
+        return np.array([c.kind.bounds(c, self) for c in self.coordinates], dtype=float)
 
     def to_model_parameters(self, coordinates: np.ndarray) -> np.ndarray:
-        """(P, d) coordinates -> (P, m) parameters of the model, in its parameter order. Complex
+        """(P, d) coordinates -> (P, m) parameters of the model, in its parameter order, each by
+        its coordinate's kind, in an order where what a kind reads is mapped first. Complex
         coordinates give complex parameters (the same map: how :meth:`to_parameters_and_seeds`
         differentiates it by complex step)."""
         theta = np.atleast_2d(np.asarray(coordinates, dtype=complex if np.iscomplexobj(coordinates) else float))
@@ -214,33 +190,8 @@ class SearchSpace:
         for name in self.bushing.search.unit_weights:
             value[name] = np.ones(theta.shape[0])
         column = {c.parameter: i for i, c in enumerate(self.coordinates)}
-        for c in sorted(self.coordinates, key=lambda c: _ORDER.index(c.kind)):
-            u = theta[:, column[c.parameter]]
-            if c.kind == "stiffness":
-                value[c.parameter] = self.k_ref * 10.0 ** u
-            elif c.kind == "gain":
-                # A >= 1 N/mm (paper); the clamp keeps rounding at the bound from crossing it.
-                value[c.parameter] = np.maximum(self.k_ref * 10.0 ** u, 1.0)
-            elif c.kind == "damping":
-                value[c.parameter] = self.c_ref * 10.0 ** u
-            elif c.kind == "exponent":
-                value[c.parameter] = u
-            elif c.kind == "force":
-                value[c.parameter] = self.F_ref * 10.0 ** u
-            elif c.kind == "travel":
-                value[c.parameter] = self.x_ref * 10.0 ** u
-            elif c.kind == "cubic":
-                value[c.parameter] = u * self.k_ref / self.x_ref ** 2
-            elif c.kind == "time_constant":
-                value[c.parameter] = self.tau_ref * 10.0 ** u * sum(value[name] for name in c.over)
-            elif c.kind == "slower":
-                value[c.parameter] = self._time_constant(value, c.partner) * 10.0 ** u * sum(value[name] for name in c.over)
-            elif c.kind == "fractional":
-                value[c.parameter] = self.k_ref * self.tau_ref ** value[c.exponent] * 10.0 ** u
-            elif c.kind == "shape":
-                value[c.parameter] = u * self._shape_scale(value[c.exponent])
-            else:  # shape_sum: u = partner' + sign*parameter'
-                value[c.parameter] = c.sign * (u * self._shape_scale(value[c.exponent]) - value[c.partner])
+        for c in evaluation_order(self.coordinates):
+            value[c.parameter] = c.kind.to_parameter(c, theta[:, column[c.parameter]], value, self)
         return np.column_stack([value[name] for name in names])
 
     def to_parameters(self, coordinates: np.ndarray) -> np.ndarray:
@@ -267,38 +218,14 @@ class SearchSpace:
         p = dict(params)
         for weight in self.bushing.search.unit_weights:   # each Bouc-Wen block's alpha, rescaled to 1
             p = _rescale_block(p, weight[len("alpha"):], p[weight])
-        theta = []
-        for c in self.coordinates:
-            value = p[c.parameter]
-            if c.kind in SCALED_KINDS:
-                theta.append(self.coordinate_of(c, value))
-            elif c.kind == "time_constant":
-                stiffness = sum(p[name] for name in c.over)
-                theta.append(math.log10(value / stiffness / self.tau_ref) if value > 0 else -math.inf)
-            elif c.kind == "slower":
-                tau = value / sum(p[name] for name in c.over)
-                theta.append(math.log10(tau / self._time_constant(p, c.partner)))
-            elif c.kind == "fractional":
-                theta.append(math.log10(value / (self.k_ref * self.tau_ref ** p[c.exponent])) if value > 0
-                             else -math.inf)
-            elif c.kind == "shape":
-                theta.append(value / self._shape_scale(p[c.exponent]))
-            else:
-                theta.append((p[c.partner] + c.sign * value) / self._shape_scale(p[c.exponent]))
-        return np.array(theta)
+        return np.array([c.kind.to_coordinate(c, p[c.parameter], p, self) for c in self.coordinates])
 
     def coordinate_of(self, c: SearchCoordinate, value: float) -> float:
-        """The coordinate ``c`` of a parameter value, for the kinds that need no other parameter
-        (SCALED_KINDS); a scale of 0 is -inf."""
-        if c.kind not in SCALED_KINDS:
-            raise ValueError(f"the {c.kind} coordinate of {c.parameter} depends on other parameters")
-        if c.kind == "exponent":
-            return value
-        if c.kind == "cubic":
-            return value * self.x_ref ** 2 / self.k_ref
-        scale = {"stiffness": self.k_ref, "gain": self.k_ref, "damping": self.c_ref, "force": self.F_ref,
-                 "travel": self.x_ref}[c.kind]
-        return math.log10(value / scale) if value > 0 else -math.inf
+        """The coordinate ``c`` of a parameter value, for a kind that reads no other parameter;
+        a scale of 0 is -inf."""
+        if c.kind.reads(c):
+            raise ValueError(f"the {c.kind.name} coordinate of {c.parameter} depends on other parameters")
+        return c.kind.to_coordinate(c, value, {}, self)
 
     def inside(self, coordinates: np.ndarray) -> np.ndarray:
         """Whether each row of coordinates lies in the box."""
@@ -306,16 +233,12 @@ class SearchSpace:
         bounds = self.bounds()
         return np.all((theta >= bounds[:, 0]) & (theta <= bounds[:, 1]), axis=1)
 
-    def _time_constant(self, values, parameter: str):
-        """The time constant [s] of the dashpot ``parameter`` (a time_constant coordinate) in
+    def time_constant(self, values, parameter: str):
+        """The time constant [s] of the dashpot ``parameter`` (a time-constant coordinate) in
         ``values`` (a mapping of parameters or of their columns): its value over the
         stiffnesses it works against."""
         over = next(c.over for c in self.coordinates if c.parameter == parameter)
         return values[parameter] / sum(values[name] for name in over)
-
-    def _shape_scale(self, n):
-        """beta = coordinate * k_ref / F_ref^n: the shape parameters' scale [N^(1-n)/mm]."""
-        return self.k_ref / self.F_ref ** n
 
 
 def rescale_hysteresis(params: Mapping[str, float], s1: float, s2: float) -> dict[str, float]:

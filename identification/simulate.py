@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from fmu_src.bushing_models import BushingModel, resolve_model
+from fmu_src.bushing_models import BushingModel, DEFAULT_MODEL, resolve_model
 from identification.compiled_core import parameter_matrix, simulate_coupled_at, simulate_population_at
 from identification.forward_model import DrivenInput, DrivenVectorInput, prepare_input
 from identification.parameter_input import parameter_sets
@@ -67,7 +67,7 @@ def simulate(parameters, time_s, displacement_mm, velocity_mm_s=None, model: str
 
 
 def simulate_driven(matrix: np.ndarray, driven: DrivenInput, max_substeps: int | None = None,
-                    model: str | BushingModel = "proposed") -> np.ndarray:
+                    model: str | BushingModel = DEFAULT_MODEL) -> np.ndarray:
     """Forces [N], shape (P, outputs), of a (P, m) matrix of ``model``'s parameters
     (``compiled_core.parameter_matrix``) on a prepared input, at its output samples
     (``driven.sample_index``). NaN from where a candidate fails."""
@@ -77,7 +77,7 @@ def simulate_driven(matrix: np.ndarray, driven: DrivenInput, max_substeps: int |
 
 
 def simulate_driven_vector(matrix: np.ndarray, driven: DrivenVectorInput, max_substeps: int | None = None,
-                           model: str | BushingModel = "proposed", coupled_axes: int = 0) -> np.ndarray:
+                           model: str | BushingModel = DEFAULT_MODEL, coupled_axes: int = 0) -> np.ndarray:
     """Force vectors [N], shape (P, outputs, d), of a (P, m) matrix of ``model``'s parameters on a
     prepared multi-axis input, at its output samples: the first ``coupled_axes`` axes (2 or 3) run
     the model's coupled form on their displacement vector (``model_definition.CoupledKernels``),

@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import Mapping
 
 from fmu_src.axes import SIX_AXES, SIX_AXIS_NAMES, six_axis
+from fmu_src.bushing_models import LINEAR_BASELINE
 from fmu_src.bushing_params import ParameterError
 from fmu_src.parameter_files import read_parameter_set, read_six_axis, save_six_axis
 
@@ -48,7 +49,7 @@ def assemble(axis_files: Mapping[str, str | Path], out: str | Path, rigid_missin
             axes[axis.name] = (one.model.name, one.parameters)
             sources[axis.name] = f"{default} (default)"
         elif rigid_missing:
-            axes[axis.name] = ("kelvin_voigt", {"k": RIGID_STIFFNESS, "c": 0.0, "preload": 0.0})
+            axes[axis.name] = (LINEAR_BASELINE.name, {"k": RIGID_STIFFNESS, "c": 0.0, "preload": 0.0})
             sources[axis.name] = "rigid (--rigid-missing)"
         else:
             missing = [name for name in SIX_AXIS_NAMES if name not in axis_files]

@@ -127,6 +127,24 @@ def test_kelvin_voigt_is_exactly_linear():
         p["k"] * (x[:-1] + v[:-1] * 1e-3) + p["c"] * v[:-1] + p["preload"], rel=1e-9, abs=1e-6)
 
 
+def test_kelvin_voigts_linear_fit_is_numpys_least_squares_and_stays_in_its_ranges():
+    # BushingModel.linear: F = k*x + c*v by least squares; a force whose best c is negative gets c = 0
+    from identification.fitting import linear_solution
+    from identification.measurements import Measurement
+    t, x, v = secant_input(Sine(2.0, 10.0), 0.5)
+    noise = np.random.default_rng(0).normal(0.0, 5.0, t.size)
+    for k, c in ((1234.5, 6.78), (900.0, -0.5)):
+        force = k * x + c * v + noise
+        solved = linear_solution(get_model("kelvin_voigt"), [Measurement(t, x, force, v)])
+        (k_ls, c_ls), *_ = np.linalg.lstsq(np.column_stack([x, v]), force, rcond=None)
+        if c > 0:
+            assert (solved["k"], solved["c"]) == pytest.approx((k_ls, c_ls), rel=1e-10)
+        else:
+            k_alone = float(x @ force / (x @ x))        # the best k with c held at its bound 0
+            assert 0.0 <= solved["c"] < 1e-9 and solved["k"] == pytest.approx(k_alone, rel=1e-9)
+        assert solved["preload"] == 0.0
+
+
 @pytest.mark.parametrize("model, params, block", [("single_bouc_wen", BOUC_WEN, ""), ("spencer", SPENCER, "")])
 def test_the_alpha_redundancy_holds_for_the_baselines(model, params, block):
     t, x, v = secant_input(Sine(2.0, 10.0), 0.3)

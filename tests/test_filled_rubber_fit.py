@@ -48,12 +48,14 @@ def training(model):
             rig_test(model, p, Step(2.0, 0.4, 10.0), "step", 3, rise_time_s=0.4)]
 
 
-def test_the_slow_loop_gives_the_spring_and_the_friction_of_a_rate_independent_bushing():
-    # no rate-dependent part (b = 0): the loop is the spring and the friction alone
+@pytest.mark.parametrize("model", ["berg", "fractional"])
+def test_the_slow_loop_gives_the_spring_and_the_friction_of_a_rate_independent_bushing(model):
+    # no rate-dependent part (b = 0): the loop is the spring and the friction alone; each model
+    # computes the friction's shape with its own kernels (SlowLoop.friction_only)
     p = dict(SPRING_AND_FRICTION, b=0.0, alpha=0.5)
     tests = [rig_test("fractional", p, Sine(0.5, 1.0, 3.0), "sine", 4, noise_N=0.0),
              rig_test("fractional", p, Sine(2.0, 10.0, 1.0), "sine", 5, noise_N=0.0)]
-    space = SearchSpace.from_measurements([t.measurement for t in tests], "berg")
+    space = SearchSpace.from_measurements([t.measurement for t in tests], model)
     start = slow_loop_start(tests, space)
     assert start.source == "fractional_sine_4.csv"          # the slower of the two
     # the truth's own law, sampled on the same path: the least squares recovers it (measured

@@ -86,9 +86,9 @@ def test_paper_tables_with_any_parameter_moved_50_percent_lie_well_inside(table,
     space = SearchSpace.from_measurements(tests, steps=[False, True])
     theta = space.to_coordinates(params)
     for c, value, (low, high) in zip(space.coordinates, theta, space.bounds()):
-        if c.kind in LOG_KINDS:
+        if c.kind.name in LOG_KINDS:
             assert low + 0.2 <= value <= high - 0.2, (c.parameter, value, low, high)  # decades
-        elif c.kind in ("shape", "shape_sum"):
+        elif c.kind.name in ("shape", "shape_sum"):
             # the lower bound is the paper's constraint itself (beta >= 0, beta1 + gamma1 > 0, beta2 - gamma2 > 0)
             assert low <= value <= high - 0.05 * (high - low), (c.parameter, value, low, high)
         else:
