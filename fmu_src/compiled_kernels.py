@@ -248,7 +248,7 @@ def _step_one(params, state, state_x, x, v, h, max_substeps):
     return state, force(m, state, x_end, v), x_end, status
 
 
-def _row_tuple(name: str, size: int) -> str:
+def row_tuple(name: str, size: int) -> str:
     """A compiled function ``name(row)``: the first ``size`` entries of an array row as a tuple."""
     values = "".join(f"row[{i}], " for i in range(size))
     return f"@numba.njit(cache=True)\ndef {name}(row):\n    return ({values})\n\n\n"
@@ -261,7 +261,7 @@ def _fmu_appendix(model) -> str:
     return ("\n\nimport math\nimport numpy as np\nfrom " + integration_module()
             + " import OK as _OK, JUMP_RELATIVE as _JUMP_RELATIVE, JUMP_FLOOR as _JUMP_FLOOR, "
             "JUMP_WINDOW as _JUMP_WINDOW, JUMP_COUNT as _JUMP_COUNT\n\n"
-            + _row_tuple("_VALUES", len(model.specs)) + _row_tuple("_STATE", size)
+            + row_tuple("_VALUES", len(model.specs)) + row_tuple("_STATE", size)
             + "@numba.njit(cache=True)\ndef _STORE(out, i, state):\n" + stores + "\n\n"
             + inspect.getsource(_step_axes)
             + "\n\n_step_axes = numba.njit(error_model='numpy', cache=True)(_step_axes)\n\n\n"

@@ -29,48 +29,95 @@ from identification import steady_state
 _MAX_SUBSTEPS = integration.DEFAULT_MAX_SUBSTEPS
 
 
-def _population_forces(matrix, t, x, v, out_index, out_velocity, max_substeps, step_sizes, step_size_index):
-    """Forces of every parameter set (rows of ``matrix``) at the communication points
-    ``t[out_index]``; the input over [t_k, t_k+1] is x_k + v_k*(t - t_k), as in the FMU, and the
-    force at an output point is the model's force with the velocity ``out_velocity`` (the FMU's
-    direct feedthrough of the velocity set at that instant). ``step_sizes``: the distinct
-    t_k+1 - t_k, and ``step_size_index[k]`` which one step k has: the step's constants
-    (``prepare_step``) are made once per candidate and step size (empty: at every step).
+def _population_loop(matrix, seeds, t, x, v, out_index, out_velocity, max_substeps, step_sizes, step_size_index):
+    """Forces (P, outputs) of every parameter set (rows of ``matrix``) at the communication points
+    ``t[out_index]``, and what the loop carries beside them: their derivatives (P, outputs, K) in
+    the K directions ``seeds`` (P, m, K: dp/dtheta of each row) for the fit's Jacobian
+    (``fit_jacobian``), nothing (K = 0) for the forces alone. The input over [t_k, t_k+1] is
+    x_k + v_k*(t - t_k), as in the FMU, and the force at an output point is the model's force
+    with the velocity ``out_velocity`` (the FMU's direct feedthrough of the velocity set at that
+    instant). ``step_sizes``: the distinct t_k+1 - t_k, and ``step_size_index[k]`` which one step
+    k has: the step's constants (``prepare_step``) are made once per candidate and step size
+    (empty: at every step). A candidate that fails gets NaN from there on.
 
-    Written here, never called here: its source is compiled in each model's generated module
-    (see :func:`_population_appendix`), where ``prepare``, ``prepare_step``, ``step``,
-    ``step_prepared`` (``integration``) and ``force`` are that model's compiled kernels and
-    ``_VALUES(row)`` the row's values as the tuple ``prepare`` takes."""
+    Written here, never called here: its source is compiled in each model's generated module,
+    where its slots are bound to what it carries. Each slot returns a value and its derivative:
+    ``_PREPARE(values, d_values)``, ``_INITIAL(m, x0, d_m)``, ``_PREPARE_STEP(m, h, d_m)``,
+    ``_STEP(m, ms, state, state_x, x, v, h, max_substeps, d_m, d_ms, d_state)`` (the step
+    protocol, ``integration.step_prepared``), ``_FORCE(m, state, x, v, d_m, d_state)``;
+    ``_VALUES(row)`` is the row as ``prepare``'s tuple, ``_SEEDS(seeds, i)`` row i's derivatives in
+    the same layout and ``_STORE(out, i, j, d)`` stores a force's. The forces alone
+    (:func:`_population_appendix`) bind the model's kernels with empty derivatives; the
+    Jacobian's bind their generated tangents (``fit_jacobian``). The forces are the same bits."""
     count, samples, outputs = matrix.shape[0], t.size, out_index.size
     forces = np.full((count, outputs), np.nan)
+    sensitivities = np.full((count, outputs, seeds.shape[2]), np.nan)
     cached = step_sizes.size > 0
     for i in numba.prange(count):
-        row = matrix[i]
-        m = prepare(_VALUES(row))
-        prepared = [prepare_step(m, step_sizes[u] if cached else t[1] - t[0])
+        m, d_m = _PREPARE(_VALUES(matrix[i]), _SEEDS(seeds, i))
+        prepared = [_PREPARE_STEP(m, step_sizes[u] if cached else t[1] - t[0], d_m)
                     for u in range(max(step_sizes.size, 1))]
         state_x = x[0]
-        state = initial_state(m, state_x)
+        state, d_state = _INITIAL(m, state_x, d_m)
         j = 0
         if out_index[0] == 0:
-            forces[i, 0] = force(m, state, state_x, out_velocity[0])
+            f, d_f = _FORCE(m, state, state_x, out_velocity[0], d_m, d_state)
+            forces[i, 0] = f
+            _STORE(sensitivities, i, 0, d_f)
             j = 1
         for k in range(samples - 1):
             if j == outputs:
                 break
             h = t[k + 1] - t[k]
             if cached:
-                state, used, status = step_prepared(m, prepared[step_size_index[k]], state, state_x, x[k], v[k], h,
-                                                    max_substeps)
+                ms, d_ms = prepared[step_size_index[k]]
             else:
-                state, used, status = step(m, state, state_x, x[k], v[k], h, max_substeps)
+                ms, d_ms = _PREPARE_STEP(m, h, d_m)
+            result, d_result = _STEP(m, ms, state, state_x, x[k], v[k], h, max_substeps, d_m, d_ms, d_state)
+            state, used, status = result
+            d_state = d_result[0]
             if status != _OK:
                 break  # this candidate failed: NaN from here on
             state_x = x[k] + v[k] * h
             if out_index[j] == k + 1:
-                forces[i, j] = force(m, state, state_x, out_velocity[j])
+                f, d_f = _FORCE(m, state, state_x, out_velocity[j], d_m, d_state)
+                forces[i, j] = f
+                _STORE(sensitivities, i, j, d_f)
                 j += 1
-    return forces
+    return forces, sensitivities
+
+
+# The forces alone: the loop's slots bound to the model's kernels, carrying no derivative.
+def _PREPARE(values, d_values):
+    return prepare(values), ()  # noqa: F821 (the model's, where bound)
+
+
+def _INITIAL(m, x0, d_m):
+    return initial_state(m, x0), ()  # noqa: F821
+
+
+def _PREPARE_STEP(m, h, d_m):
+    return prepare_step(m, h), ()  # noqa: F821
+
+
+def _STEP(m, ms, state, state_x, x, v, h, max_substeps, d_m, d_ms, d_state):
+    return step_prepared(m, ms, state, state_x, x, v, h, max_substeps), ((),)  # noqa: F821
+
+
+def _FORCE(m, state, x, v, d_m, d_state):
+    return force(m, state, x, v), ()  # noqa: F821
+
+
+def _SEEDS(seeds, i):
+    return ()
+
+
+def _STORE(out, i, j, d):
+    pass
+
+
+FORCES_ONLY = (_PREPARE, _INITIAL, _PREPARE_STEP, _STEP, _FORCE, _SEEDS, _STORE)
+"""The population loop's slots for the forces alone (:func:`_population_loop`)."""
 
 
 def _coupled_population_forces(matrix, t, x, v, out_index, out_velocity, max_substeps):
@@ -112,14 +159,16 @@ def _coupled_population_forces(matrix, t, x, v, out_index, out_velocity, max_sub
 
 def _population_appendix(model) -> str:
     """The population loops for ``model``: ``_VALUES(row)`` (the row's values as the tuple its
-    ``prepare`` takes), ``_simulate_population`` and ``_sine_steady_state``
+    ``prepare`` takes), the forces-only slots, ``_simulate_population`` and ``_sine_steady_state``
     (``identification.steady_state``)."""
-    values = ", ".join(f"row[{i}]" for i in range(len(model.specs)))
     return ("\n\nimport math\nimport numpy as np\nfrom " + _kernels.integration_module() + " import OK as _OK\n\n"
-            + f"@numba.njit(cache=True)\ndef _VALUES(row):\n    return ({values},)\n\n\n"
-            + inspect.getsource(_population_forces)
+            + _kernels.row_tuple("_VALUES", len(model.specs))
+            + "".join(inspect.getsource(slot) + "\n\n" for slot in FORCES_ONLY)
+            + "".join(f"{slot.__name__} = numba.njit(error_model='numpy', cache=True)({slot.__name__})\n"
+                      for slot in FORCES_ONLY)
+            + "\n\n" + inspect.getsource(_population_loop)
             + "\n\n_simulate_population = numba.njit(error_model='numpy', parallel=True, cache=True)"
-              "(_population_forces)\n\n\n"
+              "(_population_loop)\n\n\n"
             + f"ROUNDING = {steady_state.ROUNDING!r}\n\n\n"
             + inspect.getsource(steady_state._sine_steady_state)
             + "\n\n_sine_steady_state = numba.njit(error_model='numpy', parallel=True, cache=True)"
@@ -127,6 +176,11 @@ def _population_appendix(model) -> str:
             + ("\n\n" + inspect.getsource(_coupled_population_forces)
                + "\n\n_simulate_coupled_population = numba.njit(error_model='numpy', parallel=True, cache=True)"
                  "(_coupled_population_forces)\n" if model.coupled is not None else ""))
+
+
+def _forces(module, matrix, *arguments) -> np.ndarray:
+    """The population loop's forces, carrying no derivative."""
+    return module._simulate_population(matrix, np.empty((matrix.shape[0], matrix.shape[1], 0)), *arguments)[0]
 
 
 _compiled_models: dict[str, types.ModuleType] = {}
@@ -158,9 +212,8 @@ def simulate_population_held(parameter_sets, time_s, displacement_mm, velocity_m
     t, x, v = _input_arrays(time_s, displacement_mm, velocity_mm_s)
     out_velocity = np.concatenate([v[:1], v[:-1]])
     model = resolve_model(model)
-    return compiled_model(model)._simulate_population(parameter_matrix(parameter_sets, model), t, x, v,
-                                                      np.arange(t.size), out_velocity, max_substeps,
-                                                      *_step_sizes(t))
+    return _forces(compiled_model(model), parameter_matrix(parameter_sets, model), t, x, v, np.arange(t.size),
+                   out_velocity, max_substeps, *_step_sizes(t))
 
 
 def simulate_population_at(parameter_sets, time_s, displacement_mm, velocity_mm_s, output_index,
@@ -170,14 +223,10 @@ def simulate_population_at(parameter_sets, time_s, displacement_mm, velocity_mm_
     (increasing), with the force's viscous feedthrough taken at ``output_velocity_mm_s``; the
     input between communication points as in :func:`simulate_population_held`."""
     t, x, v = _input_arrays(time_s, displacement_mm, velocity_mm_s)
-    out_index = np.ascontiguousarray(output_index, dtype=np.int64)
-    out_velocity = np.ascontiguousarray(output_velocity_mm_s, dtype=float)
-    if not (out_index.ndim == 1 and out_index.size >= 1 and out_index.shape == out_velocity.shape
-            and np.all(np.diff(out_index) > 0) and 0 <= out_index[0] and out_index[-1] < t.size):
-        raise ValueError("output_index must be increasing indices into time_s, one output velocity each")
+    out_index, out_velocity = output_points(t, output_index, output_velocity_mm_s)
     model = resolve_model(model)
-    return compiled_model(model)._simulate_population(parameter_matrix(parameter_sets, model), t, x, v, out_index,
-                                                      out_velocity, max_substeps, *_step_sizes(t))
+    return _forces(compiled_model(model), parameter_matrix(parameter_sets, model), t, x, v, out_index, out_velocity,
+                   max_substeps, *_step_sizes(t))
 
 
 def simulate_coupled_held(parameter_sets, time_s, displacement_mm, velocity_mm_s,
@@ -232,6 +281,17 @@ def _step_sizes(t):
     if sizes.size > MAX_STEP_SIZES:
         return np.empty(0), np.empty(0, dtype=np.int64)
     return np.ascontiguousarray(sizes), np.ascontiguousarray(index, dtype=np.int64)
+
+
+def output_points(t, output_index, output_velocity_mm_s) -> tuple[np.ndarray, np.ndarray]:
+    """(indices, velocities) of the population loop's output points, checked: increasing indices
+    into the communication points ``t``, one velocity [mm/s] each."""
+    out_index = np.ascontiguousarray(output_index, dtype=np.int64)
+    out_velocity = np.ascontiguousarray(output_velocity_mm_s, dtype=float)
+    if not (out_index.ndim == 1 and out_index.size >= 1 and out_index.shape == out_velocity.shape
+            and np.all(np.diff(out_index) > 0) and 0 <= out_index[0] and out_index[-1] < t.size):
+        raise ValueError("output_index must be increasing indices into time_s, one output velocity each")
+    return out_index, out_velocity
 
 
 def _input_arrays(time_s, displacement_mm, velocity_mm_s):

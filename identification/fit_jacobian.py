@@ -13,8 +13,9 @@ with p, m, ms and the state active and the input (x, v, h) constant. No derivati
 ``fmu_src.tangents`` generates each kernel's tangent from its source (the kernels' own
 statements, so the forces are bit for bit those of ``compiled_core``'s population loop: tested),
 ``identification.vector_tangents`` makes them carry the K directions at once (the value, the
-expensive part of a step, is computed once), and this module writes them, with the loop below,
-into a generated module that numba compiles and caches on disk like the plain kernels
+expensive part of a step, is computed once), and this module binds them to the population loop
+that the forces run too (``compiled_core._population_loop``) in a generated module that numba
+compiles and caches on disk like the plain kernels
 (``fmu_src.compiled_kernels``; the first process compiles, later ones load).
 
 What the derivative is where the forward model is not differentiable: the derivative of the
@@ -43,68 +44,22 @@ from fmu_src import compiled_kernels as _kernels, integration, tangents
 from fmu_src.bushing_models import BushingModel, DEFAULT_MODEL, resolve_model
 from fmu_src.jit import numba
 from identification.vector_tangents import vectorize
-from identification.compiled_core import _input_arrays, _step_sizes, parameter_matrix
+from identification.compiled_core import (_input_arrays, _population_loop, _step_sizes, output_points,
+                                          parameter_matrix)
 
 _MAX_SUBSTEPS = integration.DEFAULT_MAX_SUBSTEPS
 
 
-def _population_sensitivities(matrix, seeds, t, x, v, out_index, out_velocity, max_substeps, step_sizes,
-                              step_size_index):
-    """Forces (P, outputs) and their derivatives (P, outputs, K) in the K directions ``seeds``
-    (P, m, K: dp/dtheta of each row), as ``compiled_core._population_forces`` computes the forces
-    (the same protocol and statements). A candidate that fails gets NaN from there on, both.
-
-    Written here, never called here: its source is compiled in the model's generated module
-    (:func:`_appendix`), where ``_PREPARE_T`` ... ``_FORCE_T`` are the vector tangents of that
-    model's kernels, ``_VALUES(row)`` the row as ``prepare``'s tuple, ``_SEEDS(seeds, i)`` row i's
-    seeds in the same layout with a K-tuple per value and ``_STORE(out, i, j, d)`` a K-tuple's store."""
-    count, samples, outputs = matrix.shape[0], t.size, out_index.size
-    forces = np.full((count, outputs), np.nan)
-    sensitivities = np.full((count, outputs, seeds.shape[2]), np.nan)
-    cached = step_sizes.size > 0
-    for i in range(count):
-        m, d_m = _PREPARE_T(_VALUES(matrix[i]), _SEEDS(seeds, i))
-        prepared = [_PREPARE_STEP_T(m, step_sizes[u] if cached else t[1] - t[0], d_m)
-                    for u in range(max(step_sizes.size, 1))]
-        state_x = x[0]
-        state, d_state = _INITIAL_T(m, state_x, d_m)
-        j = 0
-        if out_index[0] == 0:
-            f, d_f = _FORCE_T(m, state, state_x, out_velocity[0], d_m, d_state)
-            forces[i, 0] = f
-            _STORE(sensitivities, i, 0, d_f)
-            j = 1
-        for k in range(samples - 1):
-            if j == outputs:
-                break
-            h = t[k + 1] - t[k]
-            if cached:
-                ms, d_ms = prepared[step_size_index[k]]
-            else:
-                ms, d_ms = _PREPARE_STEP_T(m, h, d_m)
-            result, d_result = _STEP_T(m, ms, state, state_x, x[k], v[k], h, max_substeps, d_m, d_ms, d_state)
-            state, used, status = result
-            d_state = d_result[0]
-            if status != _OK:
-                break  # this candidate failed: NaN from here on
-            state_x = x[k] + v[k] * h
-            if out_index[j] == k + 1:
-                f, d_f = _FORCE_T(m, state, state_x, out_velocity[j], d_m, d_state)
-                forces[i, j] = f
-                _STORE(sensitivities, i, j, d_f)
-                j += 1
-    return forces, sensitivities
-
-
 def _tangent_names(model: BushingModel, generator: tangents.Generator) -> dict[str, str]:
-    """The generated tangents of the kernels the population loop calls, by the loop's names."""
+    """The generated tangents of the kernels the population loop calls, by the loop's slot names
+    (``compiled_core._population_loop``)."""
     namespace = model.step.__globals__     # the step protocol bound to the model's kernels
     return {
-        "_PREPARE_T": generator.emit(model.prepare, (True,)),
-        "_INITIAL_T": generator.emit(model.initial_state, (True, False)),
-        "_PREPARE_STEP_T": generator.emit(namespace["prepare_step"], (True, False)),
-        "_STEP_T": generator.emit(namespace["step_prepared"], (True, True, True, False, False, False, False, False)),
-        "_FORCE_T": generator.emit(model.force, (True, True, False, False)),
+        "_PREPARE": generator.emit(model.prepare, (True,)),
+        "_INITIAL": generator.emit(model.initial_state, (True, False)),
+        "_PREPARE_STEP": generator.emit(namespace["prepare_step"], (True, False)),
+        "_STEP": generator.emit(namespace["step_prepared"], (True, True, True, False, False, False, False, False)),
+        "_FORCE": generator.emit(model.force, (True, True, False, False)),
     }
 
 
@@ -141,26 +96,26 @@ def _tuple_of_lanes(values: int, lanes: int) -> str:
 
 def _appendix(model: BushingModel, lanes: int, machinery: str) -> str:
     """The vector tangents of ``model``'s kernels for ``lanes`` directions, their helpers and the
-    population loop (:func:`_population_sensitivities`), as source for its generated module."""
+    population loop (``compiled_core._population_loop``) carrying the derivatives, as source for
+    its generated module."""
     generator = tangents.Generator()
     loop_names = _tangent_names(model, generator)
     source = vectorize("\n\n".join(generator.sources.values()), lanes)
     helpers = "\n\n".join(inspect.getsource(helper) for helper in tangents.HELPERS.values())
     functions = [*generator.sources, *tangents.HELPERS]
-    values = ", ".join(f"row[{i}]" for i in range(len(model.specs)))
     stores = "".join(f"    out[i, j, {k}] = d[{k}]\n" for k in range(lanes))
     return ("\n\nimport math\nimport numpy as np\nfrom " + machinery + " import OK as _OK\n"
             + _machinery_imports(model, source, machinery)
             + f"\nSLOPE_CAP = {tangents.SLOPE_CAP!r}\n\n\n" + helpers + "\n\n\n" + source + "\n\n\n"
             + "".join(f"{name} = numba.njit(error_model='numpy', cache=True)({name})\n" for name in functions)
             + "".join(f"{alias} = {name}\n" for alias, name in loop_names.items())
-            + f"\n\n@numba.njit(cache=True)\ndef _VALUES(row):\n    return ({values},)\n\n\n"
+            + "\n\n" + _kernels.row_tuple("_VALUES", len(model.specs))
             + _tuple_of_lanes(len(model.specs), lanes)
             + f"@numba.njit(cache=True)\ndef _STORE(out, i, j, d):\n{stores}\n\n"
-            + inspect.getsource(_population_sensitivities)
-            # not parallel: the fit asks for one point's Jacobian at a time, and numba's parallel
-            # loop over these tuple types costs a third of the module's compile time
-            + "\n\n_simulate_sensitivities = numba.njit(error_model='numpy', cache=True)(_population_sensitivities)\n")
+            + inspect.getsource(_population_loop)
+            # not parallel (its prange a range): the fit asks for one point's Jacobian at a time,
+            # and numba's parallel loop over these tuple types costs a third of the compile time
+            + "\n\n_simulate_sensitivities = numba.njit(error_model='numpy', cache=True)(_population_loop)\n")
 
 
 _compiled: dict[tuple[str, int], types.ModuleType] = {}
@@ -222,7 +177,7 @@ def sensitivity_module(model: str | BushingModel, lanes: int) -> types.ModuleTyp
 
 
 def python_sensitivities(model: str | BushingModel, lanes: int) -> Callable:
-    """The population loop (:func:`_population_sensitivities`, same arguments) with the vector
+    """The population loop (``compiled_core._population_loop``, same arguments) with the vector
     tangents of ``model``'s kernels as plain Python, uncompiled: the very source the compiled
     module holds, for tests that check every model without compiling each (interpreted, some 100
     times slower; plain Python raises where numba gives inf or NaN)."""
@@ -243,7 +198,7 @@ def python_sensitivities(model: str | BushingModel, lanes: int) -> Callable:
     def store(out, i, j, d):
         out[i, j, :] = d
     namespace["_STORE"] = store
-    return types.FunctionType(_population_sensitivities.__code__, namespace, "_population_sensitivities")
+    return types.FunctionType(_population_loop.__code__, namespace, "_population_loop")
 
 
 def population_sensitivities(parameter_sets, seeds, time_s, displacement_mm, velocity_mm_s, output_index,
@@ -254,8 +209,7 @@ def population_sensitivities(parameter_sets, seeds, time_s, displacement_mm, vel
     K): the derivatives of each row's m parameters (in the model's order) along each direction.
     NaN (both) from where a candidate fails."""
     t, x, v = _input_arrays(time_s, displacement_mm, velocity_mm_s)
-    out_index = np.ascontiguousarray(output_index, dtype=np.int64)
-    out_velocity = np.ascontiguousarray(output_velocity_mm_s, dtype=float)
+    out_index, out_velocity = output_points(t, output_index, output_velocity_mm_s)
     bushing = resolve_model(model)
     matrix = parameter_matrix(parameter_sets, bushing)
     seeds = np.ascontiguousarray(seeds, dtype=float)

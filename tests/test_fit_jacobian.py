@@ -66,28 +66,28 @@ def test_every_lane_is_the_one_direction_tangent(name):
     p = tuple(values[0])
     rng = random.Random(3)
     directions = [[rng.uniform(-1.0, 1.0) * abs(value) for value in p] for _ in range(lanes)]
-    m, d_m = vector["_PREPARE_T"](p, tuple(tuple(directions[k][a] for k in range(lanes)) for a in range(len(p))))
-    state, d_state = vector["_INITIAL_T"](m, 0.3, d_m)
-    ms, d_ms = vector["_PREPARE_STEP_T"](m, 1e-3, d_m)
+    m, d_m = vector["_PREPARE"](p, tuple(tuple(directions[k][a] for k in range(lanes)) for a in range(len(p))))
+    state, d_state = vector["_INITIAL"](m, 0.3, d_m)
+    ms, d_ms = vector["_PREPARE_STEP"](m, 1e-3, d_m)
     singles = []
     for k in range(lanes):
-        m1, d_m1 = one[names["_PREPARE_T"]](p, tuple(directions[k]))
-        singles.append([m1, d_m1, *one[names["_INITIAL_T"]](m1, 0.3, d_m1),
-                        *one[names["_PREPARE_STEP_T"]](m1, 1e-3, d_m1)])
+        m1, d_m1 = one[names["_PREPARE"]](p, tuple(directions[k]))
+        singles.append([m1, d_m1, *one[names["_INITIAL"]](m1, 0.3, d_m1),
+                        *one[names["_PREPARE_STEP"]](m1, 1e-3, d_m1)])
     t, x, v = jumping_sine(60)
     state_x = x[0]
     for i in range(t.size - 1):
-        (state, _, status), d_result = vector["_STEP_T"](m, ms, state, state_x, x[i], v[i], 1e-3, 100, d_m, d_ms,
+        (state, _, status), d_result = vector["_STEP"](m, ms, state, state_x, x[i], v[i], 1e-3, 100, d_m, d_ms,
                                                          d_state)
         d_state = d_result[0]
         for k, (m1, d_m1, state1, d_state1, ms1, d_ms1) in enumerate(singles):
-            (state1, _, _), d_result1 = one[names["_STEP_T"]](m1, ms1, state1, state_x, x[i], v[i], 1e-3, 100, d_m1,
+            (state1, _, _), d_result1 = one[names["_STEP"]](m1, ms1, state1, state_x, x[i], v[i], 1e-3, 100, d_m1,
                                                               d_ms1, d_state1)
             singles[k] = [m1, d_m1, state1, d_result1[0], ms1, d_ms1]
         state_x = x[i] + v[i] * 1e-3
-        f, d_f = vector["_FORCE_T"](m, state, state_x, v[i], d_m, d_state)
+        f, d_f = vector["_FORCE"](m, state, state_x, v[i], d_m, d_state)
         for k, (m1, d_m1, state1, d_state1, _, _) in enumerate(singles):
-            f1, d_f1 = one[names["_FORCE_T"]](m1, state1, state_x, v[i], d_m1, d_state1)
+            f1, d_f1 = one[names["_FORCE"]](m1, state1, state_x, v[i], d_m1, d_state1)
             assert f1 == f
             scale = abs(d_f1) + max(abs(value) for value in d_f)
             assert abs(d_f1 - d_f[k]) <= 1e-10 * scale, (name, i, k)
@@ -295,3 +295,12 @@ def test_the_fit_takes_differences_where_the_exact_jacobian_would_not_pay(table2
     assert str(blocked / "cache") in note and "BUSHING_CACHE_DIR" in note
     monkeypatch.undo()
     assert fitting._exact_jacobian_or_why_not(table2_problem.objective.tests, space, False) == ("exact", None)
+
+
+def test_the_sensitivities_check_their_output_points_as_the_forces_do():
+    model, values = default_values("single_bouc_wen")
+    t = np.arange(0.0, 0.01, 1e-3)
+    seeds = np.zeros(values.shape + (2,))
+    for index in (np.array([3, 2]), np.array([0, t.size])):
+        with pytest.raises(ValueError, match="increasing indices into time_s"):
+            population_sensitivities(values, seeds, t, t, t, index, t[:2], model=model)
