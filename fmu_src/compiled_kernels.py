@@ -8,7 +8,8 @@ that only plain Python calls costs nothing); its imports of the shared machinery
 (``integration``) are pointed at a generated module of that machinery, compiled the same way,
 so that every kernel calls the others compiled. Tuples and sums over a constant range are
 written out term by term first (``unrolling``), which numba needs. Generated modules are
-named after a hash of their content: a changed model or machinery compiles afresh (numba's cache
+named after a hash of their content and the compiler versions (:func:`module_name`, the one
+cache key): a changed model or machinery compiles afresh (numba's cache
 checks only a file's own time stamp, not the sources of the functions a kernel calls), and
 numba's on-disk cache lets the next process load the machine code instead of compiling.
 
@@ -50,6 +51,7 @@ import warnings
 from pathlib import Path
 
 from . import integration
+from .generated_source import check_bound_names
 from .model_definition import ModelContractError, check_step_kernels
 from .unrolling import unroll
 
@@ -74,14 +76,34 @@ def cache_directory() -> Path:
     return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "boucwen-bushing"
 
 
+def compiler_versions() -> str:
+    """The versions of what compiles a generated module (Python, numba, llvmlite, numpy), read
+    without importing numba: part of every generated module's name."""
+    from importlib import metadata
+    versions = [f"python {sys.version.split()[0]}"]
+    for package in ("numba", "llvmlite", "numpy"):
+        try:
+            versions.append(f"{package} {metadata.version(package)}")
+        except metadata.PackageNotFoundError:
+            versions.append(f"{package} absent")
+    return ", ".join(versions)
+
+
 def module_name(prefix: str, source: str) -> str:
-    """``prefix`` and a hash of ``source``."""
-    return f"{prefix}_{hashlib.sha256(source.encode()).hexdigest()[:16]}"
+    """``prefix`` and a hash of ``source`` and the compiler versions: the one key of a generated
+    module and of numba's cache of it (a changed model, machinery, template or compiler compiles
+    afresh; anything else that changes no generated source, such as a docstring outside the
+    kernel modules, does not)."""
+    return f"{prefix}_{hashlib.sha256((compiler_versions() + chr(10) + source).encode()).hexdigest()[:16]}"
 
 
-def load_generated(name: str, source: str) -> types.ModuleType:
+def load_generated(name: str, source: str, check: bool = True) -> types.ModuleType:
     """The module ``name`` with ``source``, written to the cache folder and imported (once per
-    process); in memory, uncached, if the folder cannot be written."""
+    process); in memory, uncached, if the folder cannot be written. Where it is generated (not
+    yet in the folder, or in memory) and ``check``, every name its functions read must be bound
+    (``generated_source.check_bound_names``: a GenerationError naming the function and the name);
+    the shared machinery's module, whose step protocol is a template bound in each model's
+    module, is loaded unchecked."""
     if name in sys.modules:
         return sys.modules[name]
     try:
@@ -89,6 +111,8 @@ def load_generated(name: str, source: str) -> types.ModuleType:
         folder.mkdir(parents=True, exist_ok=True)
         path = folder / f"{name}.py"
         if not path.is_file() or path.read_text() != source:
+            if check:
+                check_bound_names(source, name)
             # Written whole and renamed: worker processes start at once and must never read half a file.
             partial = path.with_suffix(f".{os.getpid()}.tmp")
             partial.write_text(source)
@@ -96,6 +120,8 @@ def load_generated(name: str, source: str) -> types.ModuleType:
     except OSError as exc:
         warnings.warn(f"cannot write the compiled model's cache in {cache_directory()} ({exc}); compiling "
                       f"in memory at every start (set {CACHE_ENVIRONMENT} to a writable folder)", stacklevel=4)
+        if check:
+            check_bound_names(source, name)
         module = types.ModuleType(name)
         sys.modules[name] = module
         exec(compile(source.replace(", cache=True", "").replace("(cache=True)", "()"), f"<{name}>", "exec"),
@@ -156,7 +182,7 @@ def integration_module() -> str:
     source = (kernel_source(integration, None) + "\n\n# ---- appended by fmu_src/compiled_kernels.py ----\n"
               + _NUMBA_IMPORT + _JIT_KERNELS)
     name = module_name("bushing_integration", source)
-    load_generated(name, source)
+    load_generated(name, source, check=False)
     return name
 
 

@@ -208,10 +208,33 @@ def main(argv: list[str] | None = None) -> int:
             return 2
         except KeyboardInterrupt as stop:
             # Interrupted (SIGINT, SIGTERM); the engines stopped their workers on the way here
-            close_open_bars()
-            sys.stdout.flush()
-            print(interrupted_message(), file=sys.stderr)
-            return stop.exit_status if isinstance(stop, Interrupted) else 128 + signal.SIGINT
+            return _stopped(stop)
+        except SystemError as error:
+            # a signal that lands inside compiled code (numba loading its cache) surfaces as a
+            # SystemError whose cause is the Interrupted our handler raised: the same stop
+            stop = _interrupt_behind(error)
+            if stop is None:
+                raise
+            return _stopped(stop)
+
+
+def _interrupt_behind(error: BaseException) -> KeyboardInterrupt | None:
+    """The interrupt among ``error``'s causes and contexts, or None."""
+    seen = set()
+    while error is not None and id(error) not in seen:
+        if isinstance(error, KeyboardInterrupt):
+            return error
+        seen.add(id(error))
+        error = error.__cause__ or error.__context__
+    return None
+
+
+def _stopped(stop: KeyboardInterrupt) -> int:
+    """The one line and the exit status of a command stopped by a signal."""
+    close_open_bars()
+    sys.stdout.flush()
+    print(interrupted_message(), file=sys.stderr)
+    return stop.exit_status if isinstance(stop, Interrupted) else 128 + signal.SIGINT
 
 
 COMMANDS = {"fit": commands.fit_command, "sensitivity": commands.sensitivity_command,

@@ -30,12 +30,9 @@ from __future__ import annotations
 
 import ast
 import builtins
-import hashlib
 import inspect
-import os
 import sys
 import types
-from pathlib import Path
 from typing import Callable
 
 import numpy as np
@@ -121,41 +118,14 @@ def _appendix(model: BushingModel, lanes: int, machinery: str) -> str:
 _compiled: dict[tuple[str, int], types.ModuleType] = {}
 
 
-def _inputs_key(model: BushingModel, lanes: int) -> str:
-    """A hash of everything the generated module's source is made from: the model's kernel module
-    and its package's other modules (the machinery, the tangent generator, the unrolling, the
-    compiled modules' contract), the vector rewrite and this module, and the lane count."""
-    files = sorted({Path(sys.modules[model.kernel_module].__file__), *Path(integration.__file__).parent.glob("*.py"),
-                    Path(__file__), Path(sys.modules[vectorize.__module__].__file__)})
-    digest = hashlib.sha256(f"{model.name} {lanes}".encode())
-    for path in files:
-        digest.update(path.read_bytes())
-    return digest.hexdigest()[:16]
-
-
 def _generated_module(model: BushingModel, lanes: int) -> types.ModuleType:
-    """The generated module's source written and loaded (``compiled_kernels``). Generating it (the
-    tangents, their vector rewrite: over a second for the proposed model) is done once per machine:
-    an index file in the cache folder, named after a hash of its inputs (:func:`_inputs_key`),
-    holds the module's name, and every later process loads that module's file as it is."""
-    index = _kernels.cache_directory() / f"bushing_jacobian{lanes}_{model.name}_{_inputs_key(model, lanes)}.name"
+    """The generated module, its source made in every process (the tangents and their vector
+    rewrite: about a second for the proposed model's 14 directions) and loaded by its name, a
+    hash of that source and the compiler versions (``compiled_kernels.module_name``, the one
+    cache key): numba's disk cache holds its machine code from the machine's first process on."""
     machinery = _kernels.integration_module()      # loaded first: the module imports it by name
-    try:
-        name = index.read_text().strip()
-        path = _kernels.cache_directory() / f"{name}.py"
-        return _kernels.load_generated(name, path.read_text())
-    except OSError:     # not generated yet on this machine (or the index cannot be read)
-        pass
     source = _kernels.model_source(model, machinery, _appendix(model, lanes, machinery))
-    name = _kernels.module_name(f"bushing_jacobian{lanes}_{model.name}", source)
-    module = _kernels.load_generated(name, source)
-    try:
-        partial = index.with_suffix(f".{os.getpid()}.tmp")
-        partial.write_text(name)
-        os.replace(partial, index)     # whole or not at all: workers start at once
-    except OSError:
-        pass
-    return module
+    return _kernels.load_generated(_kernels.module_name(f"bushing_jacobian{lanes}_{model.name}", source), source)
 
 
 def sensitivity_module(model: str | BushingModel, lanes: int) -> types.ModuleType:
@@ -163,7 +133,7 @@ def sensitivity_module(model: str | BushingModel, lanes: int) -> types.ModuleTyp
     its population loop compiled (or loaded from numba's disk cache) by a first call on a
     two-sample input: once per process. The first process on a machine compiles (about 90 s for
     the proposed model's 14 directions: every tangent statement is written 14 times); later ones
-    load the machine code (about half a second)."""
+    generate the source again and load the machine code."""
     bushing = resolve_model(model)
     key = (bushing.name, lanes)
     if key not in _compiled:

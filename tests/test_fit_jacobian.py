@@ -267,17 +267,20 @@ def test_probe_gradients_equal_central_differences(table2_problem):
         assert np.linalg.norm(gradient - central) <= 1e-6 * np.linalg.norm(central), (kind, rate, measure)
 
 
-def test_a_later_process_loads_the_generated_module_by_its_index():
-    """The module's source is generated once per machine: an index file named after its inputs
-    holds its name, and a fresh process (here: the cache forgotten) loads that very module."""
+def test_the_generated_module_is_named_after_its_source_and_the_compilers(monkeypatch):
+    """One cache key: the module's source and the compiler versions. Generated again, the same
+    source and so the same module (numba's cache holds its machine code); another compiler
+    version, another name."""
     import identification.fit_jacobian as fit_jacobian
     from fmu_src import compiled_kernels
     module = fit_jacobian.sensitivity_module("proposed", 14)
     model = get_model("proposed")
-    index = compiled_kernels.cache_directory() / (f"bushing_jacobian14_proposed_"
-                                                  f"{fit_jacobian._inputs_key(model, 14)}.name")
-    assert index.read_text().strip() == module.__name__
-    assert fit_jacobian._generated_module(model, 14) is module     # by the index, the same module
+    machinery = compiled_kernels.integration_module()
+    source = compiled_kernels.model_source(model, machinery, fit_jacobian._appendix(model, 14, machinery))
+    assert module.__name__ == compiled_kernels.module_name("bushing_jacobian14_proposed", source)
+    assert fit_jacobian._generated_module(model, 14) is module
+    monkeypatch.setattr(compiled_kernels, "compiler_versions", lambda: "numba 0.0")
+    assert compiled_kernels.module_name("bushing_jacobian14_proposed", source) != module.__name__
 
 
 def test_the_fit_takes_differences_where_the_exact_jacobian_would_not_pay(table2_problem, monkeypatch, tmp_path):

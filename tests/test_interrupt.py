@@ -265,3 +265,26 @@ def test_the_early_handler_is_only_the_command_lines():
               "print(signal.getsignal(signal.SIGINT) is signal.default_int_handler)")
     output = subprocess.run([sys.executable, "-c", script], cwd=REPO, capture_output=True, text=True, check=True)
     assert output.stdout.strip() == "True"
+
+
+def test_a_signal_inside_compiled_code_is_the_same_stop(monkeypatch, capsys, tmp_path):
+    """A signal that lands while numba loads its cache reaches the command as a SystemError whose
+    cause is our Interrupted: one line and 143, as any SIGTERM, not a traceback."""
+    from identification import cli
+    from identification.interrupt import Interrupted
+
+    def compiled_call_interrupted(args):
+        try:
+            raise Interrupted(signal.SIGTERM)
+        except Interrupted as stop:
+            raise SystemError("CPUDispatcher(<function _population_loop>) returned a result with an exception set") \
+                from stop
+    monkeypatch.setitem(cli.COMMANDS, "design", compiled_call_interrupted)
+    assert cli.main(["design", "--ensemble", str(tmp_path / "e.json")]) == 128 + signal.SIGTERM
+    assert capsys.readouterr().err.splitlines()[-1].startswith("interrupted")
+
+    def other_system_error(args):
+        raise SystemError("a real one")
+    monkeypatch.setitem(cli.COMMANDS, "design", other_system_error)
+    with pytest.raises(SystemError, match="a real one"):
+        cli.main(["design", "--ensemble", str(tmp_path / "e.json")])

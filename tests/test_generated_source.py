@@ -1,0 +1,47 @@
+"""Generated modules are checked when generated: a function reading a name the module does not
+bind is refused, naming the function and the name (fmu_src/generated_source.py)."""
+import pytest
+
+from fmu_src import compiled_kernels
+from fmu_src.bushing_models import get_model
+from fmu_src.generated_source import GenerationError, unbound_names
+from identification import compiled_core
+
+TEMPLATE = '''
+def _template(row):
+    total = 0.0
+    for k in range(len(row)):
+        total += row[k] * SCALE
+    return [prepare(v) for v in row], _UNBOUND(total), math.pi
+'''
+
+
+def test_the_unbound_names_of_a_template_are_found_and_nothing_else():
+    source = "import math\nSCALE = 2.0\n\ndef prepare(p):\n    return p\n" + TEMPLATE
+    assert unbound_names(source) == [("_template", 7, "_UNBOUND")]
+    assert unbound_names(source + "\n_UNBOUND = abs\n") == []
+    # a binding in a conditional import at the top counts, as the step protocol's prepare_step does
+    assert unbound_names(source + "\nif True:\n    from math import fabs as _UNBOUND\n") == []
+
+
+def test_a_generated_module_whose_template_reads_an_unbound_name_is_refused_at_generation(monkeypatch, tmp_path):
+    monkeypatch.setenv(compiled_kernels.CACHE_ENVIRONMENT, str(tmp_path))
+    model = get_model("single_bouc_wen")
+    machinery = compiled_kernels.integration_module()
+    appendix = compiled_core._population_appendix(model).replace("_STORE(sensitivities, i, 0, d_f)",
+                                                                  "_STORE_FORCE(sensitivities, i, 0, d_f)")
+    source = compiled_kernels.model_source(model, machinery, appendix)
+    name = compiled_kernels.module_name("bushing_probe", source)
+    with pytest.raises(GenerationError, match=r"_population_loop \(line \d+\) reads '_STORE_FORCE'"):
+        compiled_kernels.load_generated(name, source)
+    assert not (tmp_path / f"{name}.py").exists()       # nothing written
+
+
+def test_every_models_generated_modules_bind_every_name_they_read():
+    from identification import fit_jacobian
+    machinery = compiled_kernels.integration_module()
+    for name in ("proposed", "berg", "fractional", "kelvin_voigt"):
+        model = get_model(name)
+        for appendix in (compiled_core._population_appendix(model), compiled_kernels._fmu_appendix(model),
+                         fit_jacobian._appendix(model, 2, machinery)):
+            assert unbound_names(compiled_kernels.model_source(model, machinery, appendix)) == [], name
