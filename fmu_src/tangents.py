@@ -70,7 +70,6 @@ they take the kernels.
 from __future__ import annotations
 
 import ast
-import builtins
 import copy
 import inspect
 import itertools
@@ -80,7 +79,6 @@ import types
 from typing import Callable
 
 from . import kernel_language
-from .unrolling import UnrollError, kernel_definition, kernel_global, kernel_statements
 
 SLOPE_CAP = 1e100
 """Largest magnitude of the slope factor a^(b-1) of ``a ** b`` (and of d sqrt) near a = 0 (module docstring)."""
@@ -164,54 +162,32 @@ def _copy(node):
 
 
 
-class _Spec:
+class _Spec(kernel_language.KernelFunction):
     """One kernel differentiated for one pattern of argument activities."""
+    error_type = TangentError
+    verb = "differentiated"
+    facts = "activities"
 
     def __init__(self, generator: "Generator", function: types.FunctionType, activities: tuple, name: str):
+        super().__init__(function, activities)
         self.generator = generator
-        self.function = function
         self.activities = activities
         self.name = name
-        self.where = f"{function.__module__}.{function.__name__}"
-        try:
-            self.tree, self.line_offset = kernel_definition(function)
-        except UnrollError as exc:
-            raise TangentError(str(exc)) from None
-        if not isinstance(self.tree, ast.FunctionDef):
-            raise TangentError(f"{self.where}: not a function definition")
-        args = self.tree.args
-        if args.vararg or args.kwarg or args.kwonlyargs or args.defaults or args.posonlyargs:
-            raise self.error(self.tree, "only plain positional parameters")
-        self.arguments = [a.arg for a in args.args]
-        if len(self.arguments) != len(activities):
-            raise self.error(self.tree, f"called with {len(activities)} arguments")
         for node in ast.walk(self.tree):
             if isinstance(node, ast.Name) and (node.id.startswith("d_") or node.id.startswith("_t")):
                 raise self.error(node, f"the name {node.id!r} is reserved for the generated tangents "
                                        "(d_..., _t...); rename it")
-        self.locals = dict(zip(self.arguments, activities))
-        self.return_activity = None
         self.analysing = True
         self.counter = itertools.count()
 
-    def error(self, node, message: str) -> TangentError:
-        return TangentError(f"{self.where}, line {getattr(node, 'lineno', 1) + self.line_offset}: {message}")
-
     @property
-    def body(self):
-        return kernel_statements(self.tree)
+    def return_activity(self):
+        """The activity of what the kernel returns."""
+        return self.result
 
     # ------------------------------------------------------------------ activity analysis
     def analyse(self):
-        for _ in range(50):
-            before = (dict(self.locals), self.return_activity)
-            self.analyse_block(self.body)
-            if (dict(self.locals), self.return_activity) == before:
-                break
-        else:
-            raise self.error(self.tree, "the activities of its variables do not settle")
-        if self.return_activity is None:
-            raise self.error(self.tree, "returns nothing")
+        self.settle(self.analyse_block, 50)
         self.analysing = False
 
     def assign_activity(self, target, a, node):
@@ -240,7 +216,7 @@ class _Spec:
                 if s.value is None:
                     raise self.error(s, "a bare return")
                 a = self.activity(s.value)
-                self.return_activity = a if self.return_activity is None else join(self.return_activity, a)
+                self.result = a if self.result is None else join(self.result, a)
             elif isinstance(s, (ast.If, ast.While)):
                 self.activity(s.test)
                 self.analyse_block(s.body)
@@ -261,32 +237,6 @@ class _Spec:
     @staticmethod
     def augmented(s: ast.AugAssign) -> ast.BinOp:
         return ast.copy_location(ast.BinOp(ast.Name(s.target.id, ast.Load()), s.op, s.value), s)
-
-    def global_value(self, name: str, node):
-        try:
-            return kernel_global(self.function, name)
-        except NameError:
-            raise self.error(node, f"unknown name {name!r}") from None
-
-    def callee(self, e: ast.Call):
-        """('math', name), ('builtin', name) or ('kernel', function)."""
-        if e.keywords:
-            raise self.error(e, "keyword arguments")
-        f = e.func
-        if isinstance(f, ast.Attribute) and isinstance(f.value, ast.Name) and f.value.id not in self.locals \
-                and self.global_value(f.value.id, f) is math:
-            if f.attr in kernel_language.MATH:
-                return "math", f.attr
-            raise self.error(e, f"math.{f.attr} is not differentiated; only {kernel_language.describe_calls()}")
-        if isinstance(f, ast.Name) and f.id not in self.locals:
-            value = self.global_value(f.id, e)
-            if getattr(builtins, f.id, None) is value and f.id in kernel_language.BUILTINS:
-                return "builtin", f.id
-            value = getattr(value, "py_func", value)
-            if isinstance(value, types.FunctionType):
-                return "kernel", value
-            raise self.error(e, f"call of {f.id} ({type(value).__name__}) is not differentiated")
-        raise self.error(e, f"call of {ast.unparse(f)} is not differentiated")
 
     def activity(self, e):
         if isinstance(e, ast.Constant):
@@ -309,7 +259,7 @@ class _Spec:
             return tuple(self.activity(element) for element in e.elts)
         if isinstance(e, ast.Subscript):
             a = self.activity(e.value)
-            index = self.index(e)
+            index = self.literal_index(e)
             if isinstance(a, tuple):
                 if not -len(a) <= index < len(a):
                     raise self.error(e, f"index {index} of a tuple of {len(a)}")
@@ -356,18 +306,6 @@ class _Spec:
     def boolean(self, e) -> bool:
         return isinstance(e, (ast.Compare, ast.BoolOp)) or (isinstance(e, ast.UnaryOp) and isinstance(e.op, ast.Not)) \
             or (isinstance(e, ast.Constant) and isinstance(e.value, bool))
-
-    def index(self, e: ast.Subscript) -> int:
-        index = e.slice
-        if isinstance(index, ast.UnaryOp) and isinstance(index.op, ast.USub) and isinstance(index.operand, ast.Constant):
-            value = -index.operand.value
-        elif isinstance(index, ast.Constant):
-            value = index.value
-        else:
-            raise self.error(e, "only constant tuple indices")
-        if not isinstance(value, int):
-            raise self.error(e, "only int tuple indices")
-        return value
 
     # ------------------------------------------------------------------ generation
     def generate(self) -> str:
@@ -523,7 +461,7 @@ class _Spec:
             return ast.Tuple([self.coerce(T(x), self.activity(x), self.activity(x)) for x in e.elts], ast.Load())
         if isinstance(e, ast.Subscript):
             tv = T(e.value)
-            index = self.index(e)
+            index = self.literal_index(e)
             if isinstance(tv, ast.Tuple):
                 return tv.elts[index]
             return ast.Subscript(tv, ast.Constant(index) if index >= 0 else

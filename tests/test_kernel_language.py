@@ -9,6 +9,7 @@ every tool that reads the kernels, and means the same in each.
   function and the line;
 - docs/adding_a_model.md names every entry.
 """
+import inspect
 import math
 from pathlib import Path
 
@@ -219,6 +220,42 @@ def test_a_call_outside_the_table_is_refused_by_both_naming_function_and_line(fu
     with pytest.raises(TranslationError, match=f"line {line}.*{words}"):
         Translation(prefix="bw").function(function, tuple(value_type(a) for a in (0.5,)))
     with pytest.raises(TangentError, match=f"{function.__name__}, line {line}.*{words}"):
+        tangent(function, inactive=())
+
+
+from math import exp as exp_by_name  # noqa: E402  (the refused spelling below)
+
+
+def exp_imported_by_name(a):
+    return exp_by_name(a)
+
+
+def variable_index(a):
+    pair = (a, a)
+    k = 1
+    return pair[k]
+
+
+def keyword_call(a):
+    return call_tan(a=a)
+
+
+def float_index(a):
+    pair = (a, a)
+    return pair[1.0]
+
+
+@pytest.mark.parametrize("function, words", [
+    (exp_imported_by_name, "exp_by_name is math.exp imported by name; write math.exp"),
+    (variable_index, "only constant tuple indices"),
+    (keyword_call, "keyword arguments"),
+    (float_index, "index 1.0: only int tuple indices")])
+def test_the_shared_analysis_refuses_alike_in_both_tools(function, words):
+    # kernel_language.KernelFunction: one reading of names, calls and indices for both tools
+    line = function.__code__.co_firstlineno + len(inspect.getsource(function).splitlines()) - 1   # the return
+    with pytest.raises(TranslationError, match=f"{function.__name__}, line {line}: {words}"):
+        Translation(prefix="bw").function(function, (value_type(0.5),))
+    with pytest.raises(TangentError, match=f"{function.__name__}, line {line}: {words}"):
         tangent(function, inactive=())
 
 

@@ -43,14 +43,12 @@ bitwise where it can).
 from __future__ import annotations
 
 import ast
-import builtins
 import math
 import types
 from dataclasses import dataclass, field
 from typing import Callable, Union
 
 from .. import kernel_language
-from ..unrolling import UnrollError, kernel_definition, kernel_global, kernel_statements
 
 DOUBLE, INT = "double", "int"
 Type = Union[str, tuple]
@@ -153,7 +151,7 @@ class Translation:
             raise TranslationError(f"{function!r} is not a Python function: only {SUPPORTED_CALLS} are translated")
         key = (function, argument_types)
         if key not in self.functions:
-            same_name = sum(f.python is function for f in self.functions.values())
+            same_name = sum(f.function is function for f in self.functions.values())
             name = f"{self.prefix}_{function.__module__.rsplit('.', 1)[-1]}_{function.__name__}".replace("__", "_")
             # Generated functions (tangents.py) of different origin can share a Python name.
             taken = {f.name for f in self.functions.values()}
@@ -185,37 +183,32 @@ class Translation:
         return "\n".join(lines)
 
 
-class _Function:
+class _Function(kernel_language.KernelFunction):
     """One function of the kernels translated for one tuple of argument types."""
+    error_type = TranslationError
+    verb = "translated"
+    facts = "types"
 
     def __init__(self, translation: Translation, python: types.FunctionType, argument_types: tuple, name: str):
+        super().__init__(python, argument_types)
         self.translation = translation
-        self.python = python
         self.argument_types = argument_types
         self.name = name
-        try:
-            self.tree, self.line_offset = kernel_definition(python)
-        except UnrollError as exc:
-            raise TranslationError(str(exc)) from None
-        self.arguments = [a.arg for a in self.tree.args.args]
-        if len(self.arguments) != len(argument_types) or self.tree.args.vararg or self.tree.args.kwarg:
-            raise self.error(self.tree, f"called with {len(argument_types)} arguments")
-        self.locals: dict[str, Type] = dict(zip(self.arguments, argument_types))
         # C warns of variables set but never read: names never read are neither declared nor set
         self.read = live_reads(self.tree)
         self.loop_names = {n.target.id for n in ast.walk(self.tree)
                            if isinstance(n, ast.For) and isinstance(n.target, ast.Name)}
         self.check_loop_variables(self.tree, frozenset())
         self.truth_tests = self.truth_test_nodes()
-        self.return_type: Type | None = None
         self.temporaries = 0
         self.loops: list = []
 
-    # ------------------------------------------------------------------ errors
-    def error(self, node, message: str) -> TranslationError:
-        line = getattr(node, "lineno", 1) + self.line_offset
-        return TranslationError(f"{self.python.__module__}.{self.python.__name__}, line {line}: {message}")
+    @property
+    def return_type(self) -> Type | None:
+        """The C type of what the function returns."""
+        return self.result
 
+    # ------------------------------------------------------------------ errors
     def check_loop_variables(self, node, open_loops: frozenset):
         """Refuse a ``for`` variable read outside its loop's body (after the loop C leaves it at
         ``stop``, Python at ``stop - 1``), assigned other than by its ``for`` (C would change the
@@ -280,33 +273,13 @@ class _Function:
         if isinstance(self.type_of(e), tuple):
             raise self.error(e, f"a tuple as a truth value: {ast.unparse(e)}")
 
-    def math_module(self, node) -> bool:
-        """Whether ``node`` is the name ``math`` and means the math module."""
-        if not (isinstance(node, ast.Name) and node.id == "math" and node.id not in self.locals):
-            return False
-        if self.global_value("math", node) is not math:
-            raise self.error(node, "the name math is not the math module here")
-        return True
-
     # ------------------------------------------------------------------ types
     def translate(self):
         """Infer the locals' and the return type (the statements until nothing changes), then
         write the C."""
-        for _ in range(20):
-            before = (dict(self.locals), self.return_type)
-            self.infer_block(self.body)
-            if (dict(self.locals), self.return_type) == before:
-                break
-        else:
-            raise self.error(self.tree, "the types of its variables do not settle")
-        if self.return_type is None:
-            raise self.error(self.tree, "returns nothing")
+        self.settle(self.infer_block, 20)
         self.translation.c_type(self.return_type)
         self.code = self.emit_block(self.body, 1)
-
-    @property
-    def body(self):
-        return kernel_statements(self.tree)
 
     def assign_type(self, target, t: Type, node):
         if isinstance(target, ast.Name):
@@ -343,7 +316,7 @@ class _Function:
                 raise self.error(s, "a bare return")
             t = self.type_of(s.value)
             try:
-                self.return_type = t if self.return_type is None else merge(self.return_type, t)
+                self.result = t if self.result is None else merge(self.result, t)
             except TypeError as exc:
                 raise self.error(s, f"returns {exc}") from None
         elif isinstance(s, ast.If):
@@ -378,12 +351,6 @@ class _Function:
             if self.type_of(argument) != INT:
                 raise self.error(s, "range() takes ints")
         return call.args if len(call.args) == 2 else [ast.Constant(0), call.args[0]]
-
-    def global_value(self, name: str, node):
-        try:
-            return kernel_global(self.python, name)
-        except NameError:
-            raise self.error(node, f"unknown name {name!r}") from None
 
     def type_of(self, e) -> Type:
         if isinstance(e, ast.Constant):
@@ -462,14 +429,8 @@ class _Function:
     def constant_index(self, e: ast.Subscript, t: Type) -> int:
         if not isinstance(t, tuple):
             raise self.error(e, f"indexing a {describe(t)}")
-        index = e.slice
-        if isinstance(index, ast.UnaryOp) and isinstance(index.op, ast.USub) and isinstance(index.operand, ast.Constant):
-            value = -index.operand.value
-        elif isinstance(index, ast.Constant):
-            value = index.value
-        else:
-            raise self.error(e, "only constant tuple indices")
-        if not isinstance(value, int) or not -len(t) <= value < len(t):
+        value = self.literal_index(e)
+        if not -len(t) <= value < len(t):
             raise self.error(e, f"index {value!r} of a tuple of {len(t)}")
         return value % len(t)
 
@@ -485,27 +446,6 @@ class _Function:
         if isinstance(value, float):
             return DOUBLE
         raise self.error(node, f"global {ast.unparse(node)} is a {type(value).__name__}, not a number")
-
-    def callee(self, e: ast.Call):
-        """('builtin', name) or ('kernel', function) of a call."""
-        if e.keywords:
-            raise self.error(e, "keyword arguments")
-        f = e.func
-        if isinstance(f, ast.Attribute) and self.math_module(f.value):
-            if f.attr in kernel_language.MATH:
-                return "math", f.attr
-            raise self.error(e, f"math.{f.attr} is not translated; only {SUPPORTED_CALLS}")
-        if isinstance(f, ast.Name) and f.id not in self.locals:
-            value = self.global_value(f.id, e)
-            if f.id in kernel_language.BUILTINS and value is getattr(builtins, f.id):
-                return "builtin", f.id
-            if any(value is member for member in vars(math).values()):
-                raise self.error(e, f"{f.id} is math.{getattr(value, '__name__', f.id)} imported by name; write "
-                                    f"math.{getattr(value, '__name__', f.id)} (import math)")
-            if isinstance(getattr(value, "py_func", value), types.FunctionType):
-                return "kernel", value
-            raise self.error(e, f"call of {f.id} ({type(value).__name__}); only {SUPPORTED_CALLS}")
-        raise self.error(e, f"call of {ast.unparse(f)}; only {SUPPORTED_CALLS}")
 
     def call_type(self, e: ast.Call) -> Type:
         kind, what = self.callee(e)
@@ -540,7 +480,7 @@ class _Function:
         declarations = [f"    {t.c_type(v)} {self.c_name(name)};" for name, v in self.locals.items()
                         if name not in self.arguments and (name in self.read or name in self.loop_names)]
         declarations += [f"    (void){self.c_name(name)};" for name in self.arguments if name not in self.read]
-        origin = f"/* {self.python.__module__}.{self.python.__name__}{self.signature_comment()} */"
+        origin = f"/* {self.function.__module__}.{self.function.__name__}{self.signature_comment()} */"
         return "\n".join([origin, self.prototype() + " {", *declarations, *self.code, "}", ""])
 
     def signature_comment(self) -> str:
@@ -715,7 +655,7 @@ class _Function:
     def global_constant(self, e: ast.Name) -> str:
         value = self.global_value(e.id, e)
         t = self.constant_type(value, e)
-        module = self.python.__module__.rsplit(".", 1)[-1]
+        module = self.function.__module__.rsplit(".", 1)[-1]
         key = (module, e.id)
         constants = self.translation.constants
         if key not in constants:
