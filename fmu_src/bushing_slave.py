@@ -63,7 +63,6 @@ np = importlib.import_module("numpy") if STEP_AXES else None
 
 
 # Jumping inputs (integration.JUMP_*, which say why; logging only, the force is the same)
-JUMP_RELATIVE, JUMP_FLOOR = integration.JUMP_RELATIVE, integration.JUMP_FLOOR
 JUMP_WINDOW, JUMP_COUNT = integration.JUMP_WINDOW, integration.JUMP_COUNT
 _JUMP_MASK = (1 << JUMP_WINDOW) - 1
 
@@ -414,8 +413,8 @@ class BushingSlave(Fmi2Slave):
         for a, state, x_end, output, jumps_counted in steps:
             if abs(output) > a.output_bound and not a.output_warned:
                 self._warn_implausible(a, output, current_time + step_size)
-            if not (jumps_counted or self._jump_warned):   # inline: it runs on every axis and step
-                jumped = abs(a.x_now - a.state_x) > JUMP_RELATIVE * (abs(a.v * a.to_kernel) * step_size) + JUMP_FLOOR
+            if not (jumps_counted or self._jump_warned):
+                jumped = integration.displacement_jumped(a.x_now, a.state_x, a.v * a.to_kernel, step_size)
                 a.jump_history = ((a.jump_history << 1) | jumped) & _JUMP_MASK
                 if jumped and a.jump_history.bit_count() > JUMP_COUNT:
                     self._warn_jumping(a, current_time, step_size, a.jump_history)

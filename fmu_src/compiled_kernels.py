@@ -244,7 +244,7 @@ def _step_axes(params, rows, h, max_substeps, histories, next_histories):
     for i in range(count):
         m = prepare(_VALUES(params[i]))
         x, v, state_x = rows[i, 0], rows[i, 1], rows[i, 2]
-        jumped = abs(x - state_x) > _JUMP_RELATIVE * (abs(v) * h) + _JUMP_FLOOR
+        jumped = _displacement_jumped(x, state_x, v, h)
         bits = ((histories[i] << 1) | (1 if jumped else 0)) & ((np.int64(1) << _JUMP_WINDOW) - 1)
         next_histories[i] = bits
         if jumped and crossed < 0:
@@ -285,7 +285,7 @@ def _fmu_appendix(model) -> str:
     size = len(model.states)
     stores = "".join(f"    out[i, {j}] = state[{j}]\n" for j in range(size)) or "    pass\n"
     return ("\n\nimport math\nimport numpy as np\nfrom " + integration_module()
-            + " import OK as _OK, JUMP_RELATIVE as _JUMP_RELATIVE, JUMP_FLOOR as _JUMP_FLOOR, "
+            + " import OK as _OK, displacement_jumped as _displacement_jumped, "
             "JUMP_WINDOW as _JUMP_WINDOW, JUMP_COUNT as _JUMP_COUNT\n\n"
             + row_tuple("_VALUES", len(model.specs)) + row_tuple("_STATE", size)
             + "@numba.njit(cache=True)\ndef _STORE(out, i, state):\n" + stores + "\n\n"

@@ -71,8 +71,17 @@ more than JUMP_COUNT jumping steps among an axis's last JUMP_WINDOW (<= 62: the 
 bits of one integer) is a v that is not the derivative of the sampled x (a measured velocity fed
 beside a measured displacement). A smooth x(t_k) with v = dx/dt(t_k) jumps by x''*h^2/2 only:
 near reversals, at most 9 of 50 steps of a 10 Hz sine at 1 ms (24 at 30 Hz), none with v the
-secant. The pythonfmu slave, the compiled batched step (compiled_kernels._step_axes) and the
-native C (BW_JUMP_*, generated from these) apply the same test."""
+secant. The test is :func:`displacement_jumped`, one kernel that the pythonfmu slave calls, the
+compiled batched step (``compiled_kernels._step_axes``) calls compiled, and the native C calls
+translated (``BW_DISPLACEMENT_JUMPED``); the window's count (BW_JUMP_WINDOW, BW_JUMP_COUNT in C)
+is each host's bookkeeping."""
+
+
+def displacement_jumped(x, state_x, v, h):
+    """Whether a step that sets the displacement x [mm or rad] where the state is at state_x starts
+    with a jump: |x - state_x| > JUMP_RELATIVE*|v|*h + JUMP_FLOOR, v [mm/s or rad/s] the step's
+    velocity and h [s] its size (the constants' docstring says why)."""
+    return abs(x - state_x) > JUMP_RELATIVE * (abs(v) * h) + JUMP_FLOOR
 
 
 class StepError(ArithmeticError):

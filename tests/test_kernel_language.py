@@ -264,3 +264,27 @@ def test_the_model_authors_guide_names_every_call():
     paragraph = guide[guide.index("What the translator takes"):guide.index("It refuses, with a `TranslationError`")]
     missing = [call.written for call in kernel_language.CALLS if f"`{call.written}`" not in paragraph]
     assert not missing, f"docs/adding_a_model.md does not name {missing}"
+
+
+def call_abs(a):
+    return abs(a)
+
+
+def test_the_jump_test_is_one_kernel_in_python_numba_and_c(tmp_path):
+    # integration.displacement_jumped: the pythonfmu slave calls it, the compiled batched step
+    # calls it compiled, the native C calls it translated; at and around its threshold all agree
+    from fmu_src import integration
+    cases = []
+    for v, h in ((250.0, 1e-3), (0.0, 1e-3), (-80.0, 5e-4)):
+        threshold = integration.JUMP_RELATIVE * (abs(v) * h) + integration.JUMP_FLOOR
+        for mismatch in (threshold, math.nextafter(threshold, math.inf), math.nextafter(threshold, 0.0), 0.0):
+            cases.append((1.0 + mismatch, 1.0, v, h))
+            cases.append((-mismatch, 0.0, v, h))
+    # (a double-valued case too: the driver's printer of doubles must be used)
+    c = run_in_c([(integration.displacement_jumped, cases), (call_abs, [(-2.5,)])], tmp_path)
+    compiled = numba.njit(integration.displacement_jumped)
+    for index, arguments in enumerate(cases):
+        python = integration.displacement_jumped(*arguments)
+        assert bool(compiled(*arguments)) is python
+        lines, _ = c[("displacement_jumped", index)]
+        assert lines == python_lines(int(python), "int"), arguments

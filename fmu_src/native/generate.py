@@ -369,6 +369,7 @@ def model_source(axis_models, identifier: str, groups=()) -> GeneratedModel:
         if model.name not in models:
             models[model.name] = ModelCode(translation, model, model.name in coupled)
     variables = all_variables(axis_models, groups)
+    jump_test = translation.function(integration.displacement_jumped, (DOUBLE, DOUBLE, DOUBLE, DOUBLE))
     kernels = translation.source()
 
     parts = [kernels, "\ntypedef union {"]
@@ -438,8 +439,7 @@ def model_source(axis_models, identifier: str, groups=()) -> GeneratedModel:
         f"#define BW_KERNEL_TOO_MANY_SUBSTEPS {integration.TOO_MANY_SUBSTEPS}\n"
         f"#define BW_KERNEL_NOT_FINITE {integration.NOT_FINITE}\n"
         f"#define BW_MAX_SUBSTEPS {integration.DEFAULT_MAX_SUBSTEPS}\n"
-        f"#define BW_JUMP_RELATIVE {integration.JUMP_RELATIVE!r}\n"
-        f"#define BW_JUMP_FLOOR {integration.JUMP_FLOOR!r}\n"
+        f"#define BW_DISPLACEMENT_JUMPED {jump_test.name}\n"
         f"#define BW_JUMP_WINDOW {integration.JUMP_WINDOW}\n"
         f"#define BW_JUMP_COUNT {integration.JUMP_COUNT}\n"
         f"#define BW_ROUNDING_JUMP {integration.ROUNDING_JUMP_MM!r}\n\n")

@@ -609,15 +609,15 @@ static bw_status bw_refuse(bw_instance *inst, const char *format, ...) {
     return BW_DISCARD;
 }
 
-/* Record whether axis a's step starts with a displacement jump (BW_JUMP_*, generated from
-   integration.JUMP_*, which say why; before the step is committed) and warn, once per instance,
-   when more than BW_JUMP_COUNT of its last BW_JUMP_WINDOW steps do (as bushing_slave.py does). */
+/* Record whether axis a's step starts with a displacement jump (BW_DISPLACEMENT_JUMPED: the test
+   integration.displacement_jumped, translated; before the step is committed) and warn, once per
+   instance, when more than BW_JUMP_COUNT of its last BW_JUMP_WINDOW steps do (as bushing_slave.py does). */
 static void bw_count_jump(bw_instance *inst, int a, double current_time, double h) {
     const bw_axis_spec *spec = &bw_axis_specs[a];
     const bw_axis *axis = &inst->data.axes[a];
     double mismatch = fabs(axis->x_now - axis->state_x);
     double travel = fabs(axis->v * spec->to_kernel) * h;
-    int jumped = mismatch > BW_JUMP_RELATIVE * travel + BW_JUMP_FLOOR;
+    int jumped = BW_DISPLACEMENT_JUMPED(axis->x_now, axis->state_x, axis->v * spec->to_kernel, h);
     unsigned long long bits;
     int count = 0;
     inst->jump_history[a] = ((inst->jump_history[a] << 1) | (unsigned long long)jumped)
