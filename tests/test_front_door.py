@@ -195,3 +195,11 @@ def test_the_package_docstrings_module_map_names_every_module():
     modules = [m.name for m in pkgutil.iter_modules(identification.__path__) if m.name != "__main__"]
     missing = [name for name in modules if f"``{name}``" not in identification.__doc__]
     assert not missing, f"identification/__init__.py's module map does not name {missing}"
+
+
+def test_the_docs_layout_names_every_module_of_fmu_src():
+    from conftest import REPO
+    layout = (REPO / "docs" / "index.md").read_text()
+    modules = sorted(p.name for p in [*(REPO / "fmu_src").glob("*.py"), *(REPO / "fmu_src" / "native").glob("*.py")])
+    missing = [name for name in modules if f"`{name}`" not in layout]
+    assert not missing, f"docs/index.md's Layout does not name {missing}"
