@@ -34,8 +34,7 @@ The modules, in the order of the workflow:
 - the forward model: ``simulate`` (the front door), ``parameter_input`` (what counts as
   parameters), ``forward_model`` (the input between samples), ``compiled_core`` and
   ``steady_state`` (the models' kernels, compiled per model), ``refinement`` (finer steps where
-  needed), ``fit_jacobian`` (the forces' sensitivities to the parameters, computed with them) and
-  ``vector_tangents`` (the tangents of every parameter direction at once, for it);
+  needed) and ``fit_jacobian`` (the forces' sensitivities to the parameters, computed with them);
 - fitting: ``fitting`` (``fit``), ``fit_result`` (what it returns), ``presets``, ``search_space``
   (the box), ``loop_start`` (starts from a slow loop), ``objectives`` (the misfit), ``multistart``
   (screening and least-squares stages),

@@ -12,7 +12,7 @@ K directions: forward-mode sensitivities propagated through the model's own kern
 with p, m, ms and the state active and the input (x, v, h) constant. No derivative is typed here:
 ``fmu_src.tangents`` generates each kernel's tangent from its source (the kernels' own
 statements, so the forces are bit for bit those of ``compiled_core``'s population loop: tested),
-``identification.vector_tangents`` makes them carry the K directions at once (the value, the
+``tangents.Generator(lanes=K)`` makes them carry the K directions at once (the value, the
 expensive part of a step, is computed once), and this module binds them to the population loop
 that the forces run too (``compiled_core._population_loop``) in a generated module that numba
 compiles and caches on disk like the plain kernels
@@ -40,7 +40,6 @@ import numpy as np
 from fmu_src import compiled_kernels as _kernels, integration, tangents
 from fmu_src.bushing_models import BushingModel, DEFAULT_MODEL, resolve_model
 from fmu_src.jit import numba
-from identification.vector_tangents import vectorize
 from identification.compiled_core import (_input_arrays, _population_loop, _step_sizes, output_points,
                                           parameter_matrix)
 
@@ -98,9 +97,9 @@ def _appendix(model: BushingModel, lanes: int, machinery: str) -> str:
     """The vector tangents of ``model``'s kernels for ``lanes`` directions, their helpers and the
     population loop (``compiled_core._population_loop``) carrying the derivatives, as source for
     its generated module."""
-    generator = tangents.Generator()
+    generator = tangents.Generator(lanes)
     loop_names = _tangent_names(model, generator)
-    source = vectorize("\n\n".join(generator.sources.values()), lanes)
+    source = generator.lane_source()
     helpers = "\n\n".join(inspect.getsource(helper) for helper in tangents.HELPERS.values())
     functions = [*generator.sources, *tangents.HELPERS]
     stores = "".join(f"    out[i, j, {k}] = d[{k}]\n" for k in range(lanes))
@@ -155,9 +154,9 @@ def python_sensitivities(model: str | BushingModel, lanes: int) -> Callable:
     module holds, for tests that check every model without compiling each (interpreted, some 100
     times slower; plain Python raises where numba gives inf or NaN)."""
     bushing = resolve_model(model)
-    generator = tangents.Generator()
+    generator = tangents.Generator(lanes)
     loop_names = _tangent_names(bushing, generator)
-    source = vectorize("\n\n".join(generator.sources.values()), lanes)
+    source = generator.lane_source()
     namespace: dict = {}
     # integration's globals under the model's own (_machinery_imports refuses a name both have)
     for function in (integration.block_gain, bushing.prepare):

@@ -1,4 +1,4 @@
-"""The fit's exact Jacobian (identification/fit_jacobian.py, identification/vector_tangents.py): the
+"""The fit's exact Jacobian (identification/fit_jacobian.py, fmu_src/vector_tangents.py): the
 forces computed with their sensitivities are the plain forces bit for bit, every lane of the vector
 tangents is the one-direction tangent of the kernels, the sensitivities and the residuals'
 Jacobian equal central differences of the plain forward model, the search space's derivatives
@@ -16,7 +16,7 @@ import build_fmu
 from fmu_src import tangents
 from fmu_src.bushing_models import MODELS, get_model
 from fmu_src.parameter_files import load_parameters
-from identification.vector_tangents import vectorize
+from fmu_src.vector_tangents import vectorize
 from identification.compiled_core import _step_sizes, simulate_population_at
 from identification.errors import IdentificationError
 from identification.fit_jacobian import _tangent_names, population_sensitivities, python_sensitivities

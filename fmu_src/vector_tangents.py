@@ -1,4 +1,8 @@
-"""Vector-mode tangents: the generated tangents (``fmu_src.tangents``) rewritten to carry K directions at once.
+"""Vector-mode tangents: the generated tangents (``tangents``) rewritten to carry K directions at once.
+
+Reached through the generator: ``tangents.Generator(lanes=K).lane_source()``. The rewrite reads
+the generator's one-direction source, recognising tangents by the names the generator reserves
+for them (``d_...``, ``_td...``: a kernel that uses such a name is refused there).
 
 A tangent that ``fmu_src.tangents.Generator`` writes computes the kernel's value and one directional
 derivative. The fit needs the derivatives of the forces in every direction of its search space
