@@ -119,6 +119,7 @@ print(repr(float(forces[0, -1])), len(stats.cache_hits), len(stats.cache_misses)
 """
 
 
+@pytest.mark.slow   # in CI's slow phase: it keeps the README's test command near 5 minutes
 def test_a_changed_model_source_compiles_afresh_instead_of_loading_stale_machine_code(tmp_path):
     # numba checks only the time stamp of a kernel's own file, and the generated files are
     # rewritten: the cache must follow the model's source. A copy of the packages whose

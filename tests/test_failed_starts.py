@@ -133,6 +133,7 @@ def fit_command(tmp_path, *options, seed=8):
     return code, out
 
 
+@pytest.mark.slow   # in CI's slow phase: it keeps the README's test command near 5 minutes
 def test_the_starved_fit_of_the_issue_ends_with_its_file_and_a_warning(tmp_path, capsys):
     # seed 8 ended in a traceback from the ensemble's profiles (2026-11-26, this machine): its only
     # start died on a sensitivity of 2e303; on any processor, a file and a warning or convergence

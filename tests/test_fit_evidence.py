@@ -138,6 +138,7 @@ def test_the_same_seed_gives_the_same_file_on_one_worker_two_workers_and_a_dask_
     assert json.loads(files[0])["fit"]["steps_per_sample"][0] == (2 if refined else 1)
 
 
+@pytest.mark.slow   # in CI's slow phase: it keeps the README's test command near 5 minutes
 def test_an_unreachable_scheduler_is_a_clear_error_not_a_hang(tmp_path, capsys):
     import time
     manifest = write_tests(tmp_path / "bushing", short_tests(paper_parameters("table5")))
