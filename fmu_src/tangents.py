@@ -346,12 +346,8 @@ class _Spec(kernel_language.KernelFunction):
             hoisted, replaced = self.hoist(s.value)
             tangent = self.coerce(self.tangent(s.value, replaced), self.activity(s.value), self.return_activity)
             return hoisted + [ast.Return(ast.Tuple([self.primal(s.value, replaced), tangent], ast.Load()))]
-        if isinstance(s, ast.If):
-            return [ast.If(s.test, self.block(s.body) or [ast.Pass()], self.block(s.orelse))]
-        if isinstance(s, ast.While):
-            return [ast.While(s.test, self.block(s.body) or [ast.Pass()], self.block(s.orelse))]
-        if isinstance(s, ast.For):
-            return [ast.For(s.target, s.iter, self.block(s.body) or [ast.Pass()], self.block(s.orelse), None)]
+        if isinstance(s, (ast.If, ast.While, ast.For)):
+            return [with_bodies(s, self.block)]
         if isinstance(s, ast.Expr) and isinstance(s.value, ast.Constant):
             return []
         return [s]
@@ -538,6 +534,18 @@ class _Spec(kernel_language.KernelFunction):
             out = _add(out, _mul(ast.Call(ast.Name("tangent_pow_log", ast.Load()), [_copy(base), _copy(exponent)], []),
                                  tb))
         return out
+
+
+def with_bodies(s, block):
+    """The ``if``, ``while`` or ``for`` statement ``s`` with its test or loop kept and its bodies
+    rewritten by ``block`` (an empty body a ``pass``): how the tangent generator and its lanes
+    rewrite (``vector_tangents``) keep the kernel's control flow."""
+    body, orelse = block(s.body) or [ast.Pass()], block(s.orelse)
+    if isinstance(s, ast.If):
+        return ast.If(s.test, body, orelse)
+    if isinstance(s, ast.While):
+        return ast.While(s.test, body, orelse)
+    return ast.For(s.target, s.iter, body, orelse, None)
 
 
 def _compare(a, op, b):

@@ -45,6 +45,8 @@ import ast
 import copy
 import itertools
 
+from .tangents import with_bodies
+
 TANGENT_PREFIXES = ("d_", "_td")
 """The names the generated tangents hold their tangents in (``tangents`` reserves them)."""
 
@@ -232,12 +234,8 @@ class _Vectorizer:
             prelude = []
             tangent = self.vector(s.value.elts[1], prelude)
             return prelude + [ast.Return(ast.Tuple([s.value.elts[0], tangent], ast.Load()))]
-        if isinstance(s, ast.If):
-            return [ast.If(s.test, self.block(s.body) or [ast.Pass()], self.block(s.orelse))]
-        if isinstance(s, ast.While):
-            return [ast.While(s.test, self.block(s.body) or [ast.Pass()], self.block(s.orelse))]
-        if isinstance(s, ast.For):
-            return [ast.For(s.target, s.iter, self.block(s.body) or [ast.Pass()], self.block(s.orelse), None)]
+        if isinstance(s, (ast.If, ast.While, ast.For)):
+            return [with_bodies(s, self.block)]
         return [s]
 
 

@@ -266,10 +266,6 @@ def test_the_model_authors_guide_names_every_call():
     assert not missing, f"docs/adding_a_model.md does not name {missing}"
 
 
-def call_abs(a):
-    return abs(a)
-
-
 def test_the_jump_test_is_one_kernel_in_python_numba_and_c(tmp_path):
     # integration.displacement_jumped: the pythonfmu slave calls it, the compiled batched step
     # calls it compiled, the native C calls it translated; at and around its threshold all agree
