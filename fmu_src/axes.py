@@ -38,6 +38,7 @@ ROTATIONAL_UNITS = {
     "N/mm": "N.mm/rad", "N.s/mm": "N.mm.s/rad", "mm": "rad", "N": "N.mm", "1": "1",
     "N^(1-n)/mm": "(N.mm)^(1-n)/rad", "N^(1-n1)/mm": "(N.mm)^(1-n1)/rad", "N^(1-n2)/mm": "(N.mm)^(1-n2)/rad",
     "N/mm^3": "N.mm/rad^3", "N.s^alpha/mm": "N.mm.s^alpha/rad",
+    "N.s^2/mm": "N.mm.s^2/rad", "N.s^2/mm^2": "N.mm.s^2/rad^2",
 }
 """A translational parameter's unit -> the same parameter's unit on a rotational axis."""
 

@@ -146,6 +146,14 @@ UNIT_DEFINITIONS: dict[str, dict[str, str] | None] = {
     "(N.mm)^(1-n)/rad": None,
     "(N.mm)^(1-n1)/rad": None,
     "(N.mm)^(1-n2)/rad": None,
+    # the hydraulic mount (hydraulic_model): the fluid column's effective mass and turbulent
+    # damping, and the rate of its velocity state
+    "N.s^2/mm": {"kg": "1", "factor": "1000"},
+    "N.s^2/mm^2": {"kg": "1", "m": "-1", "factor": "1000000"},
+    "m/s/s": {"m": "1", "s": "-2"},
+    "N.mm.s^2/rad": {"kg": "1", "m": "2", "rad": "-1", "factor": "0.001"},
+    "N.mm.s^2/rad^2": {"kg": "1", "m": "2", "rad": "-2", "factor": "0.001"},
+    "rad/s/s": {"rad": "1", "s": "-2"},
 }
 
 

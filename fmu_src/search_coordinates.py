@@ -186,6 +186,50 @@ class PowerLaw(CoordinateKind):
         return math.log10(value / (scales.k_ref * scales.tau_ref ** params[c.exponent])) if value > 0 else -math.inf
 
 
+class Resonance(CoordinateKind):
+    """log10(f/1 Hz) of a mass [N.s^2/mm] as the resonance f = sqrt(k/mass)/(2*pi) it makes with
+    the stiffnesses ``c.over`` (k their sum): a hydraulic mount's inertia track by its tuning."""
+    name = "resonance"
+
+    def reads(self, c):
+        return tuple(c.over)
+
+    def to_parameter(self, c, u, values, scales):
+        return sum(values[name] for name in c.over) / (2.0 * math.pi * 10.0 ** u) ** 2
+
+    def to_coordinate(self, c, value, params, scales):
+        return math.log10(math.sqrt(sum(params[name] for name in c.over) / value) / (2.0 * math.pi))
+
+
+class DampingRatio(CoordinateKind):
+    """log10(zeta) of a dashpot as the damping ratio zeta = value/(2*sqrt(k*mass)) of the
+    oscillator it damps: the stiffnesses ``c.over`` (k their sum) and the mass ``c.partner``."""
+    name = "damping_ratio"
+
+    def reads(self, c):
+        return (*c.over, c.partner)
+
+    def to_parameter(self, c, u, values, scales):
+        return 2.0 * 10.0 ** u * (sum(values[name] for name in c.over) * values[c.partner]) ** 0.5
+
+    def to_coordinate(self, c, value, params, scales):
+        critical = 2.0 * math.sqrt(sum(params[name] for name in c.over) * params[c.partner])
+        return math.log10(value / critical) if value > 0 else -math.inf
+
+
+class QuadraticDamping(CoordinateKind):
+    """log10(value/(c_ref^2/(k_ref*x_ref))) of a damping whose force is value*|v|*v
+    [N.s^2/mm^2]: against the force c_ref*v_ref of the data's damping at its velocity scale
+    v_ref = x_ref/tau_ref."""
+    name = "quadratic_damping"
+
+    def to_parameter(self, c, u, values, scales):
+        return scales.c_ref ** 2 / (scales.k_ref * scales.x_ref) * 10.0 ** u
+
+    def to_coordinate(self, c, value, params, scales):
+        return _log_ratio(value, scales.c_ref ** 2 / (scales.k_ref * scales.x_ref))
+
+
 class _Kinds:
     """The kinds by name, as models name them: ``KIND.stiffness`` (an attribute per kind)."""
 
@@ -202,7 +246,8 @@ KIND = _Kinds(
     LogScaled("damping", "c_ref"),        # log10(value/c_ref)
     LogScaled("force", "F_ref"),          # log10(value/F_ref): a friction force limit
     LogScaled("travel", "x_ref"),         # log10(value/x_ref): a friction's travel, x_ref the largest amplitude
-    Gain(), Exponent(), Cubic(), TimeConstant(), Slower(), Shape(), ShapeSum(), PowerLaw())
+    Gain(), Exponent(), Cubic(), TimeConstant(), Slower(), Shape(), ShapeSum(), PowerLaw(), Resonance(), DampingRatio(),
+    QuadraticDamping())
 """Every kind of coordinate, by name: ``KIND.stiffness``, ``KIND.time_constant``, ..."""
 
 

@@ -4,7 +4,8 @@ definitions under test), in the paper's N-mm-s system.
 Springs k [N/mm] and dashpots c [N.s/mm] by F = k*x + c*v; the Bouc-Wen variable z is a force
 [N], so in dz/dt = A*dx/dt - beta*|dx/dt|*|z|^(n-1)*z - gamma*dx/dt*|z|^n the gain A is N/mm and
 beta, gamma are N^(1-n)/mm; n and the weights alpha (F = alpha*z + ...) are dimensionless;
-Spencer's x0 is a length [mm]; the Kelvin-Voigt preload is a force [N].
+Spencer's x0 is a length [mm]; the Kelvin-Voigt preload is a force [N]; the hydraulic mount's
+fluid column has a mass [N.s^2/mm] and a turbulent damping [N.s^2/mm^2] (in the mount's coordinates).
 """
 _BLOCK = {"A{}": "N/mm", "beta{}": "N^(1-n{})/mm", "gamma{}": "N^(1-n{})/mm", "n{}": "1", "alpha{}": "1"}
 
@@ -25,6 +26,13 @@ PARAMETER_UNITS = {
     "berg": {"k0": "N/mm", "k3": "N/mm^3", "Ff_max": "N", "x2": "mm", "k1": "N/mm", "c1": "N.s/mm", "k2": "N/mm",
              "c2": "N.s/mm"},
     "fractional": {"k0": "N/mm", "k3": "N/mm^3", "Ff_max": "N", "x2": "mm", "b": "N.s^alpha/mm", "alpha": "1"},
+    # F = k0*x + c0*dx/dt + f1 + kb*(x - y - u) and P = kb*(x - y) - kc*y are forces with x, y, u
+    # in mm: k0, kb, kc are N/mm, c0 (times mm/s) N.s/mm; df1/dt = k1*dx/dt - (k1/c1)*f1 makes k1
+    # N/mm and k1/c1 a rate [1/s], so c1 N.s/mm; mf*dw/dt = dp - cf*w - ct*|w|*w is a force with
+    # w in mm/s and dw/dt in mm/s^2: cf N.s/mm, mf N.s^2/mm, ct N.s^2/mm^2; u = gap*tanh(...) is a
+    # travel, so gap is mm
+    "hydraulic": {"k0": "N/mm", "c0": "N.s/mm", "k1": "N/mm", "c1": "N.s/mm", "kb": "N/mm", "kc": "N/mm",
+                  "mf": "N.s^2/mm", "cf": "N.s/mm", "ct": "N.s^2/mm^2", "gap": "mm"},
 }
 
 MOUNTING_UNITS = {"offset": "mm", "preload": "N"}

@@ -26,7 +26,22 @@ def fractional_rhs(p, s, x, v):
     return [v, 0.0, 0.0] + [k * v - r * f for k, r, f in zip(stiffness, rates, s[3:])]
 
 
+def hydraulic_rhs(p, s, x, v):
+    """The hydraulic mount, typed from its equations: P = kb*(x - y) - kc*y, the decoupler's
+    u = gap*tanh(P/((kb + kc)*gap)), dp = P - (kb + kc)*u; dy/dt = w,
+    mf*dw/dt = dp - cf*w - ct*|w|*w, df1/dt = k1*v - (k1/c1)*f1."""
+    y, w, f1 = s
+    pressure = p["kb"] * (x - y) - p["kc"] * y
+    u = p["gap"] * np.tanh(pressure / ((p["kb"] + p["kc"]) * p["gap"])) if p["gap"] > 0.0 else 0.0
+    drive = pressure - (p["kb"] + p["kc"]) * u
+    return [w, (drive - p["cf"] * w - p["ct"] * abs(w) * w) / p["mf"], p["k1"] * v - p["k1"] / p["c1"] * f1]
+
+
 FILLED_RUBBER = {"k0": 500.0, "k3": 10.0, "Ff_max": 60.0, "x2": 0.08}
+HYDRAULIC = {"k0": 200.0, "c0": 0.05, "k1": 40.0, "c1": 0.4, "kb": 250.0, "kc": 25.0, "mf": 0.07, "cf": 1.3,
+             "ct": 0.005, "gap": 0.1}
+"""data/params_hydraulic_mount.json's values: (kb + kc)*gap = 27.5 N, so the states drawn below put
+the chambers' pressure difference P both inside the decoupler's free travel and on its cage."""
 
 CASES = {
     # model: (parameters, independent right-hand side(p, state, x, v), state scale)
@@ -36,6 +51,7 @@ CASES = {
     "single_bouc_wen": (BOUC_WEN, bouc_wen_rhs, (500.0,)),
     "berg": (dict(FILLED_RUBBER, k1=150.0, c1=15.0, k2=250.0, c2=0.5), berg_rhs, (1.0, 50.0, 1.0, 100.0, 100.0)),
     "fractional": (dict(FILLED_RUBBER, b=70.0, alpha=0.22), fractional_rhs, (1.0, 50.0, 1.0) + (100.0,) * 20),
+    "hydraulic": (HYDRAULIC, hydraulic_rhs, (1.0, 100.0, 50.0)),
 }
 
 
@@ -75,6 +91,15 @@ def test_the_friction_models_switch_where_the_velocity_changes_sign_and_reverse_
         turned = bushing.update(constants, state, 0.4, -2.0)
         friction = params["Ff_max"] * 0.4 / (params["x2"] + 0.4)    # from rest, typed: Ff_max*x/(x2 + x)
         assert turned[:3] == (0.0, pytest.approx(friction, rel=1e-14), -1.0) and turned[3:] == state[3:]
+
+
+def test_the_hydraulic_model_has_no_switches():
+    # the decoupler's tanh and the turbulent |w|*w are smooth enough (C1): nothing for a host to locate
+    bushing = MODELS["hydraulic"]
+    constants = bushing.constants(HYDRAULIC)
+    assert bushing.switch_specs == () and bushing.update is None
+    for state, x, v in (((0.0, 0.0, 0.0), 0.0, 0.0), ((0.3, -120.0, 15.0), 0.8, -40.0), ((-2.0, 50.0, -5.0), 1.5, 9.0)):
+        assert bushing.switches(constants, state, x, v) == ()
 
 
 def test_kelvin_voigt_has_no_state_to_integrate():

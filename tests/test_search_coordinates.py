@@ -16,7 +16,7 @@ from identification.search_space import SearchSpace
 ROOT = Path(__file__).resolve().parents[1]
 SPACE = SearchSpace(1850.0, 2.7, 4400.0, 0.001, x_ref=2.0)
 # what the kinds that read other parameters read, at plausible values of a proposed-model set
-OTHERS = {"k1": 400.0, "k2": 50.0, "n": 0.8, "beta": 2e-3, "c1": 30.0}
+OTHERS = {"k1": 400.0, "k2": 50.0, "n": 0.8, "beta": 2e-3, "c1": 30.0, "mf": 0.07}
 COORDINATES = {
     "stiffness": SearchCoordinate("p", KIND.stiffness, -3.0, 1.0),
     "damping": SearchCoordinate("p", KIND.damping, -4.0, 2.0),
@@ -30,6 +30,9 @@ COORDINATES = {
     "shape": SearchCoordinate("p", KIND.shape, 0.0, 20.0, "n"),
     "shape_sum": SearchCoordinate("p", KIND.shape_sum, 0.0, 40.0, "n", partner="beta", sign=-1.0),
     "power_law": SearchCoordinate("p", KIND.power_law, -4.0, 3.0, exponent="n"),
+    "resonance": SearchCoordinate("p", KIND.resonance, -0.5, 2.5, over=("k1", "k2")),
+    "damping_ratio": SearchCoordinate("p", KIND.damping_ratio, -3.0, 0.5, over=("k1", "k2"), partner="mf"),
+    "quadratic_damping": SearchCoordinate("p", KIND.quadratic_damping, -6.0, 1.0),
 }
 
 
@@ -85,6 +88,17 @@ def test_every_model_reads_only_its_parameters_and_in_order(model):
             assert name in model.parameter_names, (c.parameter, name)
             assert name in seen or name not in coordinates, (c.parameter, name)
         seen.add(c.parameter)
+
+
+def test_the_resonance_and_damping_ratio_kinds_mean_what_they_say():
+    # a mass m with stiffness k = 450 N/mm: f = sqrt(k/m)/(2*pi) (typed), and the damping ratio
+    # of a dashpot c against them c/(2*sqrt(k*m))
+    values = {"k1": np.array([400.0]), "k2": np.array([50.0]), "mf": np.array([0.07])}
+    mass = KIND.resonance.to_parameter(COORDINATES["resonance"], np.array([1.0]), values, Scales)[0]
+    assert math.sqrt(450.0 / mass) / (2.0 * math.pi) == pytest.approx(10.0, rel=1e-14)
+    dashpot = KIND.damping_ratio.to_parameter(COORDINATES["damping_ratio"], np.array([math.log10(0.15)]), values,
+                                              Scales)[0]
+    assert dashpot / (2.0 * math.sqrt(450.0 * 0.07)) == pytest.approx(0.15, rel=1e-14)
 
 
 def test_a_cycle_of_reads_is_refused_with_the_coordinates_named():

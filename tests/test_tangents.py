@@ -4,8 +4,10 @@ differentiation of the plain kernel (central differences where the kernel cannot
 numbers), finite on the switches, refusals named, and the generated source translatable to C."""
 from __future__ import annotations
 
+import cmath
 import math
 import random
+import types
 
 import pytest
 
@@ -94,8 +96,72 @@ def shifted(value, direction, scale):
     return value + scale * direction
 
 
+def _analytic(name):
+    def function(a):
+        return Cs(getattr(cmath, name)(a)) if isinstance(a, complex) else getattr(math, name)(a)
+    return staticmethod(function)
+
+
+class ComplexMath:
+    """``math`` for complex step: the analytic functions by cmath on a complex argument, the
+    others (signs, tests, rounding) by its real part, as the kernels' branches read it."""
+
+    def __getattr__(self, name):
+        return getattr(math, name)
+
+    exp, log, sqrt, sin, cos = _analytic("exp"), _analytic("log"), _analytic("sqrt"), _analytic("sin"), _analytic("cos")
+
+    @staticmethod
+    def fabs(a):
+        return abs(a) if isinstance(a, complex) else math.fabs(a)
+
+    @staticmethod
+    def copysign(a, b):
+        magnitude = abs(a) if isinstance(a, complex) else math.fabs(a)
+        return magnitude if math.copysign(1.0, _real(b)) > 0.0 else -magnitude
+
+    @staticmethod
+    def pow(a, b):
+        return a ** b
+
+    @staticmethod
+    def isfinite(a):
+        return math.isfinite(_real(a))
+
+    @staticmethod
+    def isnan(a):
+        return math.isnan(_real(a))
+
+    @staticmethod
+    def isinf(a):
+        return math.isinf(_real(a))
+
+
+_COMPLEX_NAMESPACES: dict = {}
+
+
+def on_complex_numbers(function):
+    """``function`` with ``math`` read as :class:`ComplexMath` in it and in every function it
+    calls (each rebound to a copy of its module's globals), so that complex step runs through
+    math.exp and its kin."""
+    module = function.__module__
+    if module not in _COMPLEX_NAMESPACES:
+        namespace = dict(vars(__import__(module, fromlist=["_"])))
+        _COMPLEX_NAMESPACES[module] = namespace
+        namespace["math"] = ComplexMath()
+        for name, value in list(namespace.items()):
+            if isinstance(value, types.FunctionType):
+                namespace[name] = on_complex_numbers(value)
+    namespace = _COMPLEX_NAMESPACES[module]
+    own = namespace.get(function.__name__)
+    if isinstance(own, types.FunctionType) and own.__code__ is function.__code__ and own.__globals__ is namespace:
+        return own
+    return types.FunctionType(function.__code__, namespace, function.__name__, function.__defaults__)
+
+
 def complex_step(kernel, m, state, x, v, d_state, d_x, d_v):
     """The directional derivative by complex step, or None if the kernel cannot run on complex numbers."""
+    kernel = on_complex_numbers(kernel)
     try:
         out = kernel(m, tuple(Cs(complex(s, STEP * d)) for s, d in zip(state, d_state)),
                      Cs(complex(x, STEP * d_x)), Cs(complex(v, STEP * d_v)))

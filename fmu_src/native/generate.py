@@ -39,6 +39,8 @@ NOMINAL_DISPLACEMENT = {"m": 1e-3, "rad": 1e-2}
 that a host's error control sees them at their size in m or rad."""
 NOMINAL_FORCE = {"N": 1000.0, "N.m": 1.0}
 """Nominal values of hysteretic-force states: a kilonewton (a newton metre on rotational axes)."""
+NOMINAL_VELOCITY = {"m/s": 0.1, "rad/s": 1.0}
+"""Nominal values of velocity states (a hydraulic mount's fluid column: 100 mm/s, 1 rad/s)."""
 
 
 def c_string(text: str) -> str:
@@ -346,7 +348,7 @@ def nominal(variable: FmuVariable) -> float:
     """A state's nominal value (1.0 for the other variables and for dimensionless states)."""
     if variable.kind != "state" or variable.unit == "1":
         return 1.0
-    return NOMINAL_DISPLACEMENT.get(variable.unit) or NOMINAL_FORCE[variable.unit]
+    return {**NOMINAL_DISPLACEMENT, **NOMINAL_VELOCITY, **NOMINAL_FORCE}[variable.unit]
 
 
 @dataclass(frozen=True)

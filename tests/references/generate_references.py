@@ -1,16 +1,18 @@
 """Reference results of the one-axis bushing models on the paper's Table 5 tests.
 
-    python tests/references/generate_references.py [--check-convergence]
+    python tests/references/generate_references.py [--check-convergence] [--model NAME]
 
 Writes, next to this file, ``<model>_sine_2mm_10Hz.csv`` and ``<model>_step_2mm_rise0.4s.csv``
 (columns time_s, displacement_mm, force_N; 1 ms samples) and ``<model>.png`` (hysteresis loop
 and step response) for the proposed model (the paper's Table 5), Spencer's, the single Bouc-Wen
-and Kelvin-Voigt (the project's fitted sets), and the filled-rubber models Berg and fractional
-(illustrative sets typed in data/). Running it again rewrites the same bytes on the same
-numpy/scipy/matplotlib.
+and Kelvin-Voigt (the project's fitted sets), the filled-rubber models Berg and fractional
+(illustrative sets typed in data/), and the hydraulic mount (rubber path, inertia track,
+decoupler; an illustrative set typed in data/). Running it again rewrites the same bytes on the
+same numpy/scipy/matplotlib.
 
-Independent of the code under test: the equations are typed here from the paper (eqs. 1-5) and
-Spencer et al. (1997) as the model modules' docstrings state them, the parameter files are read
+Independent of the code under test: the equations are typed here from the paper (eqs. 1-5),
+Spencer et al. (1997) and the hydraulic mount's lumped-parameter equations (Flower 1985; Singh,
+Kim and Ravindra 1992) as the model modules' docstrings state them, the parameter files are read
 as plain JSON, and scipy's Radau integrates the continuous-time inputs (no sampling, no
 interpolation, no communication steps). The filled-rubber models are typed in
 ``filled_rubber.py`` beside this file and solved exactly on a path of straight pieces, 10 us long
@@ -26,7 +28,8 @@ the step's velocity jumps from 5 mm/s to 0; the sample there is the right limit 
 
 ``--check-convergence`` solves every ODE case again with 10x tighter tolerances (the filled-rubber
 sines on 10x shorter pieces) and prints the largest difference relative to the peak |F| (the
-README quotes it); the files are not rewritten.
+README quotes it); the files are not rewritten. ``--model NAME`` restricts either to one model
+(the other models' files are left as they are).
 
 Units: time s, displacement mm, velocity mm/s, force N, parameters in the paper's N-mm-s.
 """
@@ -55,6 +58,7 @@ STEP = {"name": "step_2mm_rise0.4s", "amplitude_mm": 2.0, "rise_time_s": 0.4, "d
 RTOL = 1e-10
 ATOL_MM = 1e-12      # on the states in mm (y, w)
 ATOL_N = 1e-9        # on the hysteretic forces in N (z, up to ~1e3 N): the same 1e-12 relative to their scale
+ATOL_MM_S = 1e-10    # on velocities in mm/s (the hydraulic mount's fluid column w, up to ~1e2 mm/s): the same 1e-12
 MAX_STEP_S = 1e-3    # 1/100 of the sine's period
 TIGHTER = 10.0       # the convergence check divides rtol and atol by this
 
@@ -74,6 +78,9 @@ MODELS = {
     "fractional": ("params_fractional_filled_rubber.json",
                    "spring k0*x + k3*x^3, Berg's friction, b*D^alpha x (the exact fractional derivative); an "
                    "illustrative filled rubber"),
+    "hydraulic": ("params_hydraulic_mount.json",
+                  "hydraulic mount: rubber k0, c0 and a Maxwell element in parallel with bulge kb, inertia track "
+                  "mf, cf, ct, bellows kc and a tanh decoupler of travel gap; an illustrative engine mount"),
 }
 PATH_MODELS = ("berg", "fractional")
 """Solved on a fine straight-piece path (filled_rubber.py), not by an ODE solver."""
@@ -163,10 +170,44 @@ def single_bouc_wen_start(p, x0):
     return [0.0]
 
 
+def hydraulic_track(p, x, y):
+    """(kb*(x - y - u), dp) of the hydraulic mount: the fluid path's force on the mount [N] and
+    the pressure difference that drives the inertia track [N], with the chambers' pressure
+    difference (decoupler closed) P = kb*(x - y) - kc*y and the decoupler's travel
+    u = gap*tanh(P/((kb + kc)*gap)), u = 0 where gap = 0."""
+    kb, kc, gap = p["kb"], p["kc"], p["gap"]
+    pressure = kb * (x - y) - kc * y
+    u = gap * np.tanh(pressure / ((kb + kc) * gap)) if gap > 0.0 else 0.0 * pressure
+    return kb * (x - y - u), pressure - (kb + kc) * u
+
+
+def hydraulic_rhs(t, state, p, signal):
+    """d/dt (y, w, f1) of the hydraulic mount: dy/dt = w, mf*dw/dt = dp - cf*w - ct*|w|*w (the
+    fluid column in the inertia track), df1/dt = k1*dx/dt - (k1/c1)*f1 (the rubber's Maxwell element)."""
+    y, w, f1 = state
+    x, xd = signal(t)
+    _, drive = hydraulic_track(p, x, y)
+    return [w, (drive - p["cf"] * w - p["ct"] * abs(w) * w) / p["mf"], p["k1"] * xd - p["k1"] / p["c1"] * f1]
+
+
+def hydraulic_force(p, states, x, xd):
+    """F = k0*x + c0*dx/dt + f1 + kb*(x - y - u)."""
+    y, _, f1 = states
+    bulge, _ = hydraulic_track(p, x, y)
+    return p["k0"] * x + p["c0"] * xd + f1 + bulge
+
+
+def hydraulic_start(p, x0):
+    """Relaxed at x0: the chambers' pressures equal (P = 0: y = kb*x0/(kb + kc), u = 0), the
+    fluid still, the Maxwell element relaxed."""
+    return [p["kb"] * x0 / (p["kb"] + p["kc"]), 0.0, 0.0]
+
+
 EQUATIONS = {
     "proposed": (proposed_rhs, proposed_force, proposed_start, [ATOL_MM, ATOL_N, ATOL_MM, ATOL_N]),
     "spencer": (spencer_rhs, spencer_force, spencer_start, [ATOL_MM, ATOL_N]),
     "single_bouc_wen": (single_bouc_wen_rhs, single_bouc_wen_force, single_bouc_wen_start, [ATOL_N]),
+    "hydraulic": (hydraulic_rhs, hydraulic_force, hydraulic_start, [ATOL_MM, ATOL_MM_S, ATOL_N]),
 }
 
 
@@ -237,7 +278,8 @@ def header(model: str, test: dict) -> str:
         solver = (f"exact on straight pieces (tests/references/filled_rubber.py: Berg's friction, lsim, the L1 sum), "
                   f"pieces of {'1 ms' if test is STEP else f'{FINE_SINE_S:g} s'}, from rest at x(0)")
     else:
-        solver = (f"scipy {scipy.__version__} solve_ivp Radau, rtol = {RTOL:g}, atol = {ATOL_MM:g} mm "
+        velocity = f" / {ATOL_MM_S:g} mm/s" if ATOL_MM_S in EQUATIONS[model][3] else ""
+        solver = (f"scipy {scipy.__version__} solve_ivp Radau, rtol = {RTOL:g}, atol = {ATOL_MM:g} mm{velocity} "
                   f"/ {ATOL_N:g} N, max_step = {MAX_STEP_S:g} s, from relaxed equilibrium at x(0)")
     return (f"# model: {model} ({MODELS[model][1]}); parameters: data/{MODELS[model][0]}; signal: {signal}, "
             f"sampled every 1 ms; solver: {solver}; generator: tests/references/generate_references.py")
@@ -286,8 +328,10 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--check-convergence", action="store_true",
                         help="solve again with 10x tighter tolerances and print the differences; write nothing")
+    parser.add_argument("--model", choices=list(MODELS), metavar="NAME",
+                        help=f"only this model ({', '.join(MODELS)}); the other models' files are left as they are")
     args = parser.parse_args(argv)
-    for model in MODELS:
+    for model in ([args.model] if args.model else MODELS):
         p = read_parameters(model)
         results = {}
         for test in (SINE, STEP):
