@@ -2,6 +2,7 @@
 the default set's data sheet drawn for the docs.
 
     python benchmarks/bench_hydraulic_mount.py [--figure docs/img/hydraulic_data_sheet.png]
+                                              [--recovery] [--speed] [--workers N]
 
 1. Closed form (issue 43's target: ``characterise`` within 1e-4 in |K*| and 0.01 deg of K*(omega)
    over 0.5-100 Hz): the default set without its decoupler and turbulent term (gap = 0, ct = 0),
@@ -9,6 +10,16 @@ the default set's data sheet drawn for the docs.
    ``tests/references/hydraulic_closed_form.py`` (numpy only). Prints the largest differences.
 2. The default set's data sheet over 0.05-2 mm x 1-50 Hz: printed (|K*| [N/mm] and loss angle
    [deg] per amplitude) and drawn, with the closed form beside it.
+3. ``--recovery`` (issue 43's target: the recommended model predicts the unseen amplitudes within
+   5 % in |K*| and 3 deg): ``compare --kdyn`` every model on data/generate_hydraulic.py's synthetic
+   training sheet (0.1, 0.5, 2 mm x 1-50 Hz, 1 % and 0.2 deg noise) with its 1 mm / 8 Hz sine (3 N
+   noise), then each fitted model's sheet at the unseen 0.3 and 1 mm against the truth's
+   (``kdyn_synthetic_hydraulic_unseen.csv``): the largest |K*| and loss-angle errors per model.
+   Also the hydraulic fit alone from the table alone and from the table with the sine, timed
+   (target: <= 2 min on 2 cores).
+4. ``--speed`` (target: the native step <= 1 us): the native FMU of the default set in the plain C
+   master of ``bench_fmu_step.py`` (2 mm / 10 Hz sine, 1 ms steps; a larger amplitude than the
+   target's 1 mm, so a harder case for the track's substeps), against the trivial native FMU.
 """
 from __future__ import annotations
 
@@ -24,6 +35,7 @@ import numpy as np
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
+sys.path.insert(0, str(REPO / "benchmarks"))
 
 from fmu_src.parameter_files import load_parameters  # noqa: E402
 from identification.dynamic_stiffness import characterise  # noqa: E402
@@ -88,9 +100,82 @@ def data_sheet(params, figure: Path | None) -> None:
     print(f"wrote {figure}")
 
 
+def recovery(workers: int) -> None:
+    import json
+    import tempfile
+    data = REPO / "data"
+    train, sine = data / "kdyn_synthetic_hydraulic_train.csv", data / "synthetic_hydraulic_sine_1mm_8Hz.csv"
+    from identification.kdyn_table import load_kdyn_table
+    unseen = load_kdyn_table(data / "kdyn_synthetic_hydraulic_unseen.csv")
+    with tempfile.TemporaryDirectory() as work:
+        work = Path(work)
+        for name, extra in (("table alone", []), ("table and the sine", ["--sine", str(sine)])):
+            started = time.perf_counter()
+            subprocess.run([sys.executable, "-m", "identification", "fit", "--model", "hydraulic", "--kdyn", str(train),
+                            *extra, "--workers", str(workers), "--quiet", "--out", str(work / "fit.json")],
+                           check=True, cwd=REPO, capture_output=True)
+            print(f"fit of the hydraulic model from the {name}: {time.perf_counter() - started:.0f} s wall "
+                  f"({workers} workers; target <= 120 s)")
+        started = time.perf_counter()
+        run = subprocess.run([sys.executable, "-m", "identification", "compare", "--kdyn", str(train), "--sine",
+                              str(sine), "--workers", str(workers), "--out", str(work / "compare")],
+                             cwd=REPO, capture_output=True, text=True, check=True)
+        recommended = run.stdout.strip().splitlines()[-1].split()[-1]
+        print(f"compare --kdyn (every model, {time.perf_counter() - started:.0f} s): recommended {recommended}")
+        print("  model             unseen 0.3 and 1 mm: largest |K*| error   loss angle error   training at floor")
+        rows = []
+        for params_file in sorted((work / "compare").glob("params_*.json")):
+            saved = json.loads(params_file.read_text())
+            model = params_file.stem[len("params_"):]
+            sheet = characterise(saved["parameters"], amplitudes_mm=(0.3, 1.0),
+                                 frequencies_hz=np.unique(unseen.frequency_hz), model=model)
+            order = np.lexsort((sheet.frequency_hz, sheet.amplitude_mm))
+            truth = np.lexsort((unseen.frequency_hz, unseen.amplitude_mm))
+            kdyn = np.max(np.abs(sheet.kdyn_N_per_mm[order] / unseen.kdyn_N_per_mm[truth] - 1.0))
+            angle = np.max(np.abs(sheet.loss_angle_deg[order] - unseen.loss_angle_deg[truth]))
+            rows.append((model, kdyn, angle))
+        floors = {}
+        with open(work / "compare" / "comparison.csv") as handle:
+            import csv
+            for row in csv.DictReader(handle):
+                floors[row["model"]] = row["at_floor"]
+        for model, kdyn, angle in sorted(rows, key=lambda r: r[1]):
+            mark = "  <- recommended" if model == recommended else ""
+            print(f"  {model:17s} {kdyn:36.2%} {angle:15.2f} deg {floors.get(model, '?'):>12s}{mark}")
+        print("  target for the recommended model: 5 % and 3 deg")
+
+
+def speed() -> None:
+    import statistics
+    import tempfile
+
+    import build_fmu
+    from bench_fmu_step import _c_master
+    from fmu_src.native.build import fmi_header_directory
+    from fmu_src.parameter_files import save_parameters
+    with tempfile.TemporaryDirectory() as work:
+        work = Path(work)
+        gain = save_parameters(work / "gain.json", {"k": 0.002, "c": 0.0, "preload": 0.0}, "kelvin_voigt")
+        fmus = {"trivial": build_fmu.build_native_fmu(gain, work / "a", "kelvin_voigt").path,
+                "hydraulic": build_fmu.build_native_fmu(out_dir=work / "b", model="hydraulic").path}
+        master = work / "c_master_timing"
+        subprocess.run(["cc", "-O2", "-std=c99", "-I", str(fmi_header_directory()), "-o", str(master),
+                        str(REPO / "benchmarks" / "c_master_timing.c"), "-ldl", "-lm"], check=True)
+        times = {key: [] for key in fmus}
+        for _ in range(5):
+            for key, fmu in fmus.items():
+                times[key] += _c_master(master, fmu, work / key, 100000, 1)
+        median = {key: statistics.median(values) for key, values in times.items()}
+        print(f"native step in the C master (2 mm / 10 Hz, 1 ms steps, median of 5 runs of 1e5 steps): hydraulic "
+              f"{median['hydraulic'] * 1e6:.3f} us, trivial native FMU {median['trivial'] * 1e6:.3f} us (target <= 1 us)")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--figure", type=Path, default=REPO / "docs" / "img" / "hydraulic_data_sheet.png")
+    parser.add_argument("--recovery", action="store_true", help="compare --kdyn on the synthetic mount (minutes)")
+    parser.add_argument("--speed", action="store_true", help="the native FMU's step in a C master")
+    parser.add_argument("--workers", type=int, default=2)
     args = parser.parse_args()
     commit = subprocess.run(["git", "-C", str(REPO), "rev-parse", "--short", "HEAD"], capture_output=True,
                             text=True).stdout.strip()
@@ -99,6 +184,10 @@ def main() -> None:
     params = load_parameters(REPO / "data" / "params_hydraulic_mount.json", "hydraulic")
     closed_form_check(params)
     data_sheet(params, args.figure)
+    if args.speed:
+        speed()
+    if args.recovery:
+        recovery(args.workers)
 
 
 if __name__ == "__main__":

@@ -142,6 +142,20 @@ class SlowLoop:
 
 
 @dataclass(frozen=True)
+class TrackStart:
+    """A fluid column (an inertia track of mass ``mass``, damping ``damping``) that resonates
+    against a bulge stiffness ``stiffness`` and a chamber stiffness ``compliance``, in parallel with
+    a static spring ``static``, behind a decoupler of free travel ``travel`` ("" if none): the fit
+    reads their starts off a dynamic-stiffness table's resonance (``identification.table_start``)."""
+    static: str
+    stiffness: str
+    compliance: str
+    mass: str
+    damping: str
+    travel: str = ""
+
+
+@dataclass(frozen=True)
 class LinearForce:
     """A model whose force is linear in its parameters: F = sum of parameter * regressor over
     ``regressors`` ((parameter, "displacement" [mm] or "velocity" [mm/s]) pairs), with the
@@ -156,11 +170,13 @@ class SearchBox:
     """Where the fit searches a model: its ``coordinates`` (one per free parameter), the
     Bouc-Wen weights held at 1 (``unit_weights``: each block's alpha, which the force does not
     identify apart from its A, beta and gamma), the parameters held at 0 (``zeros``) and the
-    spring and friction a slow loop gives starts for (``loop_start``, a :class:`SlowLoop`, or None)."""
+    spring and friction a slow loop gives starts for (``loop_start``, a :class:`SlowLoop`, or None)
+    and the fluid track a data sheet gives starts for (``table_start``, a :class:`TrackStart`, or None)."""
     coordinates: tuple[SearchCoordinate, ...]
     unit_weights: tuple[str, ...] = ()
     zeros: tuple[str, ...] = ()
     loop_start: SlowLoop | None = None
+    table_start: TrackStart | None = None
 
 
 @dataclass(frozen=True)
@@ -259,6 +275,10 @@ class BushingModel:
     """(matplotlib colour, line style) of the model in comparison plots."""
     rank: int = 100
     """Position in listings (the command line's choices, ``compare``'s columns): lower first."""
+    settling_s: float = 0.0
+    """The time [s] a sine from rest takes to settle, at least (0: a few cycles do): the fit's
+    fixed loop on a dynamic-stiffness table runs each row this long or its cycles, whichever is
+    more (``identification.kdyn_table``)."""
     coupled: CoupledKernels | None = None
     """The model on a displacement vector (a coupled group of axes); None: it has none (it acts
     on each axis alone: Kelvin-Voigt, whose linear elements couple nothing)."""

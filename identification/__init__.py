@@ -36,7 +36,8 @@ The modules, in the order of the workflow:
   ``steady_state`` (the models' kernels, compiled per model), ``refinement`` (finer steps where
   needed) and ``fit_jacobian`` (the forces' sensitivities to the parameters, computed with them);
 - fitting: ``fitting`` (``fit``), ``fit_result`` (what it returns), ``presets``, ``search_space``
-  (the box), ``loop_start`` (starts from a slow loop), ``objectives`` (the misfit), ``multistart``
+  (the box), ``loop_start`` (starts from a slow loop), ``table_start`` (starts from a data sheet),
+  ``objectives`` (the misfit), ``multistart``
   (screening and least-squares stages),
   ``ensemble`` (how sure), ``engine`` (where tasks run), ``progress``, ``fleet`` (many bushings);
 - analysis: ``predict`` (force and band), ``fmu_input`` (a measurement as an FMU's input), ``dynamic_stiffness`` (data sheet), ``design`` (the next

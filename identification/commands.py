@@ -379,15 +379,13 @@ def fit_many_command(args) -> int:
 
 def compare_command(args) -> int:
     from identification.compare import compare_models
-    if args.kdyn is not None:
-        raise UsageError("--kdyn: compare fits on time series; give a table to predict as --validate-kdyn, or fit a "
-                         "table with `fit --kdyn`")
     if args.multiaxis:
         raise UsageError("--multiaxis: compare fits on one-axis tests and weighs the couplings on held-out multi-axis "
                          "files (--coupling none,radial --validate-multiaxis FILE); fit a model to multi-axis tests "
                          "with `fit --multiaxis FILE --coupling radial`")
     from identification.kdyn_table import load_kdyn_table
     table = load_kdyn_table(args.validate_kdyn) if args.validate_kdyn is not None else None
+    training_table = load_kdyn_table(args.kdyn) if args.kdyn is not None else None
     tests, _ = training_tests_of(args)
     models = [name.strip() for name in args.models.split(",") if name.strip()]
     unknown = [name for name in models if name not in MODEL_CHOICES]
@@ -405,7 +403,8 @@ def compare_command(args) -> int:
     validation = args.validate or [Path(t.measurement.source) for t in tests]
     compare_models(models, tests, validation, args.out, preset=args.preset, seed=args.seed, workers=args.workers,
                    scheduler=args.scheduler, screening=args.screening, starts=args.starts,
-                   ensemble=not args.no_ensemble, table=table, multiaxis=multiaxis, couplings=couplings)
+                   ensemble=not args.no_ensemble, table=table, multiaxis=multiaxis, couplings=couplings,
+                   training_table=training_table)
     return 0
 
 

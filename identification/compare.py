@@ -3,9 +3,10 @@ has, and recommend one (the paper's comparison study, §3.1, §4.3, Figs. 15-17,
 
 Each model is fitted (``fitting.fit``) and assessed on:
 
-- training: its NRMSE against each test's noise level (at the floor: every test within
-  ``fit_result.FLOOR_FACTOR`` of it), chi^2/n, and Schwarz's information criterion
-  BIC = chi^2 + d*ln(n) over its d free parameters;
+- training: its NRMSE against each test's noise level and, where a dynamic-stiffness table is
+  training data too (``training_table``, ``compare --kdyn``), the table's rms error in units of
+  its uncertainty (at the floor: each within ``fit_result.FLOOR_FACTOR`` of it), chi^2/n, and
+  Schwarz's information criterion BIC = chi^2 + d*ln(n) over its d free parameters;
 - held out: the validation files that are not training files (NRMSE and the paper's eq. 10), and
   a dynamic-stiffness table (|K*| and loss-angle errors per amplitude and frequency, and their
   rms in units of the table's uncertainty, ``kdyn_table``).
@@ -62,7 +63,7 @@ class Assessment:
     free_parameters: int
     residuals: int
     misfit: float                          # chi^2/n over the training tests
-    training_ratio: float                  # the largest NRMSE over the noise level of a training test
+    training_ratio: float                  # the largest NRMSE over the noise level of a training test or table
     at_floor: bool
     converged: bool
     seconds: float
@@ -86,9 +87,9 @@ class Assessment:
 
     @classmethod
     def of(cls, result: FitResult) -> "Assessment":
+        ratios = [t.ratio for t in result.tests] + ([result.table.ratio] if result.table is not None else [])
         return cls(result.model, result.free_parameters, result.residuals, result.misfit,
-                   max((t.ratio for t in result.tests), default=math.nan), result.at_floor, result.converged,
-                   result.seconds)
+                   max(ratios, default=math.nan), result.at_floor, result.converged, result.seconds)
 
 
 @dataclass(frozen=True)
@@ -147,8 +148,10 @@ def _predicting_best(pool: list[Assessment], tolerance: float, why: list[str]) -
 def compare_models(models: Sequence[str | BushingModel], tests: Sequence[RigTest], validation_files: Sequence[Path],
                    out_dir: Path, preset: str = "default", seed: int = 0, workers: int | None = None,
                    scheduler=None, screening: int | None = None, starts: int | None = None, ensemble: bool = True,
-                   table: KdynTable | None = None, multiaxis=(), couplings: Sequence[str] = ()) -> dict:
-    """Fit every model on ``tests``, assess it on the training tests, on the ``validation_files``
+                   table: KdynTable | None = None, multiaxis=(), couplings: Sequence[str] = (),
+                   training_table: KdynTable | None = None) -> dict:
+    """Fit every model on ``tests`` and the ``training_table`` (a data sheet, alone or with the
+    tests, as ``fit(kdyn=...)``), assess it on the training data, on the ``validation_files``
     and on the held-out dynamic-stiffness ``table``, write the files (module docstring) and
     recommend one. ``models``: names or ``BushingModel``s, each resolved once here and passed on.
     Returns ``{"parameters": {model: params}, "errors": {(file, model): (nrmse, eq10)},
@@ -166,8 +169,9 @@ def compare_models(models: Sequence[str | BushingModel], tests: Sequence[RigTest
             model = bushing.name
             print(f"fitting {bushing.title} ...", file=sys.stderr)
             result = fit(tests, model=bushing, preset=preset, seed=seed, engine=engine, screening=screening,
-                         starts=starts, ensemble=ensemble)
-            result.save(out_dir / f"params_{model}.json", data=[t.measurement.source for t in tests])
+                         starts=starts, ensemble=ensemble, kdyn=training_table)
+            result.save(out_dir / f"params_{model}.json", data=[t.measurement.source for t in tests]
+                        + ([training_table.source] if training_table is not None else []))
             parameters[model] = result.parameters.parameters
             assessment = Assessment.of(result)
             if table is not None:

@@ -224,22 +224,24 @@ def characterise(parameters, amplitudes_mm: Sequence[float] = DEFAULT_AMPLITUDES
 
 
 def run_sines(matrix: np.ndarray, model: str | BushingModel, amplitude_mm: np.ndarray, frequency_hz: np.ndarray,
-              preload_mm: np.ndarray, steps_per_cycle: int, max_cycles: int, tolerance: float,
+              preload_mm: np.ndarray, steps_per_cycle: int, max_cycles, tolerance: float,
               max_substeps: int = MAX_SUBSTEPS):
     """Every parameter set (rows of ``matrix``) on every case (equal-length arrays): the compiled
     loop of ``identification.steady_state``, cases of all sets in parallel. Returns its
     ``result`` (P*cases, 4: a, b, cycles, status; set-major) and ``last`` (P*cases, steps).
-    ``tolerance`` 0 runs exactly ``max_cycles`` cycles (a smooth function of the parameters,
-    as a fit needs; status 1 then means done). ``max_substeps`` per communication step before a
-    case fails (status 2)."""
+    ``max_cycles``: one cap for all cases, or one per case. ``tolerance`` 0 runs exactly
+    ``max_cycles`` cycles (a smooth function of the parameters, as a fit needs; status 1 then
+    means done). ``max_substeps`` per communication step before a case fails (status 2)."""
     from identification.compiled_core import compiled_model
     members, cases = matrix.shape[0], amplitude_mm.size
+    cycles = np.broadcast_to(np.asarray(max_cycles, dtype=np.int64), (cases,))
     rows = np.repeat(np.arange(members, dtype=np.int64), cases)
     result = np.zeros((rows.size, 4))
     last = np.zeros((rows.size, steps_per_cycle))
     compiled_model(model)._sine_steady_state(
         matrix, rows, np.tile(amplitude_mm, members), np.tile(frequency_hz, members), np.tile(preload_mm, members),
-        steps_per_cycle, min(MIN_CYCLES, max_cycles), max_cycles, tolerance, max_substeps, result, last)
+        steps_per_cycle, min(MIN_CYCLES, int(cycles.min())), np.tile(cycles, members), tolerance, max_substeps,
+        result, last)
     return result, last
 
 

@@ -281,7 +281,8 @@ class FitResult:
         if self.table is not None:
             lines.append(self.table.format())
             if self.table.cycles_error > 0.1 * KDYN_UNCERTAINTY:
-                lines.append(f"note: the fit's {FIT_CYCLES}-cycle loop differs from the steady state by up to "
+                lines.append(f"note: the fit's fixed-cycle loop ({FIT_CYCLES} cycles a row or the model's settling "
+                             f"time) differs from the steady state by up to "
                              f"{self.table.cycles_error:.2%} in |K*| at the fitted set (a slow transient); more than "
                              "a tenth of the table's uncertainty")
         if self.space is not None:

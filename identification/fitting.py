@@ -63,6 +63,7 @@ from identification.refinement import refine_steps
 from identification.rig_tests import Manifest, RigTest
 from identification.search_space import SearchSpace
 from identification.simulate import simulate
+from identification.table_start import table_start
 
 MIN_FINAL_STARTS = 3
 """A reduced budget (``starts``) keeps at least this many starts to the end: with two, one
@@ -325,6 +326,11 @@ def _search(tests, noise, model, preset, settings, seed, engine, progress, start
                                 **multi.objective_arguments()), space, jacobian_kind)
     ga_evaluations = PAPER_GA["population"] * PAPER_GA["generations"]
     loop = slow_loop_start(tests, space) if preset != "paper" else None
+    if loop is None and preset != "paper":
+        loop = table_start(table, space)
+        if isinstance(loop, str):           # the table gives no start, and why
+            notes.append(loop)
+            loop = None
     if loop is not None:
         notes.append(f"note: {LOOP_STARTS} of the screened starts take the {loop.describe()}")
     bars = SearchProgress(progress, settings, ga_evaluations if preset == "paper" else
@@ -534,9 +540,9 @@ def table_fit(table: KdynTable | None, parameters: ParameterSet) -> TableFit | N
         return None
     from identification.dynamic_stiffness import MAX_CYCLES, STEPS_PER_CYCLE, TOLERANCE, run_sines, stiffness_from_sums
     from identification.objectives import PreparedTable
-    prepared = PreparedTable.of(table)
-    rows = prepared.rows
     model = parameters.model
+    prepared = PreparedTable.of(table, model)
+    rows = prepared.rows
     matrix = parameter_matrix([parameters.parameters], model)
 
     def steady(steps):

@@ -105,13 +105,15 @@ def slow_loop_start(tests: Sequence[RigTest], space: SearchSpace) -> LoopStart |
     return LoopStart(values, test.name, unexplained)
 
 
-def anchored_coordinates(start: LoopStart, space: SearchSpace) -> dict[int, float]:
-    """{coordinate index: value} of the start's parameters in the box's coordinates, clipped into
-    the box (a stiffness of 0 at the box's lowest)."""
+def anchored_coordinates(start, space: SearchSpace) -> dict[int, float]:
+    """{coordinate index: value} of a start's parameters (a slow loop's, :class:`LoopStart`, or a
+    data sheet's, ``table_start.TableStart``) in the box's coordinates, clipped into the box (a
+    stiffness of 0 at the box's lowest); a coordinate whose kind reads a parameter the start does
+    not give is left to the screening."""
     bounds = space.bounds()
     out = {}
     for i, c in enumerate(space.coordinates):
-        if c.parameter in start.parameters:
-            value = space.coordinate_of(c, start.parameters[c.parameter])
+        if c.parameter in start.parameters and all(name in start.parameters for name in c.kind.reads(c)):
+            value = c.kind.to_coordinate(c, start.parameters[c.parameter], start.parameters, space)
             out[i] = float(np.clip(value, bounds[i, 0], bounds[i, 1]))
     return out

@@ -91,16 +91,21 @@ class PreparedMultiAxis:
 
 @dataclass(frozen=True)
 class PreparedTable:
-    """The rows of a dynamic-stiffness table the objective counts (weight > 0) and its loop."""
+    """The rows of a dynamic-stiffness table the objective counts (weight > 0) and its loop:
+    ``cycles`` per row."""
     rows: KdynTable
-    steps_per_cycle: int = FIT_STEPS_PER_CYCLE
-    cycles: int = FIT_CYCLES
+    steps_per_cycle: int
+    cycles: np.ndarray
 
     @classmethod
-    def of(cls, table: KdynTable, search: bool = False) -> "PreparedTable":
-        """With the fit's loop, or the search's coarser one (``search``)."""
-        loop = (SEARCH_STEPS_PER_CYCLE, SEARCH_CYCLES) if search else (FIT_STEPS_PER_CYCLE, FIT_CYCLES)
-        return cls(table.kept(), *loop)
+    def of(cls, table: KdynTable, model: str | BushingModel, search: bool = False) -> "PreparedTable":
+        """With the fit's loop, or the search's coarser one (``search``): FIT_CYCLES (SEARCH_CYCLES)
+        per row, or more where the model takes longer to settle (``BushingModel.settling_s``; the
+        search runs half that time)."""
+        steps, cycles = (SEARCH_STEPS_PER_CYCLE, SEARCH_CYCLES) if search else (FIT_STEPS_PER_CYCLE, FIT_CYCLES)
+        rows = table.kept()
+        settling = resolve_model(model).settling_s * (cycles / FIT_CYCLES)
+        return cls(rows, steps, np.maximum(cycles, np.ceil(settling * rows.frequency_hz)).astype(np.int64))
 
     @property
     def size(self) -> int:
@@ -168,7 +173,7 @@ class Objective:
             self.tests.append(PreparedTest(test.name, driven, m.force_N[driven.sample_index], sigma))
         self._source_table = table
         self.search = search and table is not None
-        self.table = PreparedTable.of(table, search) if table is not None else None
+        self.table = PreparedTable.of(table, self.bushing, search) if table is not None else None
         self._source_multiaxis = tuple(multiaxis)
         self.coupling = coupling
         self.multiaxis_noise = [list(levels) for levels in multiaxis_noise] if multiaxis_noise is not None else \

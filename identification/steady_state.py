@@ -19,8 +19,8 @@ b = k*X, a = c*omega*X). Steady state (the criterion): from ``min_cycles`` on, t
 change d_j = |K*_j - K*_(j-1)|/|K*_j| is at most ``tolerance`` and so is what is left of a
 geometric approach, d_j*r/(1 - r) with r = d_j/d_(j-1) < 1 (a mode slower than a cycle, such
 as the w relaxation of Table 5 with (c0 + c2)/k2 = 48 s, changes each cycle by little while
-far from its end); or d_j is at rounding level (1e-13). After ``max_cycles`` the loop stops
-unconverged (status 1). Rounding: the sums are of rectangle-rule quadrature over a period,
+far from its end); or d_j is at rounding level (1e-13). After ``max_cycles[i]`` cycles (a cap per
+item) the loop stops unconverged (status 1). Rounding: the sums are of rectangle-rule quadrature over a period,
 exact for a band-limited force.
 
 Results per item: ``result[i] = (a, b, cycles, status)`` (status 0 converged, 1 cycle cap, 2
@@ -48,7 +48,7 @@ def _sine_steady_state(matrix, rows, amplitude, frequency, preload, steps, min_c
         state = initial_state(m, P)
         previous_re, previous_im, previous_change = 0.0, 0.0, -1.0
         status, cycles, a, b = 1, 0, 0.0, 0.0
-        while cycles < max_cycles:
+        while cycles < max_cycles[i]:
             a, b = 0.0, 0.0
             failed = False
             for k in range(steps):

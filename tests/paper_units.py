@@ -30,9 +30,9 @@ PARAMETER_UNITS = {
     # in mm: k0, kb, kc are N/mm, c0 (times mm/s) N.s/mm; df1/dt = k1*dx/dt - (k1/c1)*f1 makes k1
     # N/mm and k1/c1 a rate [1/s], so c1 N.s/mm; mf*dw/dt = dp - cf*w - ct*|w|*w is a force with
     # w in mm/s and dw/dt in mm/s^2: cf N.s/mm, mf N.s^2/mm, ct N.s^2/mm^2; u = gap*tanh(...) is a
-    # travel, so gap is mm
+    # travel, so gap is mm; kd*u is the membrane's force against P, so kd is N/mm
     "hydraulic": {"k0": "N/mm", "c0": "N.s/mm", "k1": "N/mm", "c1": "N.s/mm", "kb": "N/mm", "kc": "N/mm",
-                  "mf": "N.s^2/mm", "cf": "N.s/mm", "ct": "N.s^2/mm^2", "gap": "mm"},
+                  "mf": "N.s^2/mm", "cf": "N.s/mm", "ct": "N.s^2/mm^2", "gap": "mm", "kd": "N/mm"},
 }
 
 MOUNTING_UNITS = {"offset": "mm", "preload": "N"}

@@ -27,6 +27,11 @@ BAD_VALUES = [  # model, parameter, value, what the message says after "<name> =
     ("fractional", "alpha", 1.0, "[1] must be in (0, 1)"),
     ("fractional", "alpha", -0.2, "[1] must be in (0, 1)"),
     ("fractional", "k3", -1.0, "[N/mm^3] must be >= 0"),
+    # the hydraulic mount: a fluid column without mass, a chamber without a wall, a negative travel
+    ("hydraulic", "mf", 0.0, "[N.s^2/mm] must be > 0"),
+    ("hydraulic", "kb", -5.0, "[N/mm] must be > 0"),
+    ("hydraulic", "gap", -0.1, "[mm] must be >= 0"),
+    ("hydraulic", "ct", float("inf"), "[N.s^2/mm^2]"),
 ]
 
 

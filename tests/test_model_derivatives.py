@@ -28,19 +28,19 @@ def fractional_rhs(p, s, x, v):
 
 def hydraulic_rhs(p, s, x, v):
     """The hydraulic mount, typed from its equations: P = kb*(x - y) - kc*y, the decoupler's
-    u = gap*tanh(P/((kb + kc)*gap)), dp = P - (kb + kc)*u; dy/dt = w,
+    u = gap*tanh(P/((kb + kc + kd)*gap)), dp = P - (kb + kc)*u; dy/dt = w,
     mf*dw/dt = dp - cf*w - ct*|w|*w, df1/dt = k1*v - (k1/c1)*f1."""
     y, w, f1 = s
     pressure = p["kb"] * (x - y) - p["kc"] * y
-    u = p["gap"] * np.tanh(pressure / ((p["kb"] + p["kc"]) * p["gap"])) if p["gap"] > 0.0 else 0.0
+    u = p["gap"] * np.tanh(pressure / ((p["kb"] + p["kc"] + p["kd"]) * p["gap"])) if p["gap"] > 0.0 else 0.0
     drive = pressure - (p["kb"] + p["kc"]) * u
     return [w, (drive - p["cf"] * w - p["ct"] * abs(w) * w) / p["mf"], p["k1"] * v - p["k1"] / p["c1"] * f1]
 
 
 FILLED_RUBBER = {"k0": 500.0, "k3": 10.0, "Ff_max": 60.0, "x2": 0.08}
 HYDRAULIC = {"k0": 200.0, "c0": 0.05, "k1": 40.0, "c1": 0.4, "kb": 250.0, "kc": 25.0, "mf": 0.07, "cf": 1.3,
-             "ct": 0.005, "gap": 0.1}
-"""data/params_hydraulic_mount.json's values: (kb + kc)*gap = 27.5 N, so the states drawn below put
+             "ct": 0.005, "gap": 0.1, "kd": 50.0}
+"""data/params_hydraulic_mount.json's values: (kb + kc + kd)*gap = 32.5 N, so the states drawn below put
 the chambers' pressure difference P both inside the decoupler's free travel and on its cage."""
 
 CASES = {

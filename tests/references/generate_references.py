@@ -174,10 +174,10 @@ def hydraulic_track(p, x, y):
     """(kb*(x - y - u), dp) of the hydraulic mount: the fluid path's force on the mount [N] and
     the pressure difference that drives the inertia track [N], with the chambers' pressure
     difference (decoupler closed) P = kb*(x - y) - kc*y and the decoupler's travel
-    u = gap*tanh(P/((kb + kc)*gap)), u = 0 where gap = 0."""
+    u = gap*tanh(P/((kb + kc + kd)*gap)), u = 0 where gap = 0."""
     kb, kc, gap = p["kb"], p["kc"], p["gap"]
     pressure = kb * (x - y) - kc * y
-    u = gap * np.tanh(pressure / ((kb + kc) * gap)) if gap > 0.0 else 0.0 * pressure
+    u = gap * np.tanh(pressure / ((kb + kc + p["kd"]) * gap)) if gap > 0.0 else 0.0 * pressure
     return kb * (x - y - u), pressure - (kb + kc) * u
 
 

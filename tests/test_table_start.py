@@ -1,0 +1,78 @@
+"""A fluid track's starts read off a data sheet (identification/table_start.py): near the truth on
+the hydraulic model's own synthetic sheet, and a clear note where a sheet cannot give them."""
+import json
+import math
+
+import numpy as np
+import pytest
+
+from conftest import REPO
+from identification.kdyn_table import KdynTable, load_kdyn_table
+from identification.loop_start import anchored_coordinates
+from identification.search_space import SearchSpace
+from identification.table_start import TableStart, table_start
+
+TRAIN = REPO / "data" / "kdyn_synthetic_hydraulic_train.csv"
+TRUTH = {name: float(value) for name, value in
+         json.loads((REPO / "data" / "params_hydraulic_mount.json").read_text())["parameters"].items()}
+
+
+def resonance_hz(p):
+    """The track's resonance with the decoupler on its cage, typed: sqrt((kb + kc)/mf)/(2*pi)."""
+    return math.sqrt((p["kb"] + p["kc"]) / p["mf"]) / (2.0 * math.pi)
+
+
+def test_the_synthetic_sheet_gives_the_track_near_its_truth():
+    # data/generate_hydraulic.py's training sheet (0.1, 0.5, 2 mm x 1-50 Hz, 1 % and 0.2 deg noise):
+    # the starts need only land in the truth's basin; measured: resonance 9.6 Hz (truth 9.98),
+    # kb 260 (250), k0 199 (200), gap 0.091 mm (0.1)
+    table = load_kdyn_table(TRAIN)
+    start = table_start(table, SearchSpace.from_table(table, "hydraulic"))
+    assert isinstance(start, TableStart) and not start.missing
+    p = start.parameters
+    assert resonance_hz(p) == pytest.approx(resonance_hz(TRUTH), rel=0.1)
+    assert p["kb"] == pytest.approx(TRUTH["kb"], rel=0.2)
+    assert p["k0"] == pytest.approx(TRUTH["k0"], rel=0.2)
+    assert 0.5 * TRUTH["gap"] <= p["gap"] <= 2.0 * TRUTH["gap"]
+    assert "fluid track from the data sheet" in start.describe()
+
+
+def test_the_anchored_coordinates_are_the_starts_in_the_box():
+    table = load_kdyn_table(TRAIN)
+    space = SearchSpace.from_table(table, "hydraulic")
+    start = table_start(table, space)
+    anchored = anchored_coordinates(start, space)
+    assert {space.names[i] for i in anchored} == set(start.parameters)
+    full = space.to_coordinates({**TRUTH, **start.parameters})
+    for i, value in anchored.items():
+        assert value == pytest.approx(full[i], abs=1e-12)
+
+
+def _table(amplitudes, frequencies, kdyn, angle):
+    amplitudes, frequencies = np.asarray(amplitudes, float), np.asarray(frequencies, float)
+    return KdynTable(amplitudes, frequencies, np.zeros(amplitudes.size), np.asarray(kdyn, float),
+                     np.asarray(angle, float), np.ones(amplitudes.size), "sheet.csv")
+
+
+def test_a_sheet_without_a_peak_or_with_too_few_frequencies_says_so():
+    space = SearchSpace(300.0, 1.0, 600.0, 1e-3, "hydraulic", 2.0)
+    rising = _table([2.0] * 4, [1.0, 5.0, 10.0, 50.0], [200.0, 250.0, 300.0, 350.0], [3.0, 5.0, 8.0, 12.0])
+    note = table_start(rising, space)
+    assert isinstance(note, str) and "no peak inside its frequencies (1-50 Hz)" in note and "default box" in note
+    two = _table([2.0, 2.0], [5.0, 10.0], [200.0, 300.0], [10.0, 40.0])
+    note = table_start(two, space)
+    assert isinstance(note, str) and "2 frequencies" in note
+
+
+def test_one_amplitude_leaves_the_travel_to_the_box():
+    space = SearchSpace(300.0, 1.0, 600.0, 1e-3, "hydraulic", 2.0)
+    one = _table([1.0] * 5, [2.0, 5.0, 8.0, 12.0, 30.0], [220.0, 200.0, 500.0, 700.0, 480.0],
+                 [5.0, 20.0, 60.0, 30.0, 4.0])
+    start = table_start(one, space)
+    assert "gap" not in start.parameters and "travel is left to the box" in start.missing
+
+
+def test_a_model_without_a_track_and_no_table_give_no_start():
+    table = load_kdyn_table(TRAIN)
+    assert table_start(table, SearchSpace.from_table(table, "berg")) is None
+    assert table_start(None, SearchSpace.from_table(table, "hydraulic")) is None
