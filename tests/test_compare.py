@@ -104,3 +104,32 @@ def test_compare_on_the_filled_rubber_bushing_writes_its_files_and_recommends_a_
     assert int(rows["berg"]["free_parameters"]) == 8 and int(rows["kelvin_voigt"]["free_parameters"]) == 2
     with open(out / "kdyn_errors.csv") as handle:
         assert sum(1 for _ in csv.DictReader(handle)) == 2 * 25      # every row of the table, per model
+
+
+@pytest.mark.slow
+def test_compare_on_a_hydromount_data_sheet_recommends_the_hydraulic_model(tmp_path, capsys):
+    # compare --kdyn (issue 43): the synthetic mount's training sheet (0.1, 0.5, 2 mm x 1-50 Hz) and
+    # its 1 mm / 8 Hz sine, data/generate_hydraulic.py; only the hydraulic model has a fluid column
+    # to give a 60-70 deg loss-angle peak, so only it reaches the floor
+    out = tmp_path / "cmp"
+    code = main(["compare", "--models", "hydraulic,berg,kelvin_voigt", "--kdyn",
+                 str(DATA / "kdyn_synthetic_hydraulic_train.csv"), "--sine",
+                 str(DATA / "synthetic_hydraulic_sine_1mm_8Hz.csv"), "--no-ensemble", "--quiet", "--out", str(out)])
+    printed = capsys.readouterr().out
+    assert code == 0
+    assert printed.strip().splitlines()[-1] == "recommended: hydraulic"
+    with open(out / "comparison.csv") as handle:
+        floor = {row["model"]: row["at_floor"] for row in csv.DictReader(handle)}
+    assert floor == {"hydraulic": "True", "berg": "False", "kelvin_voigt": "False"}
+
+
+@pytest.mark.slow
+def test_compare_on_filled_rubber_does_not_recommend_the_hydraulic_model(tmp_path, capsys):
+    # the hydraulic model has no rate-independent friction: on the filled rubber (its stiffness
+    # falling with amplitude, a loss angle flat over frequency) Berg's model stays the choice
+    out = tmp_path / "cmp"
+    code = main(["compare", "--models", "berg,hydraulic", "--sine", f"{FILLED}_sine_2mm_10Hz.csv",
+                 "--sine", f"{FILLED}_sine_0.5mm_3Hz.csv", "--validate", f"{FILLED}_random_2mm.csv",
+                 "--screening", "256", "--starts", "8", "--no-ensemble", "--quiet", "--out", str(out)])
+    assert code == 0
+    assert capsys.readouterr().out.strip().splitlines()[-1] == "recommended: berg"

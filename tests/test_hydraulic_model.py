@@ -178,3 +178,29 @@ def test_model_exchange_with_cvode_follows_the_radau_reference(native_model_fmus
                                   lambda s: 2e-3 * omega * np.cos(omega * s))
     error = np.max(np.abs(run.force_N - force_ref[:t.size])) / np.max(np.abs(force_ref))
     assert error <= 1e-5, error
+
+
+@pytest.mark.parametrize("kind", ["pythonfmu", "native"])
+def test_a_hydraulic_axis_of_the_six_axis_fmu_is_the_one_axis_model(tmp_path, kind):
+    # the mount on the z axis of a six-axis FMU (the others Kelvin-Voigt), driven on every axis:
+    # its force is the one-axis model's fed with z alone (the compiled path, the kernels' bits)
+    import build_fmu
+    from fmpy import simulate_fmu
+    from fmu_src.parameter_files import save_six_axis
+    from identification.compiled_core import simulate_model_held
+    stiff = {"k": 500.0, "c": 1.0, "preload": 0.0}
+    axes = {name: ("kelvin_voigt", stiff) for name in ("x", "y", "rx", "ry", "rz")}
+    axes["z"] = ("hydraulic", DEFAULTS)
+    document = save_six_axis(tmp_path / "six.json", axes)
+    build = build_fmu.build_native_fmu if kind == "native" else build_fmu.build_fmu
+    built = build(document, tmp_path / "out", "six_axis")
+    fmu = getattr(built, "path", built)
+    t = np.arange(0.0, 0.4, 1e-3)
+    omega = 2 * np.pi * 8.0
+    ports = {"dx": 1e-3 * np.sin(3 * t), "vx": 3e-3 * np.cos(3 * t), "dz": 1e-3 * np.sin(omega * t),
+             "vz": 1e-3 * omega * np.cos(omega * t)}
+    inputs = np.array(list(zip(t, *ports.values())), dtype=[("time", float)] + [(k, float) for k in ports])
+    result = simulate_fmu(str(fmu), start_time=0.0, stop_time=t[-1], step_size=1e-3, output_interval=1e-3,
+                          input=inputs, output=["Fz"])
+    expected = simulate_model_held("hydraulic", DEFAULTS, t, ports["dz"] * 1e3, ports["vz"] * 1e3)
+    np.testing.assert_allclose(result["Fz"][:t.size], expected, rtol=1e-12, atol=1e-12 * np.max(np.abs(expected)))
