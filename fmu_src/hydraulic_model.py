@@ -139,7 +139,10 @@ def jump(m, state, jump_mm):
 def track_substeps(kb, kc, mf, cf, ct, w, h):
     """The substeps over h [s] that keep each within THETA_TRACK of the column's fastest rate."""
     rate = math.sqrt((kb + kc) / mf) + (cf + 2.0 * ct * abs(w)) / mf
-    return max(1, int(math.ceil(h * rate / THETA_TRACK)))
+    count = h * rate / THETA_TRACK
+    if not count < 1e9:         # inf or NaN (w not finite, mf vanishing): more than any budget
+        return 1_000_000_000
+    return max(1, int(math.ceil(count)))
 
 
 def integrate(m, state, x, v, h, max_substeps):
@@ -179,7 +182,7 @@ def derivatives(m, state, x, v):
 
 
 def switches(m, state, x, v):
-    """None: the equations have no branch (module docstring)."""
+    """No switches, (): the equations have no branch (module docstring)."""
     return ()
 
 

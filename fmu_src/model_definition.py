@@ -278,7 +278,7 @@ class BushingModel:
     settling_s: float = 0.0
     """The time [s] a sine from rest takes to settle, at least (0: a few cycles do): the fit's
     fixed loop on a dynamic-stiffness table runs each row this long or its cycles, whichever is
-    more (``identification.kdyn_table``)."""
+    more (``identification.objectives.PreparedTable``)."""
     coupled: CoupledKernels | None = None
     """The model on a displacement vector (a coupled group of axes); None: it has none (it acts
     on each axis alone: Kelvin-Voigt, whose linear elements couple nothing)."""

@@ -385,6 +385,9 @@ def compare_command(args) -> int:
                          "with `fit --multiaxis FILE --coupling radial`")
     from identification.kdyn_table import load_kdyn_table
     table = load_kdyn_table(args.validate_kdyn) if args.validate_kdyn is not None else None
+    if args.kdyn is not None and args.validate_kdyn is not None and args.kdyn.resolve() == args.validate_kdyn.resolve():
+        raise UsageError(f"--kdyn and --validate-kdyn are the same table ({args.kdyn}): a table the models are fitted "
+                         "on is not held out; give another table to --validate-kdyn, or leave it out")
     training_table = load_kdyn_table(args.kdyn) if args.kdyn is not None else None
     tests, _ = training_tests_of(args)
     models = [name.strip() for name in args.models.split(",") if name.strip()]

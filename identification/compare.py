@@ -62,7 +62,7 @@ class Assessment:
     model: str
     free_parameters: int
     residuals: int
-    misfit: float                          # chi^2/n over the training tests
+    misfit: float                          # chi^2/n over the training data (tests and a training table)
     training_ratio: float                  # the largest NRMSE over the noise level of a training test or table
     at_floor: bool
     converged: bool
@@ -121,7 +121,8 @@ def recommend(assessments: Sequence[Assessment], tolerance: float = PREDICTION_T
         chosen = min(held_out, key=lambda a: (a.information_criterion, a.free_parameters))
         why.append(f"{chosen.model} has the lowest BIC{' of those' if filtered else ''}")
         caveat = (f"no model describes these data to their noise level; the best, {chosen.model}, misses its worst "
-                  f"training test by {chosen.training_ratio:.3g}x the noise (the floor is {FLOOR_FACTOR}x): treat "
+                  f"training data by {chosen.training_ratio:.3g}x the noise (or a training table's uncertainty; the floor is "
+                  f"{FLOOR_FACTOR}x): treat "
                   "its predictions as approximate")
         return Recommendation(chosen.model, "; ".join(why), caveat)
     chosen = min(held_out, key=lambda a: (a.free_parameters, a.information_criterion))
@@ -286,7 +287,8 @@ def format_assessments(assessments: Sequence[Assessment], recommendation: Recomm
         mark = "  <- recommended" if a.model == recommendation.model else ""
         lines.append(f"{a.model:17s} {a.free_parameters:6d} {a.training_ratio:17.2f} {'yes' if a.at_floor else 'NO':>5s} "
                      f"{a.misfit:9.3f} {a.information_criterion - best_bic:9.1f} {held:>14s} {table:>13s}{mark}")
-    lines.append(f"floor: every training test's NRMSE within {FLOOR_FACTOR}x its noise level; dBIC: BIC = chi^2 + "
+    lines.append(f"floor: every training test's NRMSE within {FLOOR_FACTOR}x its noise level (a training table's "
+                 f"rms error within {FLOOR_FACTOR}x its uncertainty; the column is the worst of them); dBIC: BIC = chi^2 + "
                  "d*ln(n) over the best; held-out NRMSE: the mean over the validation files that are not training "
                  f"files; table err/unc: rms error in units of {KDYN_UNCERTAINTY:.0%} on |K*| and "
                  f"{LOSS_ANGLE_UNCERTAINTY_DEG:g} deg")

@@ -24,10 +24,11 @@ residuals are in units of its noise. A fit at the table's floor has an rms of bo
 ``fit_result.FLOOR_FACTOR``.
 
 Model side: the compiled sine loop (``identification.steady_state``) with FIT_STEPS_PER_CYCLE
-steps per cycle for exactly FIT_CYCLES cycles from rest at the preload (a fixed count keeps the
+steps per cycle for exactly FIT_CYCLES cycles from rest at the preload, or a model's settling
+time where it declares a longer one (``BushingModel.settling_s``; a fixed count per row keeps the
 misfit a smooth function of the parameters; a steady-state test would make it jump from one
 candidate to the next); the screening and the early stages use a coarser loop
-(SEARCH_STEPS_PER_CYCLE, SEARCH_CYCLES). The fit checks, at its result, how far the last of
+(SEARCH_STEPS_PER_CYCLE, SEARCH_CYCLES; ``objectives.PreparedTable``). The fit checks, at its result, how far the last of
 these cycles is from the converged table (``FitResult.summary``).
 """
 from __future__ import annotations

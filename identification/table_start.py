@@ -13,7 +13,9 @@ reads back from it (at the table's largest amplitude, where the decoupler rests 
   peak and its neighbours in log f; the loss angle itself peaks below the resonance, where the
   storage stiffness dips);
 - the bulge stiffness kb from the rise of the storage stiffness K' = |K*|*cos(delta) from the
-  lowest frequency to the highest (the fluid path goes from kb*kc/(kb + kc) to kb);
+  lowest frequency to the highest (the fluid path goes from kb*kc/(kb + kc) to kb, a rise of
+  kb^2/(kb + kc), 0.91*kb with the bellows below; the rubber's Maxwell element adds to the rise
+  about as much, so the rise itself is taken);
 - kc as a tenth of kb (a soft bellows: the notch that would give it moves with the rubber's
   damping and the track's, too much to read);
 - the mass mf = (kb + kc)/(2*pi*f_r)^2;
@@ -21,12 +23,15 @@ reads back from it (at the table's largest amplitude, where the decoupler rests 
   column's kb^2/(omega_r*cf) dominates there;
 - the static spring k0 = K'(lowest frequency) - kb*kc/(kb + kc) (at least 1 % of it);
 - the decoupler's travel from the amplitudes: the peak appears once the pressure kb*X exceeds
-  what the free membrane takes, (kb + kc)*gap, so gap is about kb/(kb + kc) times the smallest
+  what the membrane takes, (kb + kc + kd)*gap with kd its stiffness, taken as small against
+  kb + kc (a soft membrane), so gap is about kb/(kb + kc) times the smallest
   amplitude whose peak loss angle reaches half the largest amplitude's (the geometric mean of it
   and the largest amplitude below it, where the table has one).
 
-What the table cannot give (no loss-angle peak inside its frequencies, a single frequency
-below three, one amplitude for the travel) is left to the box, and :func:`table_start` says so.
+Read at one preload: the table's most common one among the largest amplitude's rows (the one
+nearest 0 of equally common ones). What the table cannot give (no peak of the loss stiffness
+inside its frequencies, fewer than three frequencies, a single amplitude for the travel) is left
+to the box, and :func:`table_start` says so.
 The fit's screening then adds ``loop_start.LOOP_STARTS`` candidates anchored at these values
 (``multistart.screen``), as it does for a slow loop's.
 
@@ -78,19 +83,24 @@ def table_start(table: KdynTable | None, space: SearchSpace) -> TableStart | str
     if track is None or table is None:
         return None
     kept = table.weight > 0
+    largest = float(table.amplitude_mm[kept].max())
+    preloads, counts = np.unique(table.preload_mm[kept & (table.amplitude_mm == largest)], return_counts=True)
+    preload = min(preloads[counts == counts.max()], key=abs)
+    kept &= table.preload_mm == preload
     amplitude, frequency = table.amplitude_mm[kept], table.frequency_hz[kept]
     kdyn, angle = table.kdyn_N_per_mm[kept], table.loss_angle_deg[kept]
-    largest = float(amplitude.max())
     rows = np.flatnonzero(amplitude == largest)
     rows = rows[np.argsort(frequency[rows])]
+    at = f"at its largest amplitude ({largest:g} mm" + (f", preload {preload:g} mm)" if preload else ")")
     if rows.size < MIN_FREQUENCIES:
-        return (f"note: the table has {rows.size} frequencies at its largest amplitude ({largest:g} mm), fewer than "
-                f"{MIN_FREQUENCIES}: no resonance to read, the fit starts from the default box")
+        count = "a single frequency" if rows.size == 1 else f"{rows.size} frequencies"
+        return (f"note: the table has {count} {at}, fewer than {MIN_FREQUENCIES}: no resonance to read, the fit "
+                "starts from the default box")
     f, k, d = frequency[rows], kdyn[rows], np.radians(angle[rows])
     storage, loss = k * np.cos(d), k * np.sin(d)
     resonance = _peak_frequency(f, loss)
     if resonance is None:
-        return (f"note: the table's loss stiffness at {largest:g} mm has no peak inside its frequencies "
+        return (f"note: the table's loss stiffness {at} has no peak inside its frequencies "
                 f"({f[0]:g}-{f[-1]:g} Hz): no resonance to read, the fit starts from the default box")
     bulge = max(storage[-1] - storage[0], 0.01 * storage[0])
     chamber = 0.1 * bulge
@@ -104,7 +114,8 @@ def table_start(table: KdynTable | None, space: SearchSpace) -> TableStart | str
     if track.travel:
         travel = _travel(amplitude, angle, largest, bulge / (bulge + chamber))
         if travel is None:
-            missing = "one amplitude shows no threshold: the decoupler's travel is left to the box"
+            missing = (f"the table has a single amplitude ({largest:g} mm): the decoupler's travel is left to "
+                       "the box")
         else:
             values[track.travel] = travel
     return TableStart(values, table.source, missing)

@@ -347,3 +347,10 @@ def test_the_search_loop_is_coarser_and_close_to_the_fit_loop():
     # in units of the table's uncertainty: the fit loop a tenth of it, the search loop under one
     # (0.69 for Table 5 at 3 cycles from rest: a bias the last stage, on the fit loop, removes)
     assert np.max(np.abs(fine)) < 0.15 and np.max(np.abs(coarse)) < 1.0
+
+
+def test_compare_refuses_the_training_table_as_held_out(tmp_path, capsys):
+    path = _write_table(tmp_path / "k.csv", "amplitude_mm,frequency_hz,kdyn_N_per_mm,loss_angle_deg\n1,10,1000,5\n")
+    assert main(["compare", "--kdyn", str(path), "--validate-kdyn", str(path), "--models", "kelvin_voigt",
+                 "--out", str(tmp_path / "c")]) == 2
+    assert "are the same table" in capsys.readouterr().err and not (tmp_path / "c").exists()

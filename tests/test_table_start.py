@@ -61,7 +61,21 @@ def test_a_sheet_without_a_peak_or_with_too_few_frequencies_says_so():
     assert isinstance(note, str) and "no peak inside its frequencies (1-50 Hz)" in note and "default box" in note
     two = _table([2.0, 2.0], [5.0, 10.0], [200.0, 300.0], [10.0, 40.0])
     note = table_start(two, space)
-    assert isinstance(note, str) and "2 frequencies" in note
+    assert isinstance(note, str) and "2 frequencies at its largest amplitude (2 mm)" in note
+
+
+def test_a_sheet_at_two_preloads_is_read_at_one():
+    # the synthetic sheet again at a 1.5 mm preload, stiffer by half: the starts are the ones of
+    # the sheet at preload 0 alone (the more common preload at the largest amplitude, then the
+    # nearest 0)
+    table = load_kdyn_table(TRAIN)
+    space = SearchSpace.from_table(table, "hydraulic")
+    both = KdynTable(*(np.concatenate([column, column]) for column in (
+        table.amplitude_mm, table.frequency_hz)), np.concatenate([table.preload_mm, table.preload_mm + 1.5]),
+        np.concatenate([table.kdyn_N_per_mm, 1.5 * table.kdyn_N_per_mm]),
+        np.concatenate([table.loss_angle_deg, table.loss_angle_deg]), np.concatenate([table.weight, table.weight]),
+        "two.csv")
+    assert table_start(both, space).parameters == table_start(table, space).parameters
 
 
 def test_one_amplitude_leaves_the_travel_to_the_box():
@@ -69,7 +83,7 @@ def test_one_amplitude_leaves_the_travel_to_the_box():
     one = _table([1.0] * 5, [2.0, 5.0, 8.0, 12.0, 30.0], [220.0, 200.0, 500.0, 700.0, 480.0],
                  [5.0, 20.0, 60.0, 30.0, 4.0])
     start = table_start(one, space)
-    assert "gap" not in start.parameters and "travel is left to the box" in start.missing
+    assert "gap" not in start.parameters and "single amplitude (1 mm)" in start.missing
 
 
 def test_a_model_without_a_track_and_no_table_give_no_start():
