@@ -26,7 +26,7 @@ sys.path.insert(0, {repo!r})
 import numpy as np
 from build_fmu import default_parameter_file
 from fmu_src.parameter_files import load_parameters
-from identification.simulate import simulate
+from identification.forward.simulate import simulate
 params = load_parameters(default_parameter_file({model!r}))
 t = np.arange(1000) * 1e-3
 x = 2.0 * np.sin(2 * np.pi * 10.0 * t)

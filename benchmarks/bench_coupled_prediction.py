@@ -38,8 +38,8 @@ import build_fmu  # noqa: E402
 from fmu_src.axes import SIX_AXES  # noqa: E402
 from fmu_src.parameter_files import save_six_axis  # noqa: E402
 from identification import fit, training_tests  # noqa: E402
-from identification.measurements import write_measurement  # noqa: E402
-from identification.multiaxis import write_multiaxis  # noqa: E402
+from identification.measured.measurements import write_measurement  # noqa: E402
+from identification.measured.multiaxis import write_multiaxis  # noqa: E402
 
 _spec = importlib.util.spec_from_file_location("coupled_references",
                                                REPO / "tests" / "references" / "generate_coupled_references.py")

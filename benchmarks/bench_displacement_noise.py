@@ -23,8 +23,8 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
 from fmu_src.parameter_files import load_parameters  # noqa: E402
-from identification.protocols import Step, sample_times  # noqa: E402
-from identification.simulate import simulate  # noqa: E402
+from identification.measured.signals import Step, sample_times  # noqa: E402
+from identification.forward.simulate import simulate  # noqa: E402
 
 RATE_HZ = 1000.0
 WINDOW_S = 0.05

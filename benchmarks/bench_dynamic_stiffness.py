@@ -23,7 +23,7 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
 from fmu_src.parameter_files import load_parameters  # noqa: E402
-from identification.dynamic_stiffness import characterise  # noqa: E402
+from identification.forward.dynamic_stiffness import characterise  # noqa: E402
 
 
 def timed(function, repeats):

@@ -7,7 +7,7 @@ On the paper's two tests (default: the synthetic Table 2 sine 2 mm/10 Hz and ste
 1 % force noise, ``data/synthetic_table2_noise1pct_*``), the default fit (``identification.fit``,
 preset ``default``, with its ensemble unless ``--no-ensemble``) runs with ``jacobian="difference"``
 (forward differences, what the fit did before) and ``jacobian="exact"`` (the forces'
-sensitivities, ``identification.fit_jacobian``), alternating, ``--repeats`` times each, in this
+sensitivities, ``identification.forward.parameter_jacobian``), alternating, ``--repeats`` times each, in this
 process (the compiled modules loaded before the first timing; each fit starts its own worker
 processes, which load them from the disk cache, as a fit does). Printed per run: wall time, CPU
 time (this process and the fit's workers: less sensitive than the wall time to other load on a
@@ -93,10 +93,10 @@ def main() -> None:
 
     import warnings
     from identification import fit, training_tests
-    from identification.fit_jacobian import sensitivity_module
-    from identification.fit_result import FitNotConvergedWarning
-    from identification.multistart import Problem, difference_jacobian, jacobian
-    from identification.objectives import Objective
+    from identification.forward.parameter_jacobian import sensitivity_module
+    from identification.fitting.result import FitNotConvergedWarning
+    from identification.fitting.multistart import Problem, difference_jacobian, jacobian
+    from identification.fitting.objectives import Objective
 
     warnings.simplefilter("ignore", FitNotConvergedWarning)
     tests = training_tests(sine=[args.sine], step=[args.step], rise_times_s=[args.rise_time])

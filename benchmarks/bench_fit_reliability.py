@@ -4,7 +4,7 @@
                                                [--workers N] [--json results.json]
 
 Truths: the paper's Tables 2, 4 and 5, then sets drawn uniformly in the search box of the
-documented bounds (``identification/search_space.py``, scaled as for Table 5's tests) and kept
+documented bounds (``identification/fitting/search_space.py``, scaled as for Table 5's tests) and kept
 only if they are plausible bushings (peak force 0.5-20 kN on the 2 mm/10 Hz sine, 2-30 %
 relaxation from the end of the step's ramp to 10 s) and lie inside the box scaled by their
 own tests (what a fit searches). Data: the paper's two training tests (sine 2 mm/10 Hz for 1 s;
@@ -40,11 +40,11 @@ sys.path.insert(0, str(REPO))
 
 from fmu_src.proposed_model import PARAMETER_NAMES  # noqa: E402
 from fmu_src.parameter_files import load_parameters  # noqa: E402
-from identification.measurements import Measurement  # noqa: E402
-from identification.protocols import Sine, Step, sample_times  # noqa: E402
-from identification.rig_tests import RigTest  # noqa: E402
-from identification.search_space import SearchSpace  # noqa: E402
-from identification.simulate import simulate  # noqa: E402
+from identification.measured.measurements import Measurement  # noqa: E402
+from identification.measured.signals import Sine, Step, sample_times  # noqa: E402
+from identification.measured.rig_tests import RigTest  # noqa: E402
+from identification.fitting.search_space import SearchSpace  # noqa: E402
+from identification.forward.simulate import simulate  # noqa: E402
 
 NOISE = 0.01
 FLOOR = 1.25
@@ -126,7 +126,7 @@ def training_data(params, noise_seed: int):
 
 
 def grid_cases():
-    from identification.report import grid_protocols
+    from identification.analysis.paper_verification import grid_protocols
     for name, protocol in grid_protocols():
         if name not in ("sine 2 mm 10 Hz", "step 2 mm rise 0.4 s"):
             yield name, protocol
@@ -134,8 +134,8 @@ def grid_cases():
 
 def judge(members, truth, sigma_N):
     """Worst grid NRMSE of the best member, and the band coverage where it misses > 1 %."""
-    from identification.objectives import nrmse
-    from identification.predict import predict
+    from identification.fitting.objectives import nrmse
+    from identification.analysis.predict import predict
     worst, coverages = 0.0, []
     for name, protocol in grid_cases():
         t = sample_times(protocol.duration_s, 1000.0)
@@ -151,7 +151,7 @@ def judge(members, truth, sigma_N):
 
 
 def run_default(tests, seed, workers):
-    from identification.fitting import fit
+    from identification.fitting.fit import fit
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         result = fit(tests, seed=seed, workers=workers, progress=False)
@@ -159,16 +159,16 @@ def run_default(tests, seed, workers):
 
 
 def _problem(tests):
-    from identification.multistart import Problem
-    from identification.objectives import Objective
+    from identification.fitting.multistart import Problem
+    from identification.fitting.objectives import Objective
     space = SearchSpace.from_measurements([t.measurement for t in tests], steps=[t.kind == "step" for t in tests])
     return Problem(Objective(tests), space)
 
 
 def _finish(problem, theta, tests):
-    from identification.fitting import _test_fits
+    from identification.fitting.fit import _test_fits
     from fmu_src.parameter_files import ParameterSet
-    from identification.noise import estimate_noise
+    from identification.measured.noise import estimate_noise
     params = dict(zip(PARAMETER_NAMES, map(float, problem.space.to_parameters(theta)[0])))
     fits = _test_fits(tests, [estimate_noise(t.measurement.force_N) for t in tests],
                       ParameterSet(problem.space.bushing, params))
@@ -178,8 +178,8 @@ def _finish(problem, theta, tests):
 def run_de(tests, seed, workers):
     """The previous default: differential evolution (rand1bin, 15 x 14 x 100), then a polish."""
     from scipy.optimize import differential_evolution
-    from identification.engine import SerialEngine
-    from identification.multistart import _least_squares_task
+    from identification.fitting.engine import SerialEngine
+    from identification.fitting.multistart import _least_squares_task
     problem = _problem(tests)
     bounds = problem.space.bounds()
     search = differential_evolution(lambda columns: problem.misfit(columns.T), bounds, vectorized=True,

@@ -5,7 +5,7 @@
 Makes a fleet of synthetic bushings (the paper's Tables 2, 4, 5, then Table 5 with four
 parameters moved by 10-30 %, seeded), each with the paper's two training tests (sine
 2 mm/10 Hz, step 2 mm/0.4 s held to 10 s) at 1 kHz with 1 % force noise and a tests.json, in a
-temporary folder; fits them with ``identification.fleet.fit_many`` (default preset, one
+temporary folder; fits them with ``identification.fitting.fleet.fit_many`` (default preset, one
 bushing per worker) and prints the time, the bushings per minute and each bushing's verdict.
 """
 from __future__ import annotations
@@ -25,9 +25,9 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
 from fmu_src.parameter_files import load_parameters  # noqa: E402
-from identification.measurements import write_measurement  # noqa: E402
-from identification.protocols import Sine, Step, sample_times  # noqa: E402
-from identification.simulate import simulate  # noqa: E402
+from identification.measured.measurements import write_measurement  # noqa: E402
+from identification.measured.signals import Sine, Step, sample_times  # noqa: E402
+from identification.forward.simulate import simulate  # noqa: E402
 
 
 def bushings(count: int):
@@ -59,7 +59,7 @@ def write_fleet(folder: Path, count: int) -> None:
 
 
 def main() -> None:
-    from identification.fleet import fit_many
+    from identification.fitting.fleet import fit_many
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--bushings", type=int, default=6)
     parser.add_argument("--workers", type=int, default=os.cpu_count())

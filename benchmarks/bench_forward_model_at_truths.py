@@ -7,7 +7,7 @@ training tests are made noise-free from the continuous-time truth (16 substeps p
 sample, as that benchmark does) and scored by the fit's objective at the true parameters,
 with the 1 % noise level the benchmark adds. Printed per truth, for the steps per sample the
 signal alone chooses and for the fit's refinement of them at the truth
-(``identification.refinement``, with the region's delta chi^2 at the floor): the steps per
+(``identification.fitting.refinement``, with the region's delta chi^2 at the floor): the steps per
 sample of the sine and the step, the sine's rms residual in noise levels, and chi^2 of the
 sine, of the step and in all. A perfect forward model scores 0.
 The total is how far above a perfect model the truth starts in every fit of its data: where it
@@ -29,13 +29,13 @@ sys.path.insert(0, str(REPO))
 sys.path.insert(0, str(REPO / "benchmarks"))
 
 from bench_fit_reliability import NOISE, TRAINING, load_or_draw_truths, truth_forces  # noqa: E402
-from identification.compiled_core import parameter_matrix  # noqa: E402
-from identification.ensemble import misfit_threshold  # noqa: E402
-from identification.measurements import Measurement  # noqa: E402
-from identification.noise import NoiseEstimate  # noqa: E402
-from identification.objectives import FAILED_RESIDUAL, FIT_MAX_SUBSTEPS, Objective  # noqa: E402
-from identification.refinement import refine_steps  # noqa: E402
-from identification.rig_tests import RigTest  # noqa: E402
+from identification.forward.population import parameter_matrix  # noqa: E402
+from identification.fitting.ensemble import misfit_threshold  # noqa: E402
+from identification.measured.measurements import Measurement  # noqa: E402
+from identification.measured.noise import NoiseEstimate  # noqa: E402
+from identification.fitting.objectives import FAILED_RESIDUAL, FIT_MAX_SUBSTEPS, Objective  # noqa: E402
+from identification.fitting.refinement import refine_steps  # noqa: E402
+from identification.measured.rig_tests import RigTest  # noqa: E402
 
 
 def chi2_at_truth(truth: dict) -> list[tuple]:

@@ -38,7 +38,7 @@ sys.path.insert(0, str(REPO))
 sys.path.insert(0, str(REPO / "benchmarks"))
 
 from fmu_src.parameter_files import load_parameters  # noqa: E402
-from identification.dynamic_stiffness import characterise  # noqa: E402
+from identification.forward.dynamic_stiffness import characterise  # noqa: E402
 
 _spec = importlib.util.spec_from_file_location("hydraulic_closed_form",
                                                REPO / "tests" / "references" / "hydraulic_closed_form.py")
@@ -105,7 +105,7 @@ def recovery(workers: int) -> None:
     import tempfile
     data = REPO / "data"
     train, sine = data / "kdyn_synthetic_hydraulic_train.csv", data / "synthetic_hydraulic_sine_1mm_8Hz.csv"
-    from identification.kdyn_table import load_kdyn_table
+    from identification.measured.kdyn_table import load_kdyn_table
     unseen = load_kdyn_table(data / "kdyn_synthetic_hydraulic_unseen.csv")
     with tempfile.TemporaryDirectory() as work:
         work = Path(work)

@@ -36,12 +36,12 @@ def main() -> None:
     from fmu_src.integration import StepError
     from fmu_src.proposed_model import MODEL, PARAMETER_NAMES
     from fmu_src.parameter_files import load_parameters
-    from identification.compiled_core import simulate_population_held
-    from identification.measurements import load_measurement
-    from identification.objectives import Objective
-    from identification.rig_tests import RigTest
-    from identification.protocols import Sine, sample_times
-    from identification.search_space import SearchSpace
+    from identification.forward.population import simulate_population_held
+    from identification.measured.measurements import load_measurement
+    from identification.fitting.objectives import Objective
+    from identification.measured.rig_tests import RigTest
+    from identification.measured.signals import Sine, sample_times
+    from identification.fitting.search_space import SearchSpace
     from python_core import simulate_python_core
 
     sine = load_measurement(REPO / "data" / "synthetic_table5_sine_2mm_10Hz.csv")

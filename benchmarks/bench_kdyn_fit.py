@@ -31,13 +31,13 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
 from fmu_src.parameter_files import load_parameters  # noqa: E402
-from identification.dynamic_stiffness import characterise  # noqa: E402
-from identification.kdyn_table import KdynTable  # noqa: E402
-from identification.measurements import Measurement  # noqa: E402
-from identification.objectives import nrmse  # noqa: E402
-from identification.protocols import Sine, Step, sample_times  # noqa: E402
-from identification.rig_tests import RigTest  # noqa: E402
-from identification.simulate import simulate  # noqa: E402
+from identification.forward.dynamic_stiffness import characterise  # noqa: E402
+from identification.measured.kdyn_table import KdynTable  # noqa: E402
+from identification.measured.measurements import Measurement  # noqa: E402
+from identification.fitting.objectives import nrmse  # noqa: E402
+from identification.measured.signals import Sine, Step, sample_times  # noqa: E402
+from identification.measured.rig_tests import RigTest  # noqa: E402
+from identification.forward.simulate import simulate  # noqa: E402
 
 TRAINING_AMPLITUDES_MM = (0.5, 1.0, 2.0, 3.0)
 TRAINING_FREQUENCIES_HZ = (1.0, 5.0, 10.0, 20.0, 30.0)
@@ -53,7 +53,7 @@ def main() -> None:
     parser.add_argument("--time-series-too", action="store_true",
                         help="also fit the truth's sine and step tests, for the time side by side")
     args = parser.parse_args()
-    from identification.fitting import fit
+    from identification.fitting.fit import fit
     truth = load_parameters(args.truth)
     rng = np.random.default_rng(2026)
     exact = characterise(truth, TRAINING_AMPLITUDES_MM, TRAINING_FREQUENCIES_HZ)

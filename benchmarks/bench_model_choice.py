@@ -16,7 +16,7 @@ file, the recommended model's NRMSE over that of a least-squares Kelvin-Voigt fi
 itself (the best linear bushing there) and over the Kelvin-Voigt trained on the same sine (target
 <= 0.5).
 
-Both run ``compare`` (identification.compare) with the default preset, seed 0, on every core, and
+Both run ``compare`` (identification.analysis.compare) with the default preset, seed 0, on every core, and
 print each model's fit time (target for the filled-rubber models: <= 3 min on 2 cores).
 """
 from __future__ import annotations
@@ -35,12 +35,12 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
 from fmu_src.bushing_models import MODEL_NAMES  # noqa: E402
-from identification.compare import compare_models  # noqa: E402
-from identification.kdyn_table import load_kdyn_table  # noqa: E402
-from identification.measurements import load_measurement  # noqa: E402
-from identification.objectives import nrmse  # noqa: E402
-from identification.rig_tests import training_tests  # noqa: E402
-from identification.search_space import KelvinVoigtFit  # noqa: E402
+from identification.analysis.compare import compare_models  # noqa: E402
+from identification.measured.kdyn_table import load_kdyn_table  # noqa: E402
+from identification.measured.measurements import load_measurement  # noqa: E402
+from identification.fitting.objectives import nrmse  # noqa: E402
+from identification.measured.rig_tests import training_tests  # noqa: E402
+from identification.fitting.search_space import KelvinVoigtFit  # noqa: E402
 
 DATA = REPO / "data"
 BRFD = DATA / "brfd"
@@ -100,7 +100,7 @@ def friction_damper(out: Path, models, ensemble: bool, held_out: bool = True) ->
 def prediction_error(result: dict, model: str, measurement) -> float:
     """NRMSE of ``model``'s fitted set (``compare``'s result) on ``measurement``: compare's own
     figure where it scored the file, else simulated here."""
-    from identification.simulate import simulate
+    from identification.forward.simulate import simulate
     name = Path(measurement.source).name
     if (name, model) in result["errors"]:
         return result["errors"][name, model][0]

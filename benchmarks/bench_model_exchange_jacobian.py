@@ -4,7 +4,7 @@
 
 Builds each model's native FMU (FMI 2.0, default parameters: Table 5 for the proposed model) and
 integrates its model-exchange states with scipy's implicit solvers (``Radau`` and ``BDF``, the
-classes behind ``solve_ivp``) on the paper's sine (2 mm, 10 Hz, ``identification.protocols.Sine``;
+classes behind ``solve_ivp``) on the paper's sine (2 mm, 10 Hz, ``identification.measured.signals.Sine``;
 the FMU takes metres): the inputs x(t), v(t) are set at the exact time of every right-hand side,
 the right-hand side is ``fmi2GetDerivatives``. Each method and tolerance runs twice in one process:
 once with the Jacobian d der(states)/d states from the FMU (``fmi2GetDirectionalDerivative``, one
@@ -55,7 +55,7 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
 import build_fmu  # noqa: E402
-from identification.protocols import Sine  # noqa: E402
+from identification.measured.signals import Sine  # noqa: E402
 
 SINE = Sine(2.0, 10.0, 1.0)                     # the paper's sine: 2 mm, 10 Hz, mm and s
 SOLVERS = {"Radau": Radau, "BDF": BDF}

@@ -3,9 +3,9 @@
     python benchmarks/bench_sensitivity_ranks.py
 
 The sensitivity of each measure (the 10 Hz sine's rms force, the step's force at the end of its
-rise and at 10 s) to a 10 % change of each parameter of Table 5 (identification.sensitivity),
+rise and at 10 s) to a 10 % change of each parameter of Table 5 (identification.analysis.parameter_sensitivity),
 ranked, against the ranks the paper computed in ADAMS (Tables 1 and 3, typed in
-identification.sensitivity.PAPER_RANKS); prints Spearman's rho per measure and the parameter
+identification.analysis.parameter_sensitivity.PAPER_RANKS); prints Spearman's rho per measure and the parameter
 ranked first. tests/test_identification.py asserts rho > 0.7 and the first ranks.
 """
 from __future__ import annotations
@@ -22,7 +22,7 @@ sys.path.insert(0, str(REPO))
 
 from fmu_src.parameter_files import load_parameters  # noqa: E402
 from fmu_src.proposed_model import PARAMETER_NAMES  # noqa: E402
-from identification.sensitivity import MEASURES, PAPER_RANKS, sensitivity  # noqa: E402
+from identification.analysis.parameter_sensitivity import MEASURES, PAPER_RANKS, sensitivity  # noqa: E402
 
 
 def main() -> None:

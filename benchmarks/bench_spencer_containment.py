@@ -7,7 +7,7 @@ Fits the proposed model (default preset, with the ensemble) on data/synthetic_sp
 and data/synthetic_spencer_step_2mm_rise0.4s.csv (made from data/params_spencer_fit_synthetic_table5.json,
 0.5 % noise: docs/data.md), prints the fit's summary (training NRMSE against the noise), then its
 errors against Spencer's noise-free forces over the paper's §5 grid and the random input
-(identification.report.grid_errors), with the ensemble's band width. docs/models.md quotes it.
+(identification.analysis.paper_verification.grid_errors), with the ensemble's band width. docs/models.md quotes it.
 """
 from __future__ import annotations
 
@@ -21,9 +21,9 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
 from fmu_src.parameter_files import load_parameters  # noqa: E402
-from identification.fitting import fit  # noqa: E402
-from identification.report import format_errors, grid_errors  # noqa: E402
-from identification.rig_tests import training_tests  # noqa: E402
+from identification.fitting.fit import fit  # noqa: E402
+from identification.analysis.paper_verification import format_errors, grid_errors  # noqa: E402
+from identification.measured.rig_tests import training_tests  # noqa: E402
 
 DATA = REPO / "data"
 

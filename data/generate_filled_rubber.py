@@ -30,8 +30,8 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
 sys.path.insert(0, str(HERE.parent / "tests" / "references"))
 import filled_rubber  # noqa: E402  (the independent equations)
-from identification.measurements import write_measurement  # noqa: E402
-from identification.protocols import Random, Sine, Step, sample_times  # noqa: E402
+from identification.measured.measurements import write_measurement  # noqa: E402
+from identification.measured.signals import Random, Sine, Step, sample_times  # noqa: E402
 
 PARAMETERS = HERE / "params_fractional_filled_rubber.json"
 PREFIX = "synthetic_filled_rubber"

@@ -31,11 +31,11 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
 from fmu_src.parameter_files import load_parameters  # noqa: E402
-from identification.dynamic_stiffness import characterise  # noqa: E402
-from identification.kdyn_table import write_kdyn_table  # noqa: E402
-from identification.measurements import write_measurement  # noqa: E402
-from identification.protocols import Sine, sample_times  # noqa: E402
-from identification.simulate import simulate  # noqa: E402
+from identification.forward.dynamic_stiffness import characterise  # noqa: E402
+from identification.measured.kdyn_table import write_kdyn_table  # noqa: E402
+from identification.measured.measurements import write_measurement  # noqa: E402
+from identification.measured.signals import Sine, sample_times  # noqa: E402
+from identification.forward.simulate import simulate  # noqa: E402
 
 PARAMETERS = HERE / "params_hydraulic_mount.json"
 TRAINING_AMPLITUDES_MM = (0.1, 0.5, 2.0)

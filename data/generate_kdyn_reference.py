@@ -1,6 +1,6 @@
 """Generate data/kdyn_table5_table6_grid.csv: the dynamic stiffness and loss angle of the paper's
 Table 5 parameter set on the grid of its Table 6 (0.5-3 mm, 1-30 Hz), computed by this project
-(``identification.dynamic_stiffness``; SYNTHETIC, not measured). tests/test_dynamic_stiffness.py
+(``identification.forward.dynamic_stiffness``; SYNTHETIC, not measured). tests/test_dynamic_stiffness.py
 recomputes it, so that a change in the numbers shows in review.
 
     python data/generate_kdyn_reference.py
@@ -14,7 +14,7 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
 from fmu_src.parameter_files import load_parameters  # noqa: E402
-from identification.dynamic_stiffness import STEPS_PER_CYCLE, TOLERANCE, characterise  # noqa: E402
+from identification.forward.dynamic_stiffness import STEPS_PER_CYCLE, TOLERANCE, characterise  # noqa: E402
 
 AMPLITUDES_MM = (0.5, 1.0, 2.0, 3.0)
 FREQUENCIES_HZ = (1.0, 10.0, 20.0, 30.0)

@@ -32,9 +32,9 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
 from fmu_src.parameter_files import read_parameter_set  # noqa: E402
-from identification.measurements import write_measurement  # noqa: E402
-from identification.protocols import Random, Sine, Step, sample_times  # noqa: E402
-from identification.simulate import simulate  # noqa: E402
+from identification.measured.measurements import write_measurement  # noqa: E402
+from identification.measured.signals import Random, Sine, Step, sample_times  # noqa: E402
+from identification.forward.simulate import simulate  # noqa: E402
 
 SAMPLE_RATE_HZ = 1000.0
 FORCE_NOISE_FRACTION = 0.005

@@ -17,7 +17,7 @@ import numpy as np
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
-from identification.protocols import Sine, Step, sample_times  # noqa: E402
+from identification.measured.signals import Sine, Step, sample_times  # noqa: E402
 
 STEP_S = 1e-3
 

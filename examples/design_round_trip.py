@@ -4,7 +4,7 @@
 
 1. Fit the paper's two training tests made from Table 2 with 1 % force noise
    (``data/synthetic_table2_noise1pct_{sine_2mm_10Hz,step_2mm_rise0.4s}.csv``), with its ensemble.
-2. Ask ``identification.design`` for the next test; make that test from the truth with 1 % noise
+2. Ask ``identification.analysis.design`` for the next test; make that test from the truth with 1 % noise
    (``data/generate_synthetic.py``, as a rig would measure it; written to the output folder).
 3. Refit on the three tests.
 Prints the §5 grid (and the random input) against the noise-free truth before and after, and
@@ -25,9 +25,9 @@ sys.path.insert(0, str(REPO / "data"))
 from fmu_src.parameter_files import load_parameters  # noqa: E402
 from generate_synthetic import generate, named_protocols  # noqa: E402
 from identification import FitNotConvergedWarning, fit, training_tests  # noqa: E402
-from identification.design import design  # noqa: E402
+from identification.analysis.design import design  # noqa: E402
 from identification.extras import require_or_exit  # noqa: E402
-from identification.report import grid_errors  # noqa: E402
+from identification.analysis.paper_verification import grid_errors  # noqa: E402
 
 DATA = REPO / "data"
 TRUTH = DATA / "params_table2_sine.json"

@@ -26,8 +26,8 @@ sys.path.insert(0, str(REPO))
 
 from fmu_src.parameter_files import load_parameters  # noqa: E402
 from identification import load_measurement, predict  # noqa: E402
-from identification.fmu_input import fmu_input, simulate_measurement, table_step  # noqa: E402
-from identification.objectives import nrmse  # noqa: E402
+from identification.analysis.fmu_input import fmu_input, simulate_measurement, table_step  # noqa: E402
+from identification.fitting.objectives import nrmse  # noqa: E402
 
 PARAMS = REPO / "data" / "params_fit_brfd_sine_0.5Hz_1in.json"
 MEASUREMENT = REPO / "data" / "brfd" / "sine_0.5Hz30lbtension1amplitude.csv.gz"

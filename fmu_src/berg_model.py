@@ -207,7 +207,7 @@ SEARCH = SearchBox(
 amplitude, the cubic term as k3*X^2/k_ref (0 to 2: up to twice k_ref's force added at the largest
 amplitude X); the second Maxwell element is the slower one (its time constant c2/k2 is
 10^(0..6) times c1/k1), so the two are never the same optimum twice. The spring and the friction
-have starts from the data's slowest loop (identification/loop_start.py)."""
+have starts from the data's slowest loop (identification/fitting/loop_start.py)."""
 
 
 MODEL = BushingModel(

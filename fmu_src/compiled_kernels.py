@@ -31,7 +31,7 @@ anything else):
 
 Users: the FMU (:func:`compiled_model`, when numba is importable in the host's Python; the slave
 falls back to the plain-Python kernels otherwise) and the identification
-(``identification/compiled_core.py``, which appends its population loop). Numba is optional
+(``identification/forward/population.py``, which appends its population loop). Numba is optional
 here: nothing imports it until a model is compiled.
 """
 from __future__ import annotations

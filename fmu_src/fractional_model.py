@@ -224,7 +224,7 @@ SEARCH = SearchBox(
     loop_start=SlowLoop(("k0", "k3"), "Ff_max", "x2", (("b", 0.0), ("alpha", 0.5))))
 """The fit's box: as Berg's for the spring and the friction; alpha within (0.02, 0.98) and b as
 log10(b/(k_ref*tau_ref^alpha)), the element's |K*| at the data's own time scale in units of k_ref;
-the spring and the friction have starts from the data's slowest loop (identification/loop_start.py)."""
+the spring and the friction have starts from the data's slowest loop (identification/fitting/loop_start.py)."""
 
 
 def _mode_states():

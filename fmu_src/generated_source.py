@@ -1,7 +1,7 @@
 """Checks on a generated module's source before it is compiled: every name a function reads is bound.
 
 The generated modules (``compiled_kernels``: a model's kernels with the FMU's batched step;
-``identification.compiled_core``: the population loop; ``identification.fit_jacobian``: the loop
+``identification.forward.population``: the population loop; ``identification.forward.parameter_jacobian``: the loop
 with the kernels' tangents) are put together from templates, functions written in their home
 module that read names only the generated module defines (``prepare``, ``step_prepared``,
 ``_VALUES``, ``_STORE`` ...). A name left unbound would surface only when numba first types the

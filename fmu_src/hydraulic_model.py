@@ -201,7 +201,7 @@ SEARCH = SearchBox(
 cf/(2*sqrt((kb + kc)*mf)) (1e-3 to 3, log10), the turbulent damping against the data's
 c_ref^2/(k_ref*x_ref) and the decoupler's gap against the largest amplitude, log10 both. A data
 sheet gives starts for the track, the bulge, the bellows, the static spring and the gap
-(identification/table_start.py)."""
+(identification/fitting/table_start.py)."""
 
 
 MODEL = BushingModel(

@@ -35,7 +35,7 @@ writes its equations as five kernels and uses the pieces below to step them:
 
 Kernels are plain float arithmetic that raise nothing and report errors as status codes (OK,
 TOO_MANY_SUBSTEPS, NOT_FINITE), so that the identification compiles these same functions with
-numba (``identification/compiled_core.py``) and the native FMU translates them into C.
+numba (``identification/forward/population.py``) and the native FMU translates them into C.
 
 Units (the paper's): displacements in mm, velocities in mm/s, hysteretic forces in N, time in s.
 """

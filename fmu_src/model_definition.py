@@ -26,12 +26,12 @@ themselves. ``derivatives``, ``switches`` and ``update`` are for a host that int
 at an event, for a model whose state jumps there: a friction element's reversal). The step protocol that
 every path runs is ``integration.step`` (``BushingModel.step``).
 Kernels are plain float arithmetic that raise nothing and return status codes
-(``integration.OK`` ...), so that ``identification/compiled_core.py`` compiles the same
+(``integration.OK`` ...), so that ``identification/forward/population.py`` compiles the same
 source with numba (every function the module defines) and ``native/python_to_c.py`` translates
 it into C. The shared machinery they step with is ``integration``.
 
 Beside the equations a model module declares how the fit searches its parameters
-(``SearchBox``, read by ``identification.search_space``) and how plots draw it
+(``SearchBox``, read by ``identification.fitting.search_space``) and how plots draw it
 (``plot_style``); the registry (``bushing_models``) finds the module by its name, ``*_model``.
 """
 from __future__ import annotations
@@ -120,7 +120,7 @@ class SearchCoordinate:
 class SlowLoop:
     """A progressive spring k0*x + k3*x^3 and Berg's friction (limit Ff_max, half-travel x2) in
     parallel with a model's rate-dependent part, which the fit estimates from the data's slowest
-    sine loop for some of its starts (``identification.loop_start``). ``spring``: the names of
+    sine loop for some of its starts (``identification.fitting.loop_start``). ``spring``: the names of
     the spring's linear and cubic stiffness; ``friction_limit``, ``travel``: the friction's;
     ``friction_alone``: (name, value) of every other parameter at a value that leaves the model's
     force the friction alone (its limit 1 N and the spring 0 are set by the loop), so that the
@@ -146,7 +146,7 @@ class TrackStart:
     """A fluid column (an inertia track of mass ``mass``, damping ``damping``) that resonates
     against a bulge stiffness ``stiffness`` and a chamber stiffness ``compliance``, in parallel with
     a static spring ``static``, behind a decoupler of free travel ``travel`` ("" if none): the fit
-    reads their starts off a dynamic-stiffness table's resonance (``identification.table_start``)."""
+    reads their starts off a dynamic-stiffness table's resonance (``identification.fitting.table_start``)."""
     static: str
     stiffness: str
     compliance: str
@@ -278,7 +278,7 @@ class BushingModel:
     settling_s: float = 0.0
     """The time [s] a sine from rest takes to settle, at least (0: a few cycles do): the fit's
     fixed loop on a dynamic-stiffness table runs each row this long or its cycles, whichever is
-    more (``identification.objectives.PreparedTable``)."""
+    more (``identification.fitting.objectives.PreparedTable``)."""
     coupled: CoupledKernels | None = None
     """The model on a displacement vector (a coupled group of axes); None: it has none (it acts
     on each axis alone: Kelvin-Voigt, whose linear elements couple nothing)."""

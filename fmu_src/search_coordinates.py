@@ -14,7 +14,7 @@ parameter; its ``kind`` is one of the objects here. Each kind holds, together:
 - ``floor_is_search_limit``: whether the lower bound is a limit of the search rather than a
   physical one a fit may rightly sit on (``FitResult.at_box_edge``).
 
-``scales`` is the ``identification.search_space.SearchSpace`` (duck-typed: k_ref [N/mm], c_ref
+``scales`` is the ``identification.fitting.search_space.SearchSpace`` (duck-typed: k_ref [N/mm], c_ref
 [N*s/mm], F_ref [N], x_ref [mm], tau_ref = c_ref/k_ref [s], ``shortest_time_constant_s`` and
 ``time_constant(values, dashpot)``); ``values`` maps each parameter to its column of values.
 """

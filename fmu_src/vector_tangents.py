@@ -35,7 +35,7 @@ their names: ``d_...`` and ``_td...`` hold tangents, nothing else does):
   the bodies rewritten.
 
 The result is plain Python of the kernels' subset (tuples, arithmetic, ``if``), which numba
-compiles (``identification/fit_jacobian.py``); lane k equals what the one-direction tangent
+compiles (``identification/forward/parameter_jacobian.py``); lane k equals what the one-direction tangent
 computes for direction k to rounding (the same derivative, its terms summed in another order:
 tested to 1e-10), and the value is the kernel's bit for bit (its statements untouched).
 """

@@ -26,26 +26,22 @@ A ``model`` (``fit``, ``simulate``, ``predict``, ``characterise``, ``compare.com
 model's name or the model itself (a ``BushingModel``, ``fmu_src.bushing_models.get_model``):
 resolved once at the front door, the model object is what the modules below pass on.
 
-The modules, in the order of the workflow:
+The subpackages, in the order of the workflow (each ``__init__`` names its modules and what
+they may import):
 
-- reading the tests: ``measurements`` (CSV files), ``rig_tests`` (which file is which test, the
-  manifest), ``multiaxis`` (tests along two or three axes at once, and their coupling), ``kdyn_table`` (the dynamic-stiffness table's CSV file, read and written), ``noise`` (each test's noise
-  level), ``protocols`` (the paper's test signals);
-- the forward model: ``simulate`` (the front door), ``parameter_input`` (what counts as
-  parameters), ``forward_model`` (the input between samples), ``compiled_core`` and
-  ``steady_state`` (the models' kernels, compiled per model), ``refinement`` (finer steps where
-  needed) and ``fit_jacobian`` (the forces' sensitivities to the parameters, computed with them);
-- fitting: ``fitting`` (``fit``), ``fit_result`` (what it returns), ``presets``, ``search_space``
-  (the box), ``loop_start`` (starts from a slow loop), ``table_start`` (starts from a data sheet),
-  ``objectives`` (the misfit), ``multistart``
-  (screening and least-squares stages),
-  ``ensemble`` (how sure), ``engine`` (where tasks run), ``progress``, ``fleet`` (many bushings);
-- analysis: ``predict`` (force and band), ``fmu_input`` (a measurement as an FMU's input), ``dynamic_stiffness`` (data sheet), ``design`` (the next
-  test), ``sensitivity``, ``report`` (the paper's §5 tables), ``compare`` (fit every model, recommend one),
-  ``six_axis`` (one file from six fits), ``plots``;
-- the command line: ``cli`` (arguments), ``commands`` (what each does), ``interrupt`` (Ctrl-C and
-  SIGTERM: one line, exit 130/143, outputs whole or untouched), ``extras``, ``errors`` (every error
-  and warning type).
+- ``measured``: the measured data (one-axis and multi-axis CSV tests, the rig tests and their
+  manifest, data-sheet tables, noise levels, the paper's test signals);
+- ``forward``: the forward model (``simulate``, the input path, the compiled population loop,
+  the sine loop, ``characterise``, the forces' derivatives);
+- ``fitting``: ``fit`` and what it returns, the search box, starts, objective, multistart,
+  ensemble, where tasks run, progress, fleets;
+- ``analysis``: predictions and their bands, the next test, sensitivities, ``compare``, the
+  paper's verification tables, plots;
+- ``cli``: the command line.
+
+Beside them, what every subpackage may use: ``errors`` (every error and warning type),
+``extras`` (the one-line error that names a missing extra) and ``interrupt`` (Ctrl-C and
+SIGTERM: one line, exit 130/143, outputs whole or untouched).
 """
 from identification.interrupt import exit_quietly_on_early_ctrl_c
 
@@ -54,15 +50,15 @@ exit_quietly_on_early_ctrl_c()   # first: before the imports below take their se
 from fmu_src.bushing_params import ParameterError  # noqa: E402
 from fmu_src.parameter_files import (ParameterEnsemble, ParameterSet, read_ensemble, read_parameter_set,  # noqa: E402
                                      save_ensemble, save_parameters)
-from identification.dynamic_stiffness import characterise  # noqa: E402
+from identification.forward.dynamic_stiffness import characterise  # noqa: E402
 from identification.errors import FitNotConvergedWarning, IdentificationError, MeasurementError, MissingExtraError  # noqa: E402
-from identification.fit_result import FitResult  # noqa: E402
-from identification.fitting import fit  # noqa: E402
-from identification.fmu_input import fmu_input, simulate_measurement  # noqa: E402
-from identification.measurements import load_measurement  # noqa: E402
-from identification.predict import predict  # noqa: E402
-from identification.rig_tests import RigTest, load_manifest, training_tests  # noqa: E402
-from identification.simulate import simulate  # noqa: E402
+from identification.fitting.result import FitResult  # noqa: E402
+from identification.fitting.fit import fit  # noqa: E402
+from identification.analysis.fmu_input import fmu_input, simulate_measurement  # noqa: E402
+from identification.measured.measurements import load_measurement  # noqa: E402
+from identification.analysis.predict import predict  # noqa: E402
+from identification.measured.rig_tests import RigTest, load_manifest, training_tests  # noqa: E402
+from identification.forward.simulate import simulate  # noqa: E402
 
 __all__ = ["fit", "FitResult", "FitNotConvergedWarning", "simulate", "predict", "characterise", "load_measurement",
            "fmu_input", "simulate_measurement",

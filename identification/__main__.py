@@ -1,7 +1,7 @@
-"""``python -m identification``: the command line of ``identification.cli``."""
+"""``python -m identification``: the command line of ``identification.cli.arguments``."""
 import sys
 
-from identification.cli import main
+from identification.cli.arguments import main
 
 if __name__ == "__main__":
     sys.exit(main())

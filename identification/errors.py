@@ -5,10 +5,10 @@ one-line ``error: ...`` with exit status 2; anything else is a bug and keeps its
 warnings say what a result's reader must know; the command line prints them as one line each.
 
 The modules that raise them re-export them under their old names
-(``identification.measurements.MeasurementError``, ``identification.rig_tests.ManifestError``,
-``identification.fit_result.FitNotConvergedWarning``, ``identification.engine.EngineError``,
-``identification.extras.MissingExtraError``, ``identification.commands.UsageError``,
-``identification.dynamic_stiffness.CharacterisationWarning``), and ``identification`` exports
+(``identification.measured.measurements.MeasurementError``, ``identification.measured.rig_tests.ManifestError``,
+``identification.fitting.result.FitNotConvergedWarning``, ``identification.fitting.engine.EngineError``,
+``identification.extras.MissingExtraError``, ``identification.cli.commands.UsageError``,
+``identification.forward.dynamic_stiffness.CharacterisationWarning``), and ``identification`` exports
 the ones a user catches. This module imports nothing from the package (every module may import it).
 """
 
@@ -35,12 +35,12 @@ class ManifestError(MeasurementError):
 
 class UsageError(Exception):
     """A command-line option with a value that cannot be used. Raised by the commands of
-    ``python -m identification`` (``identification.commands``) before any work, e.g. for an
+    ``python -m identification`` (``identification.cli.commands``) before any work, e.g. for an
     output path that cannot be written or options that contradict each other."""
 
 
 class EngineError(RuntimeError):
-    """The engine cannot run tasks. Raised by ``identification.engine`` when the Dask scheduler
+    """The engine cannot run tasks. Raised by ``identification.fitting.engine`` when the Dask scheduler
     cannot be reached within the timeout, has no workers, has workers with more than one thread,
     or has had no worker for too long during a fit."""
 

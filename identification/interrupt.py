@@ -1,9 +1,9 @@
 """Stopping a command from outside: Ctrl-C (SIGINT) and SIGTERM (``timeout``, a batch
 scheduler's cancel, ``docker stop``, systemd).
 
-The command line (``identification.cli.main``) runs each command under :func:`signals_raise`:
+The command line (``identification.cli.arguments.main``) runs each command under :func:`signals_raise`:
 either signal raises :class:`Interrupted` in the main thread, the engines terminate their
-workers on the way out (``identification.engine``), and ``main`` prints one line, ``interrupted:
+workers on the way out (``identification.fitting.engine``), and ``main`` prints one line, ``interrupted:
 nothing written`` or the files already written (:func:`record_written`), and returns 128 + the
 signal's number (130, 143), the shell's convention for a command ended by a signal.
 

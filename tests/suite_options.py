@@ -60,7 +60,7 @@ def rounding_variant(config):
     relative, offset = config.getoption("--perturb-force"), config.getoption("--seed-offset")
     with pytest.MonkeyPatch.context() as patch:
         if relative:
-            from identification.rig_tests import RigTest
+            from identification.measured.rig_tests import RigTest
             made = RigTest.__post_init__
 
             def perturbed(test):
@@ -71,7 +71,7 @@ def rounding_variant(config):
 
             patch.setattr(RigTest, "__post_init__", perturbed)
         if offset:
-            from identification import fitting
+            from identification.fitting import fit as fitting
             search = fitting._search
 
             def offset_seed(*args, **kwargs):

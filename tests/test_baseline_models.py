@@ -13,9 +13,9 @@ from scipy.integrate import solve_ivp
 from fmu_src.bushing_models import MODELS, get_model
 from fmu_src.bushing_params import ParameterError
 from fmu_src.parameter_files import load_parameters, read_parameter_set, save_parameters
-from identification.compiled_core import simulate_model_held
-from identification.protocols import Sine, Step, sample_times
-from identification.search_space import SearchSpace, _rescale_block
+from identification.forward.population import simulate_model_held
+from identification.measured.signals import Sine, Step, sample_times
+from identification.fitting.search_space import SearchSpace, _rescale_block
 
 SPENCER = {"c0": 4.0, "k0": 150.0, "c1": 250.0, "k1": 900.0, "x0": 0.2, "alpha": 1.0, "A": 1800.0,
            "beta": -4.0, "gamma": 11.0, "n": 0.7}
@@ -129,8 +129,8 @@ def test_kelvin_voigt_is_exactly_linear():
 
 def test_kelvin_voigts_linear_fit_is_numpys_least_squares_and_stays_in_its_ranges():
     # BushingModel.linear: F = k*x + c*v by least squares; a force whose best c is negative gets c = 0
-    from identification.fitting import linear_solution
-    from identification.measurements import Measurement
+    from identification.fitting.fit import linear_solution
+    from identification.measured.measurements import Measurement
     t, x, v = secant_input(Sine(2.0, 10.0), 0.5)
     noise = np.random.default_rng(0).normal(0.0, 5.0, t.size)
     for k, c in ((1234.5, 6.78), (900.0, -0.5)):

@@ -12,7 +12,7 @@ import pytest
 from fmpy import extract, read_model_description
 
 from conftest import paper_parameters
-from identification.protocols import Sine
+from identification.measured.signals import Sine
 from python_core import simulate_python_core
 
 HOST_SOURCE = Path(__file__).with_name("c_host") / "fmi2_host.c"

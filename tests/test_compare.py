@@ -1,4 +1,4 @@
-"""Choosing the model (identification.compare): the recommendation rule on hand-made assessments,
+"""Choosing the model (identification.analysis.compare): the recommendation rule on hand-made assessments,
 and `compare` through the command line on the synthetic filled-rubber bushing."""
 import csv
 import math
@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from identification.__main__ import main
-from identification.compare import Assessment, recommend
-from identification.fit_result import TableFit
+from identification.analysis.compare import Assessment, recommend
+from identification.fitting.result import TableFit
 
 DATA = Path(__file__).resolve().parents[1] / "data"
 FILLED = DATA / "synthetic_filled_rubber"

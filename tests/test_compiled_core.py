@@ -5,8 +5,8 @@ import pytest
 from conftest import paper_parameters
 from fmu_src.bushing_models import MODELS
 from fmu_src.proposed_model import PARAMETER_NAMES
-from identification.compiled_core import simulate_population_held
-from identification.protocols import Random, Sine, sample_times
+from identification.forward.population import simulate_population_held
+from identification.measured.signals import Random, Sine, sample_times
 from test_fmu_numerics import simulate_with_fmpy
 
 
@@ -77,7 +77,7 @@ def test_compiled_forces_equal_the_python_kernels_bitwise_for_every_model(model)
 
 CACHE_PROBE = """
 import numpy as np
-from identification import compiled_core
+from identification.forward import population as compiled_core
 t = np.linspace(0.0, 0.02, 21)
 compiled_core.simulate_population_held([dict(zip(compiled_core.PARAMETER_NAMES, [1.0] * 16))], t, t, np.ones_like(t))
 module = compiled_core.compiled_model("proposed")
@@ -109,7 +109,7 @@ def test_the_compiled_model_is_cached_on_disk_for_the_next_process(tmp_path):
 
 SPENCER_PROBE = """
 import numpy as np
-from identification import compiled_core
+from identification.forward import population as compiled_core
 t = np.linspace(0.0, 0.02, 21)
 values = {"c0": 1.0, "k0": 1.0, "c1": 1.0, "k1": 100.0, "x0": 0.0, "alpha": 1.0, "A": 1.0, "beta": 0.5,
           "gamma": 0.5, "n": 2.0}

@@ -10,7 +10,7 @@ sys.path.insert(0, str(REPO / "examples" / "cosim"))
 
 import shaker_rig  # noqa: E402
 from fmu_src.parameter_files import load_parameters  # noqa: E402
-from identification.compiled_core import simulate_population_held  # noqa: E402
+from identification.forward.population import simulate_population_held  # noqa: E402
 
 STEP = 1e-3
 STOP = 0.15

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from conftest import DATA
-from identification.measurements import MeasurementError, MeasurementWarning, load_measurement
+from identification.measured.measurements import MeasurementError, MeasurementWarning, load_measurement
 
 BRFD = DATA / "brfd"
 MM_PER_IN = 25.4
@@ -117,7 +117,7 @@ def test_a_file_that_is_not_what_its_name_says_is_refused_with_its_name(tmp_path
 
 
 def test_measurement_name_drops_the_csv_and_gz_suffixes():
-    from identification.measurements import measurement_name
+    from identification.measured.measurements import measurement_name
     assert measurement_name("data/brfd/sine_1Hz30lbtension1amplitude.csv.gz") == "sine_1Hz30lbtension1amplitude"
     assert measurement_name("x/run_2.CSV") == "run_2"
     assert measurement_name("rig.txt") == "rig.txt"

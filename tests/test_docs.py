@@ -67,10 +67,10 @@ def test_mkdocs_builds_strict(tmp_path):
     assert not list((tmp_path / "site").rglob("*.py")), "the docs' hooks are copied into the site"
 
 
-API_OBJECTS = ("identification.fit", "identification.FitResult", "identification.compare.compare_models",
-               "identification.compare.recommend", "identification.fleet.fit_many",
-               "identification.simulate.simulate", "identification.predict.predict", "identification.characterise",
-               "identification.kdyn_table.KdynTable", "identification.load_measurement", "identification.training_tests",
+API_OBJECTS = ("identification.fit", "identification.FitResult", "identification.analysis.compare.compare_models",
+               "identification.analysis.compare.recommend", "identification.fitting.fleet.fit_many",
+               "identification.forward.simulate.simulate", "identification.analysis.predict.predict", "identification.characterise",
+               "identification.measured.kdyn_table.KdynTable", "identification.load_measurement", "identification.training_tests",
                "fmu_src.parameter_files.read_parameter_set", "fmu_src.parameter_files.save_parameters",
                "build_fmu.build_fmu", "build_fmu.build_native_fmu", "fmu_src.model_definition.BushingModel",
                "fmu_src.bushing_models.get_model")

@@ -1,4 +1,4 @@
-"""Dynamic stiffness and loss angle (identification.dynamic_stiffness) against closed forms,
+"""Dynamic stiffness and loss angle (identification.forward.dynamic_stiffness) against closed forms,
 a converged scipy solution of eqs. 1-5, and the reference table kept in data/."""
 from __future__ import annotations
 
@@ -13,12 +13,12 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from fmu_src.parameter_files import load_parameters, read_ensemble, save_ensemble
-from identification.cli import main
-from identification.dynamic_stiffness import COLUMNS, CharacterisationWarning, characterise
-from identification.compiled_core import parameter_matrix
+from identification.cli.arguments import main
+from identification.forward.dynamic_stiffness import COLUMNS, CharacterisationWarning, characterise
+from identification.forward.population import parameter_matrix
 from identification.errors import IdentificationError
-from identification.kdyn_table import KDYN_UNCERTAINTY, LOSS_ANGLE_UNCERTAINTY_DEG, KdynTable, load_kdyn_table
-from identification.objectives import Objective
+from identification.measured.kdyn_table import KDYN_UNCERTAINTY, LOSS_ANGLE_UNCERTAINTY_DEG, KdynTable, load_kdyn_table
+from identification.fitting.objectives import Objective
 
 REPO = Path(__file__).resolve().parents[1]
 TABLE5 = load_parameters(REPO / "data" / "params_table5_combined.json")
@@ -224,7 +224,7 @@ def test_the_command_line_table_reads_back_identically(tmp_path, capsys):
     load_kdyn_table reads: the case bit for bit, |K*| and delta the very numbers written
     (kdyn_table.NUMBER_FORMAT), within its 10 digits of the computed table; the file is the one
     DynamicStiffness.to_csv writes, byte for byte."""
-    from identification.kdyn_table import NUMBER_FORMAT, ensemble_columns
+    from identification.measured.kdyn_table import NUMBER_FORMAT, ensemble_columns
     softer = dict(TABLE5, k0=0.8 * TABLE5["k0"], c0=1.5 * TABLE5["c0"])
     ensemble = save_ensemble(tmp_path / "e.json", [TABLE5, softer])
     out = tmp_path / "kdyn.csv"

@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 
 from identification.__main__ import main
-from identification.engine import SerialEngine
-from identification.ensemble import ProfileProblem, _profile_task, identifiability
-from identification.multistart import (EXACT_JACOBIAN_LIMIT, StartRecord, _least_squares_task, exact_usable,
+from identification.fitting.engine import SerialEngine
+from identification.fitting.ensemble import ProfileProblem, _profile_task, identifiability
+from identification.fitting.multistart import (EXACT_JACOBIAN_LIMIT, StartRecord, _least_squares_task, exact_usable,
                                        failed_starts, jacobian, run_stages)
 
 DATA = Path(__file__).resolve().parents[1] / "data"
@@ -110,7 +110,7 @@ class _Probe:
 
 @pytest.mark.parametrize("kind", ["difference", "exact"])
 def test_a_profile_whose_probe_is_not_finite_fails_without_raising(monkeypatch, kind):
-    import identification.ensemble as ensemble
+    import identification.fitting.ensemble as ensemble
     monkeypatch.setattr(ensemble, "ProbeMeasure", _Probe)
 
     class Objective:

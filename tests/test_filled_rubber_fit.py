@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 
 from identification import fit
-from identification.loop_start import slow_loop_start
-from identification.measurements import Measurement
-from identification.protocols import Sine, Step, sample_times
-from identification.rig_tests import RigTest
-from identification.search_space import SearchSpace
+from identification.fitting.loop_start import slow_loop_start
+from identification.measured.measurements import Measurement
+from identification.measured.signals import Sine, Step, sample_times
+from identification.measured.rig_tests import RigTest
+from identification.fitting.search_space import SearchSpace
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "references"))
 import filled_rubber  # noqa: E402
@@ -87,7 +87,7 @@ def test_the_default_preset_reaches_the_noise_floor_on_the_models_own_equations(
 def test_a_data_sheet_alone_gives_the_fractional_models_parameters():
     # the truth's own data sheet (no noise; data/kdyn_synthetic_filled_rubber.csv): the fit matches
     # it to the table's uncertainty and lands near the truth that made it
-    from identification.kdyn_table import load_kdyn_table
+    from identification.measured.kdyn_table import load_kdyn_table
     table = load_kdyn_table(Path(__file__).resolve().parents[1] / "data" / "kdyn_synthetic_filled_rubber.csv")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

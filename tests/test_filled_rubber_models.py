@@ -15,9 +15,9 @@ from fmu_src import integration
 from fmu_src.bushing_models import MODELS
 from fmu_src.bushing_params import ParameterError
 from fmu_src.parameter_files import load_parameters
-from identification.compiled_core import simulate_model_held
-from identification.dynamic_stiffness import characterise
-from identification.protocols import Random, Sine, Step, sample_times
+from identification.forward.population import simulate_model_held
+from identification.forward.dynamic_stiffness import characterise
+from identification.measured.signals import Random, Sine, Step, sample_times
 from model_exchange import simulate_model_exchange
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "references"))

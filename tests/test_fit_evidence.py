@@ -7,10 +7,10 @@ import pytest
 
 from conftest import DATA, paper_parameters, paper_test_force
 from identification import FitNotConvergedWarning, fit, load_measurement, predict, simulate
-from identification.cli import main
-from identification.measurements import Measurement, write_measurement
-from identification.protocols import Sine, Step, sample_times
-from identification.rig_tests import RigTest
+from identification.cli.arguments import main
+from identification.measured.measurements import Measurement, write_measurement
+from identification.measured.signals import Sine, Step, sample_times
+from identification.measured.rig_tests import RigTest
 
 SMALL = ["--screening", "64", "--starts", "2", "--quiet"]
 
@@ -84,10 +84,10 @@ def test_agreeing_starts_above_the_floor_blame_the_model_not_the_search():
     # of the best, every test far above its noise level, the best fit inside the box.
     from fmu_src.bushing_models import get_model
     from fmu_src.parameter_files import ParameterSet
-    from identification.fit_result import FitResult, RigTestFit
-    from identification.multistart import StartRecord
-    from identification.noise import estimate_noise
-    from identification.search_space import SearchSpace
+    from identification.fitting.result import FitResult, RigTestFit
+    from identification.fitting.multistart import StartRecord
+    from identification.measured.noise import estimate_noise
+    from identification.fitting.search_space import SearchSpace
     tests = short_tests(paper_parameters("table5"))
     space = SearchSpace.from_measurements([t.measurement for t in tests], steps=[t.kind == "step" for t in tests])
     best = paper_parameters("table5")
@@ -109,7 +109,7 @@ def test_agreeing_starts_above_the_floor_blame_the_model_not_the_search():
 def test_the_same_seed_gives_the_same_file_on_one_worker_two_workers_and_a_dask_cluster(tmp_path, monkeypatch,
                                                                                          refined):
     from dask.distributed import LocalCluster
-    import identification.refinement as refinement
+    import identification.fitting.refinement as refinement
     if refined:
         # no error budget: every check doubles the steps (up to 2), so the last stage runs with
         # an objective other than the screening's (the refinement runs in this process; the
@@ -172,7 +172,7 @@ def test_the_ensemble_band_holds_the_truth_where_the_best_fit_misses():
     # points and 16 starts, 2 of 6 seeds agreed on a basin at chi^2/n 1.43 (the truth scores
     # 1.18), said converged, and the band held the truth on only 36-56 % of the samples.
     # Measured at the default budget, seeds 1-4: NRMSE 1.5-2.3 %, alone 27-59 %, inside 100 %.
-    from identification.objectives import nrmse
+    from identification.fitting.objectives import nrmse
     tests = short_tests(paper_parameters("table2"), seed=5, sine_s=0.5, step_s=2.0)
     result = fit(tests, seed=1, progress=False, workers=2)
     assert result.converged and len(result.ensemble) > 10
@@ -216,7 +216,7 @@ def test_report_prints_the_band_width_per_case(table2_ensemble, capsys):
 
 def test_design_ranks_an_informative_test_above_an_uninformative_one(capsys, tmp_path):
     from fmu_src.parameter_files import save_ensemble
-    from identification.design import Candidate, design
+    from identification.analysis.design import Candidate, design
     # Two sets that differ only in the gain of the right block: a large, fast sine sees it,
     # a small slow one hardly.
     base = paper_parameters("table5")
@@ -283,9 +283,9 @@ def test_a_fit_stuck_on_the_box_says_where():
     from fmu_src.bushing_models import get_model
     from fmu_src.proposed_model import PARAMETER_NAMES
     from fmu_src.parameter_files import ParameterSet
-    from identification.fit_result import FitResult, RigTestFit
-    from identification.noise import estimate_noise
-    from identification.search_space import SearchSpace
+    from identification.fitting.result import FitResult, RigTestFit
+    from identification.measured.noise import estimate_noise
+    from identification.fitting.search_space import SearchSpace
     tests = short_tests(paper_parameters("table5"))
     space = SearchSpace.from_measurements([t.measurement for t in tests], steps=[t.kind == "step" for t in tests])
     theta = space.to_coordinates(paper_parameters("table5"))

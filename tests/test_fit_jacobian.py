@@ -1,4 +1,4 @@
-"""The fit's exact Jacobian (identification/fit_jacobian.py, fmu_src/vector_tangents.py): the
+"""The fit's exact Jacobian (identification/forward/parameter_jacobian.py, fmu_src/vector_tangents.py): the
 forces computed with their sensitivities are the plain forces bit for bit, every lane of the vector
 tangents is the one-direction tangent of the kernels, the sensitivities and the residuals'
 Jacobian equal central differences of the plain forward model, the search space's derivatives
@@ -17,14 +17,14 @@ from fmu_src import tangents
 from fmu_src.bushing_models import MODELS, get_model
 from fmu_src.parameter_files import load_parameters
 from fmu_src.vector_tangents import vectorize
-from identification.compiled_core import _step_sizes, simulate_population_at
+from identification.forward.population import _step_sizes, simulate_population_at
 from identification.errors import IdentificationError
-from identification.fit_jacobian import _tangent_names, population_sensitivities, python_sensitivities
-from identification.measurements import load_measurement
-from identification.multistart import Problem, difference_jacobian, jacobian
-from identification.objectives import Objective
-from identification.rig_tests import RigTest
-from identification.search_space import SearchSpace
+from identification.forward.parameter_jacobian import _tangent_names, population_sensitivities, python_sensitivities
+from identification.measured.measurements import load_measurement
+from identification.fitting.multistart import Problem, difference_jacobian, jacobian
+from identification.fitting.objectives import Objective
+from identification.measured.rig_tests import RigTest
+from identification.fitting.search_space import SearchSpace
 
 from conftest import DATA
 
@@ -235,7 +235,7 @@ def test_compiled_sensitivities_are_the_plain_forces_and_python_lanes():
 def test_table_rows_fall_back_to_differences(table2_problem):
     """With a dynamic-stiffness table, its rows of the exact Jacobian are forward differences
     (bit for bit those of ``jacobian="difference"``) and the tests' rows stay exact."""
-    from identification.kdyn_table import load_kdyn_table
+    from identification.measured.kdyn_table import load_kdyn_table
     table = load_kdyn_table(DATA / "kdyn_table5_table6_grid.csv")
     sine = RigTest(load_measurement(DATA / "synthetic_table2_noise1pct_sine_2mm_10Hz.csv"), "sine")
     objective = Objective([sine], model="proposed", table=table, search=True)
@@ -254,7 +254,7 @@ def test_table_rows_fall_back_to_differences(table2_problem):
 def test_probe_gradients_equal_central_differences(table2_problem):
     """The ensemble's prediction profiles take each probe's exact gradient (the rms force of a sine
     or step, a sine's dissipated energy): it equals central differences of the probe's measure."""
-    from identification.ensemble import PROBES, ProbeMeasure
+    from identification.fitting.ensemble import PROBES, ProbeMeasure
     space = table2_problem.space
     theta = space.to_coordinates(load_parameters(DATA / "params_table2_sine.json"))
     steps = 1e-6 * np.maximum(1.0, np.abs(theta))
@@ -271,7 +271,7 @@ def test_the_generated_module_is_named_after_its_source_and_the_compilers(monkey
     """One cache key: the module's source and the compiler versions. Generated again, the same
     source and so the same module (numba's cache holds its machine code); another compiler
     version, another name."""
-    import identification.fit_jacobian as fit_jacobian
+    import identification.forward.parameter_jacobian as fit_jacobian
     from fmu_src import compiled_kernels
     module = fit_jacobian.sensitivity_module("proposed", 14)
     model = get_model("proposed")
@@ -287,7 +287,7 @@ def test_the_fit_takes_differences_where_the_exact_jacobian_would_not_pay(table2
     """A fit to a dynamic-stiffness table alone (its rows are differences either way), and a cache
     folder that cannot be written (every process would compile the module again): forward
     differences, the second with a note that names the folder and the way out."""
-    from identification import fitting
+    from identification.fitting import fit as fitting
     space = table2_problem.space
     assert fitting._exact_jacobian_or_why_not([], space, False) == ("difference", None)
     blocked = tmp_path / "file_not_folder"

@@ -10,8 +10,8 @@ import build_fmu
 from fmu_harness import BushingFmu
 from fmu_src.bushing_models import MODELS
 from fmu_src.parameter_files import load_parameters
-from identification.compiled_core import simulate_model_held
-from identification.protocols import Sine, sample_times
+from identification.forward.population import simulate_model_held
+from identification.measured.signals import Sine, sample_times
 from paper_units import PARAMETER_UNITS, fmu_parameter_units
 from test_fmu_numerics import simulate_with_fmpy
 

@@ -15,10 +15,10 @@ from conftest import DATA
 from fmu_harness import BushingFmu
 from fmu_src.parameter_files import load_parameters
 from identification import load_measurement, predict, simulate
-from identification.fmu_input import fmu_input, simulate_measurement, table_step
-from identification.forward_model import prepare_input
-from identification.measurements import Measurement
-from identification.objectives import nrmse
+from identification.analysis.fmu_input import fmu_input, simulate_measurement, table_step
+from identification.forward.input_path import prepare_input
+from identification.measured.measurements import Measurement
+from identification.fitting.objectives import nrmse
 
 PARAMS = DATA / "params_fit_brfd_sine_0.5Hz_1in.json"
 MEASUREMENT = DATA / "brfd" / "sine_0.5Hz30lbtension1amplitude.csv.gz"

@@ -5,11 +5,11 @@ from fmpy import simulate_fmu
 
 from conftest import DATA, paper_force, paper_parameters, reference_force
 from fmu_harness import BushingFmu
-from identification.measurements import load_measurement
-from identification.objectives import nrmse
-from identification.forward_model import prepare_input
-from identification.protocols import Random, Sine, Step, sample_times
-from identification.simulate import simulate
+from identification.measured.measurements import load_measurement
+from identification.fitting.objectives import nrmse
+from identification.forward.input_path import prepare_input
+from identification.measured.signals import Random, Sine, Step, sample_times
+from identification.forward.simulate import simulate
 from python_core import simulate_python_core
 
 MM = 1e-3  # m per mm

@@ -5,7 +5,7 @@ import pytest
 
 from conftest import paper_parameters
 from fmu_harness import BushingFmu
-from identification.protocols import Sine, sample_times
+from identification.measured.signals import Sine, sample_times
 from python_core import simulate_python_core
 
 MM = 1e-3

@@ -4,10 +4,10 @@ import pytest
 
 from conftest import paper_force, paper_parameters
 from fmu_src.bushing_models import MODELS
-from identification.compiled_core import simulate_model_held
-from identification.forward_model import prepare_input
-from identification.protocols import Random, Sine, Step, sample_times
-from identification.simulate import simulate
+from identification.forward.population import simulate_model_held
+from identification.forward.input_path import prepare_input
+from identification.measured.signals import Random, Sine, Step, sample_times
+from identification.forward.simulate import simulate
 
 
 def sine_functions(amplitude_mm, frequency_hz):
@@ -65,8 +65,8 @@ def test_a_decimated_hold_gives_the_same_forces_at_the_samples_it_keeps():
     full = prepare_input(t, x)
     decimated = prepare_input(t, x, decimate_holds=True)
     assert decimated.sample_index.size < 0.25 * t.size
-    from identification.simulate import simulate_driven
-    from identification.compiled_core import parameter_matrix
+    from identification.forward.simulate import simulate_driven
+    from identification.forward.population import parameter_matrix
     matrix = parameter_matrix([params])
     every = simulate_driven(matrix, full)[0]
     kept = simulate_driven(matrix, decimated)[0]

@@ -50,7 +50,7 @@ def test_simulate_runs_without_numba_and_equals_the_compiled_forward_model():
     (["compare", "--sine", str(SINE), "--out", "{tmp}/cmp"], "fit"),
 ])
 def test_a_command_whose_extra_is_missing_says_which_extra_in_one_line(tmp_path, arguments, extra):
-    code = ("import sys\nfrom identification.cli import main\n"
+    code = ("import sys\nfrom identification.cli.arguments import main\n"
             f"sys.exit(main({[a.replace('{tmp}', str(tmp_path)) for a in arguments]!r}))\n")
     done = run_without_numba(code, timeout=60)
     assert done.returncode == 2
@@ -62,7 +62,7 @@ def test_a_command_whose_extra_is_missing_says_which_extra_in_one_line(tmp_path,
 
 
 def test_a_simulating_command_runs_without_numba_and_says_it_is_slower(tmp_path):
-    code = ("import sys\nfrom identification.cli import main\n"
+    code = ("import sys\nfrom identification.cli.arguments import main\n"
             f"sys.exit(main(['characterise', '--params', {str(DATA / 'params_table5_combined.json')!r}, "
             f"'--amplitudes-mm', '1', '--frequencies-hz', '10', '--out', {str(tmp_path / 'k.csv')!r}]))\n")
     done = run_without_numba(code)
@@ -82,7 +82,7 @@ def test_fit_from_python_without_the_extra_raises_a_missing_extra_error():
 def test_the_same_parameters_in_any_form_give_the_same_forces(tmp_path):
     from fmu_src.parameter_files import read_parameter_set
     from identification import characterise, predict, simulate
-    from identification.fit_result import FitResult
+    from identification.fitting.result import FitResult
     path = DATA / "params_table5_combined.json"
     parameter_set = read_parameter_set(path)
     mapping = dict(parameter_set.parameters)
@@ -110,7 +110,7 @@ def test_the_single_bouc_wen_model_keeps_its_old_name_as_an_alias(tmp_path):
     old = tmp_path / "old.json"
     old.write_text(json.dumps(document))
     assert read_parameter_set(old).model is single
-    from identification.cli import main
+    from identification.cli.arguments import main
     # the old name on the command line: accepted, and the file must be for that model
     assert main(["characterise", "--params", str(old), "--model", "bouc_wen", "--amplitudes-mm", "1",
                  "--frequencies-hz", "10", "--out", str(tmp_path / "k.csv"), "--json"]) == 0
@@ -120,7 +120,7 @@ def test_the_single_bouc_wen_model_keeps_its_old_name_as_an_alias(tmp_path):
 
 @pytest.mark.parametrize("plots", ["{file}/plots", "/proc/bushing_plots"])
 def test_an_unwritable_plots_directory_is_refused_before_the_fit(tmp_path, capsys, plots):
-    from identification.cli import main
+    from identification.cli.arguments import main
     (tmp_path / "file").write_text("a file, not a directory")
     plots = plots.replace("{file}", str(tmp_path / "file"))
     started = time.monotonic()
@@ -132,9 +132,9 @@ def test_an_unwritable_plots_directory_is_refused_before_the_fit(tmp_path, capsy
 
 
 def test_progress_bars_are_off_when_stderr_is_not_a_terminal_and_a_warning_has_its_own_line(capsys):
-    from identification.commands import print_warning
-    from identification.progress import SearchProgress, bar
-    from identification.presets import PRESETS
+    from identification.cli.commands import print_warning
+    from identification.fitting.progress import SearchProgress, bar
+    from identification.fitting.presets import PRESETS
     assert bar(10, "work", "items") is None          # pytest's captured stderr is not a terminal
     progress = SearchProgress(True, PRESETS["default"], 100)
     progress.screening(50)
@@ -144,8 +144,8 @@ def test_progress_bars_are_off_when_stderr_is_not_a_terminal_and_a_warning_has_i
 
 
 def test_the_command_line_offers_the_presets_defined_once():
-    from identification.cli import main
-    from identification.presets import PRESETS, describe
+    from identification.cli.arguments import main
+    from identification.fitting.presets import PRESETS, describe
     with pytest.raises(SystemExit):
         main(["fit", "--preset", "no-such-preset", "--sine", str(SINE), "--out", "p.json"])
     parser_help = subprocess.run([sys.executable, "-m", "identification", "fit", "--help"], cwd=REPO,
@@ -188,13 +188,53 @@ def test_the_cosimulation_examples_name_the_extra_they_lack(script, tmp_path):
     assert not (tmp_path / "out").exists()
 
 
-def test_the_package_docstrings_module_map_names_every_module():
+SUBPACKAGES = ("measured", "forward", "fitting", "analysis", "cli")
+"""identification's subpackages, in the order they may import each other: each only those before it."""
+
+
+def test_the_package_docstrings_name_every_subpackage_and_module():
+    import importlib
     import pkgutil
 
     import identification
-    modules = [m.name for m in pkgutil.iter_modules(identification.__path__) if m.name != "__main__"]
-    missing = [name for name in modules if f"``{name}``" not in identification.__doc__]
+    top = [m.name for m in pkgutil.iter_modules(identification.__path__) if m.name != "__main__"]
+    missing = [name for name in top if f"``{name}``" not in identification.__doc__]
     assert not missing, f"identification/__init__.py's module map does not name {missing}"
+    assert sorted(m.name for m in pkgutil.iter_modules(identification.__path__) if m.ispkg) == sorted(SUBPACKAGES)
+    for name in SUBPACKAGES:
+        package = importlib.import_module(f"identification.{name}")
+        modules = [m.name for m in pkgutil.iter_modules(package.__path__)]
+        assert 0 < len(modules) <= 15, f"identification/{name} holds {len(modules)} modules"
+        missing = [module for module in modules if f"``{module}``" not in package.__doc__]
+        assert not missing, f"identification/{name}/__init__.py does not name {missing}"
+        assert "May import" in package.__doc__
+
+
+def test_identifications_subpackages_import_only_those_before_them():
+    """Every import, at a module's top or inside a function, runs down the order of SUBPACKAGES;
+    the top-level modules (errors, extras, interrupt) import no subpackage."""
+    import ast
+    order = {name: i for i, name in enumerate(SUBPACKAGES)}
+    wrong = []
+    for path in sorted((REPO / "identification").rglob("*.py")):
+        parts = path.relative_to(REPO).with_suffix("").parts
+        if parts[-1] in ("__init__", "__main__") and len(parts) == 2:
+            continue                                   # the front doors hand names on
+        here = parts[1] if len(parts) > 2 else None
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.ImportFrom) and node.module:
+                names = [node.module] + [f"{node.module}.{alias.name}" for alias in node.names]
+            elif isinstance(node, ast.Import):
+                names = [alias.name for alias in node.names]
+            else:
+                continue
+            for name in names:
+                target = name.split(".")
+                if target[0] != "identification" or len(target) < 2 or target[1] not in order:
+                    continue
+                if here is None or order[target[1]] > order[here]:
+                    wrong.append(f"{path.relative_to(REPO)}:{node.lineno} imports {name}")
+    assert not wrong, wrong
 
 
 def test_the_docs_layout_names_every_module_of_fmu_src():

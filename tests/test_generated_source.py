@@ -5,7 +5,7 @@ import pytest
 from fmu_src import compiled_kernels
 from fmu_src.bushing_models import get_model
 from fmu_src.generated_source import GenerationError, unbound_names
-from identification import compiled_core
+from identification.forward import population as compiled_core
 
 TEMPLATE = '''
 def _template(row):
@@ -38,7 +38,7 @@ def test_a_generated_module_whose_template_reads_an_unbound_name_is_refused_at_g
 
 
 def test_every_models_generated_modules_bind_every_name_they_read():
-    from identification import fit_jacobian
+    from identification.forward import parameter_jacobian as fit_jacobian
     machinery = compiled_kernels.integration_module()
     for name in ("proposed", "berg", "fractional", "kelvin_voigt"):
         model = get_model(name)

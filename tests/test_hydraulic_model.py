@@ -139,7 +139,7 @@ def test_characterise_equals_the_closed_form_from_half_a_hertz_to_a_hundred():
     # harmonic over the last cycle, 256 steps a cycle on the compiled path) within 1e-4 in |K*|
     # and 0.01 deg of the closed form; the secant input's first harmonic is (pi/256)^2/3 = 5e-5
     # below the sine's, which the bound covers
-    from identification.dynamic_stiffness import characterise
+    from identification.forward.dynamic_stiffness import characterise
     frequencies = np.array([0.5, 1.0, 2.0, 3.0, 5.0, 8.0, 10.0, 12.0, 15.0, 20.0, 30.0, 50.0, 100.0])
     sheet = characterise(LINEAR, amplitudes_mm=(1.0,), frequencies_hz=frequencies, model="hydraulic")
     expected = closed_form.complex_stiffness(LINEAR, frequencies)
@@ -152,7 +152,7 @@ def test_the_default_mount_has_a_hydromount_data_sheet():
     # what hydromount data sheets show (issue 43): at 1 mm a loss-angle peak of 40-70 deg near the
     # track's resonance (9.98 Hz at the decoupler's closed state) and |K*| rising two to four times
     # from its notch below it
-    from identification.dynamic_stiffness import characterise
+    from identification.forward.dynamic_stiffness import characterise
     frequencies = np.array([1.0, 2.0, 3.0, 5.0, 7.0, 8.0, 9.0, 10.0, 12.0, 15.0, 20.0, 30.0, 50.0])
     sheet = characterise(DEFAULTS, amplitudes_mm=(1.0,), frequencies_hz=frequencies, model="hydraulic")
     assert 40.0 <= sheet.loss_angle_deg.max() <= 70.0
@@ -187,7 +187,7 @@ def test_a_hydraulic_axis_of_the_six_axis_fmu_is_the_one_axis_model(tmp_path, ki
     import build_fmu
     from fmpy import simulate_fmu
     from fmu_src.parameter_files import save_six_axis
-    from identification.compiled_core import simulate_model_held
+    from identification.forward.population import simulate_model_held
     stiff = {"k": 500.0, "c": 1.0, "preload": 0.0}
     axes = {name: ("kelvin_voigt", stiff) for name in ("x", "y", "rx", "ry", "rz")}
     axes["z"] = ("hydraulic", DEFAULTS)

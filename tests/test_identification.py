@@ -9,16 +9,16 @@ from conftest import DATA, paper_parameters
 from fmu_src.bushing_params import ParameterError
 from fmu_src.proposed_model import PARAMETER_NAMES
 from fmu_src.parameter_files import load_parameters, save_parameters
-from identification.compiled_core import simulate_population_held
+from identification.forward.population import simulate_population_held
 from fmu_src.bushing_models import MODELS
-from identification.forward_model import prepare_input
-from identification.measurements import Measurement, MeasurementError, MeasurementWarning, load_measurement
-from identification.noise import NoiseEstimate
-from identification.objectives import Objective, nrmse, rms_level_error
-from identification.rig_tests import RigTest
-from identification.simulate import simulate
-from identification.protocols import Sine, Step, sample_times
-from identification.search_space import rescale_hysteresis
+from identification.forward.input_path import prepare_input
+from identification.measured.measurements import Measurement, MeasurementError, MeasurementWarning, load_measurement
+from identification.measured.noise import NoiseEstimate
+from identification.fitting.objectives import Objective, nrmse, rms_level_error
+from identification.measured.rig_tests import RigTest
+from identification.forward.simulate import simulate
+from identification.measured.signals import Sine, Step, sample_times
+from identification.fitting.search_space import rescale_hysteresis
 
 
 def write(tmp_path, text, name="test.csv"):
@@ -187,7 +187,7 @@ def test_a_cli_fit_builds_an_fmu_that_carries_the_fitted_set(tmp_path, capsys):
     import json
 
     import build_fmu
-    from identification.cli import main
+    from identification.cli.arguments import main
     from test_fmu_numerics import simulate_with_fmpy
 
     out, ssv = tmp_path / "fitted.json", tmp_path / "fitted.ssv"
@@ -211,7 +211,7 @@ def test_a_cli_fit_builds_an_fmu_that_carries_the_fitted_set(tmp_path, capsys):
 
 
 def test_no_ensemble_and_an_ensemble_file_are_refused_together_before_the_fit(tmp_path, capsys):
-    from identification.cli import main
+    from identification.cli.arguments import main
     assert main(["fit", "--sine", str(DATA / "synthetic_table5_sine_2mm_10Hz.csv"), "--no-ensemble",
                  "--ensemble", str(tmp_path / "e.json"), "--out", str(tmp_path / "p.json")]) == 2
     assert "--no-ensemble" in capsys.readouterr().err and not (tmp_path / "p.json").exists()
@@ -226,7 +226,7 @@ def test_reduced_budget_fit_reaches_the_floor_through_the_cli_and_a_built_fmu(tm
     import json
 
     import build_fmu
-    from identification.cli import main
+    from identification.cli.arguments import main
     from test_fmu_numerics import simulate_with_fmpy
 
     out, ssv = tmp_path / "fitted.json", tmp_path / "fitted.ssv"
@@ -264,7 +264,7 @@ def test_table5_sensitivity_ranks_agree_with_the_papers_tables_1_and_3():
     # The paper ranked the parameters in ADAMS (Tables 1 and 3); our implementation of
     # eqs. 1-5 with Table 5 must rank them alike (rho per measure: benchmarks/bench_sensitivity_ranks.py).
     from scipy.stats import spearmanr
-    from identification.sensitivity import MEASURES, PAPER_RANKS, sensitivity
+    from identification.analysis.parameter_sensitivity import MEASURES, PAPER_RANKS, sensitivity
     table = sensitivity(paper_parameters("table5"))
     for measure in MEASURES:
         ranks = table.ranks(measure)
@@ -277,7 +277,7 @@ def test_report_grid_errors_of_a_scaled_bushing_are_the_scale_on_every_case():
     # Every force of eqs. 1-5 scales by s when springs, dashpots and A do, and beta, gamma by
     # s^(1-n) (z scales by s): against the truth, the NRMSE of s times its force is |s - 1|
     # exactly on every case.
-    from identification.report import grid_errors, grid_protocols
+    from identification.analysis.paper_verification import grid_errors, grid_protocols
     truth = paper_parameters("table5")
     s = 1.03
     scaled = {name: value * (s ** (1.0 - truth["n" + name[-1]]) if name[:-1] in ("beta", "gamma") else
@@ -296,8 +296,8 @@ def test_paper_ga_preset_runs_the_ga_then_the_least_squares_stages(monkeypatch):
     # screening) ranks the starts, then 4 starts -> 3 -> 3 run the least-squares stages. The
     # fourth start runs the last stage too exactly when fewer than MIN_AGREEING of the three
     # agreed (the lone-start extension); which happens depends on the processor's rounding.
-    import identification.fitting as fitting
-    import identification.multistart as multistart
+    import identification.fitting.fit as fitting
+    import identification.fitting.multistart as multistart
     monkeypatch.setitem(fitting.PAPER_GA, "population", 24)
     monkeypatch.setitem(fitting.PAPER_GA, "generations", 3)
     ga_runs = []

@@ -270,7 +270,7 @@ def test_the_early_handler_is_only_the_command_lines():
 def test_a_signal_inside_compiled_code_is_the_same_stop(monkeypatch, capsys, tmp_path):
     """A signal that lands while numba loads its cache reaches the command as a SystemError whose
     cause is our Interrupted: one line and 143, as any SIGTERM, not a traceback."""
-    from identification import cli
+    from identification.cli import arguments as cli
     from identification.interrupt import Interrupted
 
     def compiled_call_interrupted(args):

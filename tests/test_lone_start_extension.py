@@ -7,10 +7,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from identification.engine import SerialEngine
-from identification.ensemble import misfit_threshold
-from identification.fitting import MIN_AGREEING, _extend_if_alone
-from identification.multistart import StartRecord
+from identification.fitting.engine import SerialEngine
+from identification.fitting.ensemble import misfit_threshold
+from identification.fitting.fit import MIN_AGREEING, _extend_if_alone
+from identification.fitting.multistart import StartRecord
 
 RESIDUALS, COORDINATES = 100, 1      # the n and d the threshold is computed for
 

@@ -9,7 +9,7 @@ from fmu_src.integration import StepError, advance, apply_displacement_jump
 from fmu_src.proposed_model import MODEL as PROPOSED
 from fmu_src.bushing_models import MODELS
 from fmu_src.bushing_params import ParameterError
-from identification.protocols import Random, Sine, Step, sample_times
+from identification.measured.signals import Random, Sine, Step, sample_times
 from python_core import simulate_python_core
 
 

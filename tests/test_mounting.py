@@ -13,7 +13,7 @@ from fmu_src.axes import SIX_AXES
 from fmu_src.bushing_models import MODELS, get_model
 from fmu_src.integration import DEFAULT_MAX_SUBSTEPS, OK
 from fmu_src.parameter_files import read_parameter_set, read_six_axis
-from identification.simulate import simulate
+from identification.forward.simulate import simulate
 
 STEP_S = 1e-3
 t = np.arange(0.0, 0.3 + STEP_S / 2, STEP_S)
@@ -126,7 +126,7 @@ def test_simulate_takes_the_mounting_of_a_parameter_set(name):
 
 
 def test_predict_takes_each_members_mounting():
-    from identification.predict import predict
+    from identification.analysis.predict import predict
     params = read_parameter_set(DATA / "params_table5_combined.json").parameters
     plain = simulate(params, t, PATH_MM)
     members = [dict(params, offset=OFFSET_MM, preload=PRELOAD_N), dict(params, offset=0.0, preload=0.0)]

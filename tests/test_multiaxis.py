@@ -1,4 +1,4 @@
-"""Multi-axis tests (identification.multiaxis): the file format and its refusals, a model's
+"""Multi-axis tests (identification.measured.multiaxis): the file format and its refusals, a model's
 prediction of a plane path coupled and uncoupled, and `compare --coupling none,radial` choosing the
 coupling from held-out multi-axis files, on data the test makes from a truth of its own (the
 coupled equations typed in tests/references/generate_coupled_references.py)."""
@@ -15,8 +15,9 @@ from fmu_src.bushing_models import get_model
 from identification.__main__ import main
 from identification.errors import IdentificationError
 from fmu_src.parameter_files import save_parameters
-from identification.measurements import write_measurement
-from identification.multiaxis import load_multiaxis, simulate_multiaxis, vector_nrmse, write_multiaxis
+from identification.measured.measurements import write_measurement
+from identification.forward.simulate import simulate_multiaxis
+from identification.measured.multiaxis import load_multiaxis, vector_nrmse, write_multiaxis
 from test_coupled_models import run_coupled
 
 REPO = Path(__file__).resolve().parents[1]
@@ -267,11 +268,11 @@ def test_compare_says_where_multiaxis_training_goes(fit_rig, capsys):
 def test_the_multiaxis_rows_of_the_jacobian_are_its_forward_differences(fit_rig):
     """The exact Jacobian's one-axis rows come from the sensitivities, the multi-axis rows (no
     sensitivities) from differences: those rows equal difference_jacobian's bit for bit."""
-    from identification.measurements import load_measurement
-    from identification.multistart import Problem, difference_jacobian
-    from identification.objectives import Objective
-    from identification.rig_tests import RigTest
-    from identification.search_space import SearchSpace
+    from identification.measured.measurements import load_measurement
+    from identification.fitting.multistart import Problem, difference_jacobian
+    from identification.fitting.objectives import Objective
+    from identification.measured.rig_tests import RigTest
+    from identification.fitting.search_space import SearchSpace
     folder, sine, files = fit_rig
     ellipse = load_multiaxis(files["ellipse"])
     tests = [RigTest(load_measurement(sine), "sine")]

@@ -13,7 +13,7 @@ from fmpy.validation import validate_fmu
 import build_fmu
 from conftest import paper_force, paper_parameters
 from fmu_src.bushing_models import MODELS
-from identification.protocols import Random, Sine, Step, sample_times
+from identification.measured.signals import Random, Sine, Step, sample_times
 from model_exchange import simulate_model_exchange
 from test_fmu_numerics import simulate_with_fmpy
 from test_six_axis_fmu import axis_signals, run_with_fmpy

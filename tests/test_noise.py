@@ -1,11 +1,11 @@
-"""The force-noise estimate from the data alone (identification/noise.py)."""
+"""The force-noise estimate from the data alone (identification/measured/noise.py)."""
 import numpy as np
 import pytest
 
 from conftest import paper_parameters
-from identification.noise import estimate_noise
-from identification.protocols import Random, Sine, Step, sample_times
-from identification.simulate import simulate
+from identification.measured.noise import estimate_noise
+from identification.measured.signals import Random, Sine, Step, sample_times
+from identification.forward.simulate import simulate
 
 
 @pytest.mark.parametrize("protocol, duration_s", [(Sine(2.0, 10.0), 1.0), (Sine(2.0, 30.0), 1.0),

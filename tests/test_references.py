@@ -14,7 +14,7 @@ import pytest
 from conftest import REPO, paper_equations
 from fmu_harness import BushingFmu
 from fmu_src.parameter_files import read_parameter_set
-from identification.simulate import simulate
+from identification.forward.simulate import simulate
 
 REFERENCES = Path(__file__).resolve().parent / "references"
 _spec = importlib.util.spec_from_file_location("generate_references", REFERENCES / "generate_references.py")
@@ -30,7 +30,7 @@ PROJECT_NAMES = {"proposed": "proposed", "spencer": "spencer", "single_bouc_wen"
                  "kelvin_voigt": "kelvin_voigt", "berg": "berg", "fractional": "fractional",
                  "hydraulic": "hydraulic"}
 
-# max |F - F_ref| / max |F_ref| of identification.simulate.simulate (given the test's velocity;
+# max |F - F_ref| / max |F_ref| of identification.forward.simulate.simulate (given the test's velocity;
 # default communication steps) against the reference. Observed 2026-11-25 in the comments; bound
 # 1e-3, or about 10x the observed error where that is far smaller. The references' own error
 # (Radau against 10x tighter tolerances) is <= 1.1e-10, their rounding in the CSV 1.4e-10.

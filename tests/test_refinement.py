@@ -7,14 +7,14 @@ import pytest
 from scipy.stats import chi2
 
 from conftest import paper_force, paper_parameters
-from identification.compiled_core import parameter_matrix
-from identification.measurements import Measurement
-from identification.noise import NoiseEstimate
-from identification.objectives import Objective
-from identification.protocols import sample_times
-from identification.ensemble import misfit_threshold
-from identification.refinement import MAX_REFINED_STEPS, refine_steps
-from identification.rig_tests import RigTest
+from identification.forward.population import parameter_matrix
+from identification.measured.measurements import Measurement
+from identification.measured.noise import NoiseEstimate
+from identification.fitting.objectives import Objective
+from identification.measured.signals import sample_times
+from identification.fitting.ensemble import misfit_threshold
+from identification.fitting.refinement import MAX_REFINED_STEPS, refine_steps
+from identification.measured.rig_tests import RigTest
 
 SHARPLY_SATURATING = {
     # the reliability benchmark's "random 7" (benchmarks/bench_fit_reliability.py, truths seed 1):

@@ -22,7 +22,7 @@ from conftest import DATA
 from fmu_src import __version__
 from fmu_src.native import build as native_build
 from fmu_src.parameter_files import load_parameters, read_parameter_set, read_six_axis, save_parameters
-from identification.protocols import Random, sample_times
+from identification.measured.signals import Random, sample_times
 from test_fmu_numerics import simulate_with_fmpy
 from test_six_axis_fmu import axis_signals, run_with_fmpy
 

@@ -7,9 +7,9 @@ import pytest
 
 from conftest import DATA
 from fmu_src.parameter_files import load_parameters
-from identification.cli import main
-from identification.measurements import MeasurementError
-from identification.rig_tests import ManifestError, load_manifest, training_tests
+from identification.cli.arguments import main
+from identification.measured.measurements import MeasurementError
+from identification.measured.rig_tests import ManifestError, load_manifest, training_tests
 
 SINE = DATA / "synthetic_table5_sine_2mm_10Hz.csv"
 STEP = DATA / "synthetic_table5_step_2mm_rise0.4s.csv"
@@ -122,7 +122,7 @@ def test_a_fit_whose_files_cannot_be_written_after_all_is_rescued_into_the_worki
     def vanishing_folder(path, *args, **kwargs):
         shutil.rmtree(out_dir, ignore_errors=True)
         return real_save(path, *args, **kwargs)
-    monkeypatch.setattr("identification.fit_result.save_parameters", vanishing_folder)
+    monkeypatch.setattr("identification.fitting.result.save_parameters", vanishing_folder)
     assert main(["fit", "--model", "kelvin_voigt", "--sine", str(SINE), "--out", str(out_dir / "p.json"),
                  "--quiet"]) == 0
     rescued, = work.glob("rescued_fit_*.json")

@@ -11,7 +11,7 @@ import pytest
 from fmu_src.bushing_models import ALIASES, MODELS
 from fmu_src.model_definition import SearchCoordinate
 from fmu_src.search_coordinates import KIND, evaluation_order
-from identification.search_space import SearchSpace
+from identification.fitting.search_space import SearchSpace
 
 ROOT = Path(__file__).resolve().parents[1]
 SPACE = SearchSpace(1850.0, 2.7, 4400.0, 0.001, x_ref=2.0)

@@ -7,12 +7,12 @@ import pytest
 
 from conftest import paper_parameters
 from fmu_src.proposed_model import PARAMETER_NAMES
-from identification.compiled_core import parameter_matrix
-from identification.forward_model import prepare_input
-from identification.measurements import Measurement
-from identification.protocols import Sine, Step, sample_times
-from identification.search_space import TIME_CONSTANT_FLOOR, SearchSpace, rescale_hysteresis
-from identification.simulate import simulate_driven
+from identification.forward.population import parameter_matrix
+from identification.forward.input_path import prepare_input
+from identification.measured.measurements import Measurement
+from identification.measured.signals import Sine, Step, sample_times
+from identification.fitting.search_space import TIME_CONSTANT_FLOOR, SearchSpace, rescale_hysteresis
+from identification.forward.simulate import simulate_driven
 
 LOG_KINDS = ("stiffness", "gain", "damping", "time_constant")
 

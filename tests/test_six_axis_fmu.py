@@ -14,7 +14,7 @@ from fmu_harness import BushingFmu
 from fmu_src.axes import SIX_AXES, SIX_AXIS_NAMES
 from fmu_src.bushing_params import ParameterError
 from fmu_src.parameter_files import read_six_axis, save_six_axis
-from identification.compiled_core import simulate_model_held
+from identification.forward.population import simulate_model_held
 
 DEFAULT = DATA / "params_six_axis_illustrative.json"
 AMPLITUDE = {"x": 2e-3, "y": 1e-3, "z": 1.5e-3, "rx": 0.02, "ry": 0.05, "rz": 0.1}     # m or rad
@@ -206,7 +206,7 @@ def test_six_axis_parameter_file_errors_name_the_axis(tmp_path):
 
 
 def test_assemble_builds_the_six_axis_file_from_one_file_per_axis(tmp_path):
-    from identification.cli import main
+    from identification.cli.arguments import main
     files = {"x": DATA / "params_table5_combined.json", "y": DATA / "params_table2_sine.json",
              "z": DATA / "params_spencer_fit_synthetic_table5.json", "rx": DATA / "params_kelvin_voigt_fit_synthetic_table5.json",
              "ry": DATA / "params_single_bouc_wen_fit_synthetic_table5.json", "rz": DATA / "params_table4_step.ssv"}
@@ -222,7 +222,7 @@ def test_assemble_builds_the_six_axis_file_from_one_file_per_axis(tmp_path):
 
 
 def test_assemble_refuses_a_missing_axis_unless_told_how_to_fill_it(tmp_path, capsys):
-    from identification.cli import main
+    from identification.cli.arguments import main
     only_x = ["assemble", "--axis", f"x={DATA / 'params_table5_combined.json'}"]
     assert main([*only_x, "--out", str(tmp_path / "a.json")]) == 2
     assert "no parameter file for the axes y, z, rx, ry, rz" in capsys.readouterr().err

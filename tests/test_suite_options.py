@@ -2,9 +2,9 @@
 import numpy as np
 
 from conftest import DATA
-from identification import fitting
-from identification.measurements import load_measurement
-from identification.rig_tests import RigTest
+from identification.fitting import fit as fitting
+from identification.measured.measurements import load_measurement
+from identification.measured.rig_tests import RigTest
 from suite_options import rounding_variant
 
 

@@ -1,4 +1,4 @@
-"""A fluid track's starts read off a data sheet (identification/table_start.py): near the truth on
+"""A fluid track's starts read off a data sheet (identification/fitting/table_start.py): near the truth on
 the hydraulic model's own synthetic sheet, and a clear note where a sheet cannot give them."""
 import json
 import math
@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 
 from conftest import REPO
-from identification.kdyn_table import KdynTable, load_kdyn_table
-from identification.loop_start import anchored_coordinates
-from identification.search_space import SearchSpace
-from identification.table_start import TableStart, table_start
+from identification.measured.kdyn_table import KdynTable, load_kdyn_table
+from identification.fitting.loop_start import anchored_coordinates
+from identification.fitting.search_space import SearchSpace
+from identification.fitting.table_start import TableStart, table_start
 
 TRAIN = REPO / "data" / "kdyn_synthetic_hydraulic_train.csv"
 TRUTH = {name: float(value) for name, value in

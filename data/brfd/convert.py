@@ -15,7 +15,7 @@ What the conversion does, and nothing else:
 - keeps the first four columns of each test's ``data`` matrix (time [s], displacement [in],
   friction force [kip], velocity [in/s]) and drops the two actuator forces [lb];
 - converts inch to mm (x 25.4) and kip to N (x 4448.2216152605, i.e. 1000 lbf of
-  4.4482216152605 N, the factor identification.measurements uses for ``force_kip``);
+  4.4482216152605 N, the factor identification.measured.measurements uses for ``force_kip``);
 - writes ``time_s,displacement_mm,force_N,velocity_mm_s`` with fixed decimals: time 6
   (1 us; samples are 1/1024 s apart), displacement 5 (10 nm), force 2 (0.01 N), velocity 4
   (0.1 um/s), all far below the rig's resolution (displacement steps of about 1.5 um, force

@@ -19,7 +19,7 @@ interpolation, no communication steps). The filled-rubber models are typed in
 for the sine (Berg's friction from its definition, Maxwell elements by scipy's lsim, the
 fractional derivative by the L1 sum). Nothing of ``fmu_src`` or ``identification`` is imported.
 
-The tests (paper §4.1-4.3, ``identification.protocols``): x = 2 mm * sin(2*pi*10 Hz*t) over 1 s,
+The tests (paper §4.1-4.3, ``identification.measured.signals``): x = 2 mm * sin(2*pi*10 Hz*t) over 1 s,
 and a ramp from 0 to 2 mm over 0.4 s held to 10 s. The bushing starts in relaxed equilibrium at
 x(0) = 0, with the velocity of the input at t = 0 (the sine starts moving at once). At t = 0.4 s
 the step's velocity jumps from 5 mm/s to 0; the sample there is the right limit (dx/dt = 0, as
@@ -219,7 +219,7 @@ def read_parameters(model: str) -> dict[str, float]:
 
 
 def sample_times(duration_s: float) -> np.ndarray:
-    """0, 1 ms, ..., duration (inclusive), as ``identification.protocols.sample_times``."""
+    """0, 1 ms, ..., duration (inclusive), as ``identification.measured.signals.sample_times``."""
     return np.arange(round(duration_s / SAMPLE_S) + 1) / round(1.0 / SAMPLE_S)
 
 

@@ -1,0 +1,357 @@
+"""Choosing the model: fit several models on the same training tests, weigh them on what the user
+has, and recommend one (the paper's comparison study, §3.1, §4.3, Figs. 15-17, made a decision).
+
+Each model is fitted (``fitting.fit``) and assessed on:
+
+- training: its NRMSE against each test's noise level and, where a dynamic-stiffness table is
+  training data too (``training_table``, ``compare --kdyn``), the table's rms error in units of
+  its uncertainty (at the floor: each within ``result.FLOOR_FACTOR`` of it), chi^2/n, and
+  Schwarz's information criterion BIC = chi^2 + d*ln(n) over its d free parameters;
+- held out: the validation files that are not training files (NRMSE and the paper's eq. 10), and
+  a dynamic-stiffness table (|K*| and loss-angle errors per amplitude and frequency, and their
+  rms in units of the table's uncertainty, ``kdyn_table``).
+
+The recommendation (:func:`recommend`) is the simplest model that reaches the noise floor and
+predicts best: among the models at the floor, those whose held-out errors are within
+``PREDICTION_TOLERANCE`` of the best on each kind of held-out data (all of them, if none is held
+out); of those the one with the fewest free parameters, then the lowest BIC. Where no model
+reaches the floor, the fewest parameters says nothing (a linear bushing that misses the data by
+140x its noise is not simpler than one that misses by 70x, it is worse): the models that predict
+within the tolerance of the best (all, without held-out data), and of those the lowest BIC, with
+a note that no model describes the data to their noise and by how much the chosen one misses.
+
+Writes into the output directory: ``params_<model>.json`` per model (with provenance),
+``comparison.csv`` (one row per model: everything above and whether it is the recommendation),
+``validation.csv`` (NRMSE and eq. 10 per file and model), ``kdyn_errors.csv`` (per row of the
+table and model), one PNG per validation file (force over time and force-displacement loops) and
+one for the table, each whole or not at all (``interrupt.writing``). Prints the tables; the last
+line is ``recommended: <model>``.
+"""
+from __future__ import annotations
+
+import csv
+import math
+import sys
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+
+from fmu_src.bushing_models import BushingModel, resolve_model
+from identification.fitting.engine import make_engine
+from identification.errors import FitNotConvergedWarning
+from identification.fitting.result import FLOOR_FACTOR, FitResult, TableFit, information_criterion
+from identification.fitting.fit import fit, table_fit
+from identification.interrupt import writing
+from identification.measured.kdyn_table import KDYN_UNCERTAINTY, LOSS_ANGLE_UNCERTAINTY_DEG, KdynTable
+from identification.measured.measurements import load_measurement, measurement_name
+from identification.fitting.objectives import nrmse, rms_level_error
+from identification.analysis.plots import plot_comparison, plot_table_comparison
+from identification.measured.rig_tests import RigTest
+from identification.forward.simulate import simulate
+
+PREDICTION_TOLERANCE = 0.1
+"""A model predicts as well as the best if its held-out error is at most this much larger (10 %)."""
+
+
+@dataclass
+class Assessment:
+    """One model on the comparison's data."""
+    model: str
+    free_parameters: int
+    residuals: int
+    misfit: float                          # chi^2/n over the training data (tests and a training table)
+    training_ratio: float                  # the largest NRMSE over the noise level of a training test or table
+    at_floor: bool
+    converged: bool
+    seconds: float
+    validation: dict[str, tuple[float, float]] = field(default_factory=dict)   # held-out file: (NRMSE, eq. 10)
+    table: TableFit | None = None          # the held-out table at the fitted parameters
+
+    @property
+    def information_criterion(self) -> float:
+        """BIC = chi^2 + d*ln(n) (``result.information_criterion``)."""
+        return information_criterion(self.misfit, self.free_parameters, self.residuals)
+
+    @property
+    def validation_error(self) -> float | None:
+        """The mean NRMSE over the held-out files (None without any)."""
+        return float(np.mean([error for error, _ in self.validation.values()])) if self.validation else None
+
+    @property
+    def table_error(self) -> float | None:
+        """The held-out table's rms error in units of its uncertainty (None without a table)."""
+        return self.table.ratio if self.table is not None else None
+
+    @classmethod
+    def of(cls, result: FitResult) -> "Assessment":
+        ratios = [t.ratio for t in result.tests] + ([result.table.ratio] if result.table is not None else [])
+        return cls(result.model, result.free_parameters, result.residuals, result.misfit,
+                   max(ratios, default=math.nan), result.at_floor, result.converged, result.seconds)
+
+
+@dataclass(frozen=True)
+class Recommendation:
+    model: str
+    reason: str
+    caveat: str = ""
+    """Where no model reaches the noise floor: that none describes the data to their noise, the
+    recommended model's miss (its worst training test against its noise level); else empty."""
+
+
+def recommend(assessments: Sequence[Assessment], tolerance: float = PREDICTION_TOLERANCE) -> Recommendation:
+    """The model to use (module docstring), why, and a caveat where none reaches the floor.
+
+    Where some models reach the noise floor: of those, the ones that predict every kind of held-out
+    data (files, then the table) within ``tolerance`` of the best; of those the one with the fewest
+    free parameters, then the lowest BIC. Where none does, parsimony says nothing (every model misses
+    the data): the ones that predict within ``tolerance`` of the best, where held-out data are given,
+    and of those (of all, without) the lowest BIC, which weighs the fit itself against its
+    parameters."""
+    pool = [a for a in assessments if a.at_floor]
+    why = [f"{len(pool)} of {len(assessments)} at the noise floor"]
+    if not pool:
+        pool = list(assessments)
+        why = [f"no model reaches the noise floor (none of the {len(pool)} describes the data to their noise)"]
+    held_out = _predicting_best(pool, tolerance, why)
+    filtered = len(held_out) < len(pool) or len(why) > 1
+    if why[0].startswith("no model"):
+        chosen = min(held_out, key=lambda a: (a.information_criterion, a.free_parameters))
+        why.append(f"{chosen.model} has the lowest BIC{' of those' if filtered else ''}")
+        caveat = (f"no model describes these data to their noise level; the best, {chosen.model}, misses its worst "
+                  f"training data by {chosen.training_ratio:.3g}x the noise (or a training table's uncertainty; the floor is "
+                  f"{FLOOR_FACTOR}x): treat "
+                  "its predictions as approximate")
+        return Recommendation(chosen.model, "; ".join(why), caveat)
+    chosen = min(held_out, key=lambda a: (a.free_parameters, a.information_criterion))
+    simplest = [a.model for a in held_out if a.free_parameters == chosen.free_parameters]
+    why.append(f"{chosen.model} has the fewest free parameters of those ({chosen.free_parameters})"
+               + (f" and the lowest BIC among {', '.join(simplest)}" if len(simplest) > 1 else ""))
+    return Recommendation(chosen.model, "; ".join(why))
+
+
+def _predicting_best(pool: list[Assessment], tolerance: float, why: list[str]) -> list[Assessment]:
+    """Those of ``pool`` that predict each kind of held-out data they were assessed on (files, then
+    the table) within ``tolerance`` of the best, saying so in ``why``; ``pool`` where none was held out."""
+    for name, error in (("held-out files", lambda a: a.validation_error), ("table", lambda a: a.table_error)):
+        known = [a for a in pool if error(a) is not None and math.isfinite(error(a))]
+        if not known:
+            continue
+        best = min(error(a) for a in known)
+        close = [a for a in known if error(a) <= (1.0 + tolerance) * best]
+        why.append(f"{len(close)} predict the {name} within {tolerance:.0%} of the best")
+        pool = close
+    return pool
+
+
+def compare_models(models: Sequence[str | BushingModel], tests: Sequence[RigTest], validation_files: Sequence[Path],
+                   out_dir: Path, preset: str = "default", seed: int = 0, workers: int | None = None,
+                   scheduler=None, screening: int | None = None, starts: int | None = None, ensemble: bool = True,
+                   table: KdynTable | None = None, multiaxis=(), couplings: Sequence[str] = (),
+                   training_table: KdynTable | None = None) -> dict:
+    """Fit every model on ``tests`` and the ``training_table`` (a data sheet, alone or with the
+    tests, as ``fit(kdyn=...)``), assess it on the training data, on the ``validation_files``
+    and on the held-out dynamic-stiffness ``table``, write the files (module docstring) and
+    recommend one. ``models``: names or ``BushingModel``s, each resolved once here and passed on.
+    Returns ``{"parameters": {model: params}, "errors": {(file, model): (nrmse, eq10)},
+    "assessments": [Assessment], "recommendation": Recommendation}`` (keyed by model name)."""
+    bushings = [resolve_model(model) for model in models]
+    models = [bushing.name for bushing in bushings]
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    validation = [load_measurement(path) for path in validation_files]
+    training_names = {Path(t.measurement.source).name for t in tests}
+    parameters, assessments = {}, []
+    with make_engine(workers, scheduler) as engine, warnings.catch_warnings():
+        warnings.simplefilter("ignore", FitNotConvergedWarning)   # reported below, per model
+        for bushing in bushings:
+            model = bushing.name
+            print(f"fitting {bushing.title} ...", file=sys.stderr)
+            result = fit(tests, model=bushing, preset=preset, seed=seed, engine=engine, screening=screening,
+                         starts=starts, ensemble=ensemble, kdyn=training_table)
+            result.save(out_dir / f"params_{model}.json", data=[t.measurement.source for t in tests]
+                        + ([training_table.source] if training_table is not None else []))
+            parameters[model] = result.parameters.parameters
+            assessment = Assessment.of(result)
+            if table is not None:
+                assessment.table = table_fit(table, result.parameters)
+            assessments.append(assessment)
+            state = "converged" if result.converged else f"WARNING: {result.warning}"
+            print(f"  misfit {result.misfit:.4f} in {result.seconds:.0f} s; {state}", file=sys.stderr)
+
+    errors = {}
+    for m in validation:
+        name = Path(m.source).name
+        predictions = {bushing.name: simulate(parameters[bushing.name], m.time_s, m.displacement_mm,
+                                              m.measured_velocity_mm_s, model=bushing)
+                       for bushing in bushings}
+        for assessment in assessments:
+            predicted = predictions[assessment.model]
+            errors[name, assessment.model] = (nrmse(predicted, m.force_N), rms_level_error(predicted, m.force_N))
+            if name not in training_names:
+                assessment.validation[name] = errors[name, assessment.model]
+        plot_comparison(m, predictions, out_dir / f"compare_{measurement_name(m.source)}.png")
+    if table is not None:
+        plot_table_comparison(table, {a.model: a.table for a in assessments}, out_dir / f"compare_{table.name}.png")
+    recommendation = recommend(assessments)
+    coupling = weigh_couplings(parameters, bushings, multiaxis, couplings, recommendation.model) if couplings else None
+
+    print(format_assessments(assessments, recommendation))
+    if validation:
+        print(format_comparison(errors, models, [Path(m.source).name for m in validation], training_names))
+    if table is not None:
+        print(format_table_errors(table, assessments))
+    if coupling is not None:
+        print(coupling.format())
+    _write_csvs(out_dir, assessments, recommendation, errors, table)
+    if coupling is not None:
+        coupling.write(out_dir / "coupling.csv")
+    print(f"wrote {out_dir}/comparison.csv, validation.csv{', kdyn_errors.csv' if table is not None else ''}"
+          f"{', coupling.csv' if coupling is not None else ''}, params_<model>.json and compare_*.png", file=sys.stderr)
+    if recommendation.caveat:
+        print(f"note: {recommendation.caveat}")
+    if coupling is not None:
+        print(f"recommended coupling: {coupling.chosen} ({coupling.reason})")
+    print(f"why: {recommendation.reason}")
+    print(f"recommended: {recommendation.model}")
+    return {"parameters": parameters, "errors": errors, "assessments": assessments, "recommendation": recommendation,
+            "coupling": coupling}
+
+
+@dataclass
+class CouplingChoice:
+    """How each model predicts the held-out multi-axis files with each coupling, and the coupling
+    chosen for the recommended model: the lowest mean NRMSE of the force vector, where another is
+    within ``PREDICTION_TOLERANCE`` of it the simpler (none before radial before spherical)."""
+    errors: dict                        # (model, coupling): [NRMSE per file]
+    files: list[str]
+    couplings: tuple[str, ...]
+    model: str
+    chosen: str
+    reason: str
+
+    def format(self) -> str:
+        lines = [f"held-out multi-axis files ({', '.join(self.files)}): mean NRMSE of the force vector"]
+        lines.append(f"{'model':17s}" + "".join(f"{coupling:>12s}" for coupling in self.couplings))
+        for model in dict.fromkeys(m for m, _ in self.errors):
+            lines.append(f"{model:17s}" + "".join(f"{np.mean(self.errors[model, c]):12.2%}" for c in self.couplings))
+        return "\n".join(lines)
+
+    def write(self, path: Path) -> None:
+        with writing(path) as temporary, open(temporary, "w", newline="") as handle:
+            writer = csv.writer(handle)
+            writer.writerow(["model", "coupling", "file", "vector_nrmse", "chosen"])
+            for (model, coupling), values in self.errors.items():
+                for name, value in zip(self.files, values):
+                    writer.writerow([model, coupling, name, f"{value:.6g}",
+                                     model == self.model and coupling == self.chosen])
+
+
+def weigh_couplings(parameters: dict, bushings, multiaxis, couplings: Sequence[str], model: str,
+                    tolerance: float = PREDICTION_TOLERANCE) -> CouplingChoice:
+    """Each model's predictions of the multi-axis files with each coupling (``simulate.simulate_multiaxis``,
+    ``multiaxis.COUPLED_AXES``: none, its one-axis model on each axis; radial, its coupled form on x and
+    y, z alone; spherical, on x, y and z, which needs files of three axes), and the coupling for
+    ``model`` (:class:`CouplingChoice`)."""
+    from identification.forward.simulate import simulate_multiaxis
+    from identification.measured.multiaxis import vector_nrmse
+    errors = {}
+    for bushing in bushings:
+        for coupling in couplings:
+            values = []
+            for m in multiaxis:
+                predicted = simulate_multiaxis(parameters[bushing.name], m.time_s, m.displacement_mm, bushing,
+                                               coupling, m.velocity_mm_s)
+                values.append(vector_nrmse(predicted, m.force_N))
+            errors[bushing.name, coupling] = values
+    means = {coupling: float(np.mean(errors[model, coupling])) for coupling in couplings}
+    best = min(means.values())
+    order = [c for c in ("none", "radial", "spherical") if c in couplings]
+    chosen = next(c for c in order if means[c] <= (1.0 + tolerance) * best)
+    others = ", ".join(f"{c} {means[c]:.2%}" for c in order if c != chosen)
+    reason = (f"{model} predicts the held-out multi-axis files with {means[chosen]:.2%} NRMSE of the force vector"
+              + (f" against {others}" if others else "")
+              + ("; the simplest within 10 % of the best" if chosen != min(means, key=means.get) else ""))
+    return CouplingChoice(errors, [m.name for m in multiaxis], tuple(couplings), model, chosen, reason)
+
+
+def format_assessments(assessments: Sequence[Assessment], recommendation: Recommendation) -> str:
+    """One row per model: parameters, training against the noise, BIC, held-out errors."""
+    best_bic = min(a.information_criterion for a in assessments)
+    lines = [f"{'model':17s} {'params':>6s} {'worst NRMSE/noise':>17s} {'floor':>5s} {'chi2/n':>9s} {'dBIC':>9s} "
+             f"{'held-out NRMSE':>14s} {'table err/unc':>13s}"]
+    for a in assessments:
+        held = f"{a.validation_error:.2%}" if a.validation_error is not None else "-"
+        table = f"{a.table_error:.2f}" if a.table_error is not None else "-"
+        mark = "  <- recommended" if a.model == recommendation.model else ""
+        lines.append(f"{a.model:17s} {a.free_parameters:6d} {a.training_ratio:17.2f} {'yes' if a.at_floor else 'NO':>5s} "
+                     f"{a.misfit:9.3f} {a.information_criterion - best_bic:9.1f} {held:>14s} {table:>13s}{mark}")
+    lines.append(f"floor: every training test's NRMSE within {FLOOR_FACTOR}x its noise level (a training table's "
+                 f"rms error within {FLOOR_FACTOR}x its uncertainty; the column is the worst of them); dBIC: BIC = chi^2 + "
+                 "d*ln(n) over the best; held-out NRMSE: the mean over the validation files that are not training "
+                 f"files; table err/unc: rms error in units of {KDYN_UNCERTAINTY:.0%} on |K*| and "
+                 f"{LOSS_ANGLE_UNCERTAINTY_DEG:g} deg")
+    return "\n".join(lines)
+
+
+def format_comparison(errors: dict, models: Sequence[str], files: Sequence[str], training: set[str] = frozenset()) -> str:
+    """NRMSE per file (rows) and model (columns), the eq. 10 error in brackets."""
+    width = max(len(name) for name in files) + 13
+    lines = [f"{'file':{width}s}" + "".join(f"{model:>22s}" for model in models)]
+    for name in files:
+        cells = "".join(f"{errors[name, model][0]:>12.2%} ({errors[name, model][1]:+6.1%})" for model in models)
+        lines.append(f"{name + (' (training)' if name in training else ''):{width}s}{cells}")
+    lines.append("NRMSE = rms(F_pre - F_exp)/rms(F_exp); (eq. 10) = (rms F_exp - rms F_pre)/rms F_exp")
+    return "\n".join(lines)
+
+
+def format_table_errors(table: KdynTable, assessments: Sequence[Assessment]) -> str:
+    """The largest and rms |K*| and loss-angle errors of each model on the held-out table."""
+    lines = [f"held-out table {table.name} ({int(np.count_nonzero(table.weight > 0))} rows): "
+             "|K*| error largest / rms, loss angle error largest / rms"]
+    for a in assessments:
+        kdyn, angle = np.abs(a.table.kdyn_errors), np.abs(a.table.angle_errors_deg)
+        lines.append(f"  {a.model:17s} {np.max(kdyn):7.2%} / {np.sqrt(np.mean(kdyn ** 2)):6.2%}   "
+                     f"{np.max(angle):6.2f} / {np.sqrt(np.mean(angle ** 2)):5.2f} deg")
+    return "\n".join(lines)
+
+
+def _write_csvs(out_dir: Path, assessments, recommendation: Recommendation, errors: dict, table) -> None:
+    best_bic = min(a.information_criterion for a in assessments)
+    with writing(out_dir / "comparison.csv") as temporary, open(temporary, "w", newline="") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(["model", "free_parameters", "worst_nrmse_over_noise", "at_floor", "converged",
+                         "misfit_chi2_per_residual", "residuals", "bic", "delta_bic", "held_out_mean_nrmse",
+                         "table_error_over_uncertainty", "table_largest_kdyn_error", "table_largest_loss_angle_error_deg",
+                         "seconds", "recommended"])
+        for a in assessments:
+            kdyn = np.max(np.abs(a.table.kdyn_errors)) if a.table is not None else None
+            angle = np.max(np.abs(a.table.angle_errors_deg)) if a.table is not None else None
+            writer.writerow([a.model, a.free_parameters, _cell(a.training_ratio), a.at_floor, a.converged,
+                             _cell(a.misfit), a.residuals, _cell(a.information_criterion),
+                             _cell(a.information_criterion - best_bic), _cell(a.validation_error),
+                             _cell(a.table_error), _cell(kdyn), _cell(angle), f"{a.seconds:.1f}",
+                             a.model == recommendation.model])
+    with writing(out_dir / "validation.csv") as temporary, open(temporary, "w", newline="") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(["file", "model", "nrmse", "eq10_rms_level_error"])
+        for (name, model), (error, eq10) in errors.items():
+            writer.writerow([name, model, f"{error:.6g}", f"{eq10:.6g}"])
+    if table is not None:
+        kept = table.weight > 0
+        with writing(out_dir / "kdyn_errors.csv") as temporary, open(temporary, "w", newline="") as handle:
+            writer = csv.writer(handle)
+            writer.writerow(["model", "amplitude_mm", "frequency_hz", "preload_mm", "kdyn_N_per_mm", "loss_angle_deg",
+                             "kdyn_relative_error", "loss_angle_error_deg"])
+            for a in assessments:
+                for row, (X, f, P, kdyn, angle) in enumerate(zip(table.amplitude_mm[kept], table.frequency_hz[kept],
+                                                                 table.preload_mm[kept], table.kdyn_N_per_mm[kept],
+                                                                 table.loss_angle_deg[kept])):
+                    writer.writerow([a.model, f"{X:g}", f"{f:g}", f"{P:g}", f"{kdyn:.6g}", f"{angle:.6g}",
+                                     f"{a.table.kdyn_errors[row]:.6g}", f"{a.table.angle_errors_deg[row]:.6g}"])
+
+
+def _cell(value) -> str:
+    return "" if value is None else f"{value:.6g}"

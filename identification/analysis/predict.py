@@ -1,0 +1,190 @@
+"""Predict a test with a parameter set or an ensemble: the force, and the ensemble's band.
+
+``predict(parameters, time_s, displacement_mm, velocity_mm_s=None, model=None)`` simulates (the forward
+model, ``identification.simulate``) the best parameter set and, for an ensemble, every
+member, in one compiled population call, each with its mounting (offset, preload);
+``predict_multiaxis`` does the same on a multi-axis path with a coupling. The band is the members' envelope (min, max) at
+every sample: the spread of the parameter sets the training tests cannot tell apart (a
+confidence band). Add the noise level for where a measurement may fall (a prediction band).
+
+``parameters``: anything ``identification.forward.parameter_sets`` accepts (a mapping, a
+``ParameterSet`` or ``ParameterEnsemble``, a ``FitResult``, a parameter file's path, a list of
+mappings, best first).
+"""
+from __future__ import annotations
+
+import csv
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from fmu_src.bushing_models import BushingModel
+from identification.forward.population import parameter_matrix
+from identification.errors import IdentificationError
+from identification.forward.input_path import prepare_input
+from identification.forward.parameter_sets import parameter_sets
+from identification.forward.simulate import simulate_driven
+
+
+@dataclass
+class Prediction:
+    """What ``predict`` returns.
+
+    Attributes
+    ----------
+    time_s : numpy.ndarray
+        Sample times [s].
+    displacement_mm : numpy.ndarray
+        Displacement [mm] at the samples.
+    force_N : numpy.ndarray
+        Force [N] of the best (first) parameter set.
+    lower_N, upper_N : numpy.ndarray
+        The envelope [N] of every member (equal to ``force_N`` for one set).
+    members : int
+        How many parameter sets were simulated.
+    """
+    time_s: np.ndarray
+    displacement_mm: np.ndarray
+    force_N: np.ndarray              # the best (first) member
+    lower_N: np.ndarray              # the envelope of every member (equal to force_N for one set)
+    upper_N: np.ndarray
+    members: int
+
+    @property
+    def band_width_N(self) -> np.ndarray:
+        return self.upper_N - self.lower_N
+
+    def write_csv(self, path: str | Path) -> Path:
+        """``time_s,displacement_mm,force_N`` and, for an ensemble, ``force_min_N,force_max_N``."""
+        path = Path(path)
+        columns = [self.time_s, self.displacement_mm, self.force_N]
+        header = ["time_s", "displacement_mm", "force_N"]
+        if self.members > 1:
+            columns += [self.lower_N, self.upper_N]
+            header += ["force_min_N", "force_max_N"]
+        with open(path, "w", newline="", encoding="utf-8") as stream:
+            stream.write(f"# predicted by identification.predict from {self.members} parameter set(s)\n")
+            writer = csv.writer(stream)
+            writer.writerow(header)
+            for row in zip(*columns):
+                writer.writerow([f"{row[0]:.6f}", f"{row[1]:.6f}", *(f"{value:.4f}" for value in row[2:])])
+        return path
+
+
+def predict(parameters, time_s, displacement_mm, velocity_mm_s=None,
+            model: str | BushingModel | None = None) -> Prediction:
+    """Predict a test: the best set's force and the ensemble's band at every sample.
+
+    Parameters
+    ----------
+    parameters : mapping, ParameterSet, ParameterEnsemble, FitResult, str or Path
+        A set or an ensemble (paper's N-mm-s units), in any form ``parameter_sets`` accepts.
+    time_s, displacement_mm : array_like
+        Sample times [s] and displacement [mm].
+    velocity_mm_s : array_like, optional
+        Measured velocity [mm/s] at the samples.
+    model : str or BushingModel, optional
+        The model the parameters must be for (or its name).
+
+    Returns
+    -------
+    Prediction
+        ``force_N`` of the best set, ``lower_N``/``upper_N`` the members' envelope (a
+        confidence band; add the noise level for where a measurement may fall).
+
+    Raises
+    ------
+    IdentificationError
+        The best set's simulation fails (overflow), with the time it fails from.
+    """
+    bushing, sets = parameter_sets(parameters, model)
+    x = np.asarray(displacement_mm, dtype=float)
+    forces = _mounted_population(bushing, sets, lambda matrix, offset: simulate_driven(
+        matrix, prepare_input(time_s, x - offset, velocity_mm_s), model=bushing))
+    _refuse_failed(forces[0], time_s)
+    return Prediction(np.asarray(time_s, dtype=float), x, forces[0], np.nanmin(forces, axis=0),
+                      np.nanmax(forces, axis=0), len(sets))
+
+
+@dataclass
+class MultiAxisPrediction:
+    """What ``predict_multiaxis`` returns: as :class:`Prediction`, with displacement and force
+    vectors (samples, d) [mm, N] and the coupling they were simulated with."""
+    time_s: np.ndarray
+    displacement_mm: np.ndarray
+    force_N: np.ndarray
+    lower_N: np.ndarray
+    upper_N: np.ndarray
+    members: int
+    coupling: str
+
+    @property
+    def band_width_N(self) -> np.ndarray:
+        return self.upper_N - self.lower_N
+
+    def write_csv(self, path: str | Path) -> Path:
+        """A multi-axis file (``multiaxis.write_multiaxis``: ``time_s,dx_mm,dy_mm,Fx_N,Fy_N``...) and,
+        for an ensemble, ``Fx_min_N,Fx_max_N``... of each axis."""
+        from identification.measured.multiaxis import AXIS_NAMES
+        axes = AXIS_NAMES[:self.force_N.shape[1]]
+        columns = [self.time_s[:, None], self.displacement_mm, self.force_N]
+        header = ["time_s"] + [f"d{a}_mm" for a in axes] + [f"F{a}_N" for a in axes]
+        if self.members > 1:
+            for c, a in enumerate(axes):
+                columns += [self.lower_N[:, c:c + 1], self.upper_N[:, c:c + 1]]
+                header += [f"F{a}_min_N", f"F{a}_max_N"]
+        table = np.hstack(columns)
+        path = Path(path)
+        with open(path, "w", newline="", encoding="utf-8") as stream:
+            stream.write(f"# predicted by identification.predict from {self.members} parameter set(s), "
+                         f"{self.coupling} coupling\n" + ",".join(header) + "\n")
+            d = len(axes)
+            np.savetxt(stream, table, delimiter=",", fmt=["%.6f"] * (1 + d) + ["%.4f"] * (table.shape[1] - 1 - d))
+        return path
+
+
+def predict_multiaxis(parameters, time_s, displacement_mm, coupling: str, velocity_mm_s=None,
+                      model: str | BushingModel | None = None) -> MultiAxisPrediction:
+    """Predict a multi-axis path (``displacement_mm`` (samples, d = 2 or 3) [mm]) as :func:`predict`
+    does one axis, with ``coupling`` (``multiaxis.COUPLED_AXES``: none, radial, spherical):
+    ``simulate.simulate_multiaxis`` of every member in one population call. Raises
+    IdentificationError for a coupling the path cannot carry or a best set whose simulation fails."""
+    from identification.forward.input_path import prepare_vector_input
+    from identification.measured.multiaxis import coupled_axes
+    from identification.forward.simulate import simulate_driven_vector
+    bushing, sets = parameter_sets(parameters, model)
+    x = np.atleast_2d(np.asarray(displacement_mm, dtype=float))
+    t = np.asarray(time_s, dtype=float)
+    if x.ndim != 2 or x.shape[0] != t.size or x.shape[1] not in (2, 3):
+        raise IdentificationError(f"a multi-axis path has 2 or 3 displacement columns, one row per time: got "
+                                  f"{x.shape} for {t.size} times")
+    coupled = coupled_axes(coupling, x.shape[1])
+    forces = _mounted_population(bushing, sets, lambda matrix, offset: simulate_driven_vector(
+        matrix, prepare_vector_input(t, x - offset, velocity_mm_s), model=bushing, coupled_axes=coupled))
+    _refuse_failed(forces[0], t)
+    return MultiAxisPrediction(t, x, forces[0], np.nanmin(forces, axis=0), np.nanmax(forces, axis=0), len(sets),
+                               coupling)
+
+
+def _mounted_population(bushing: BushingModel, sets, simulate_at) -> np.ndarray:
+    """Forces (P, ...) of the parameter sets, each with its mounting (F = model(x - offset) +
+    preload, ``BushingModel.mounting``): ``simulate_at(matrix, offset)`` once for each mounting
+    the sets carry (a fit's members share one)."""
+    mountings = [bushing.mounting(values) for values in sets]
+    forces = [None] * len(sets)
+    for offset, preload in dict.fromkeys(mountings):
+        members = [i for i, mounting in enumerate(mountings) if mounting == (offset, preload)]
+        result = simulate_at(parameter_matrix([sets[i] for i in members], bushing), offset) + preload
+        for row, i in zip(result, members):
+            forces[i] = row
+    return np.array(forces)
+
+
+def _refuse_failed(force: np.ndarray, time_s) -> None:
+    failed = ~np.isfinite(force)
+    if failed.any():
+        first = np.argmax(failed.reshape(failed.shape[0], -1).any(axis=1))
+        raise IdentificationError(f"the simulation of the best parameter set fails from t = "
+                                  f"{np.asarray(time_s)[first]:g} s (overflow or too many substeps): "
+                                  "check the units of the displacement (mm) and the amplitude")

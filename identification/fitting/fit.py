@@ -1,0 +1,564 @@
+"""Fit a model's parameters to training tests, and say how sure the fit is.
+
+``fit(tests, model=DEFAULT_MODEL, preset="default", seed=0, workers=None, scheduler=None)``:
+
+1. the noise level of every test from its own data (``identification.measured.noise``);
+2. the search (``identification.fitting.multistart``): screened Sobol starts (for a model with a
+   spring and friction, some with those from the data's slowest loop:
+   ``identification.fitting.loop_start``), then successive
+   halving of bounded trust-region least squares on the misfit (``identification.fitting.objectives``),
+   every start a task of the engine (``identification.fitting.engine``: this process, local worker
+   processes, or a Dask cluster; the same seed gives the same bits on each);
+3. the evidence (pyPESTO's multi-start practice, ``identification.fitting.result``): how many of the last stage's starts reach
+   the best misfit within the ensemble threshold, and whether every training test is at its
+   noise floor (NRMSE <= FLOOR_FACTOR x its noise level). A fit that is not both is
+   ``converged = False`` and says why (``FitResult.warning``);
+4. how sure (``identification.fitting.ensemble``): the singular values of the residual Jacobian and
+   the ensemble: distinct start end points and posterior draws (emcee) pushed to the edge of
+   the 95 % confidence region.
+
+The ``paper`` preset replaces the Sobol screening by the paper's genetic algorithm (pymoo:
+population 300, 200 generations, uniform crossover 0.8, mutation probability 0.05 per
+coordinate) and keeps the rest. Kelvin-Voigt is fitted by linear least squares (the
+optimum is exact, so only the floor is checked).
+"""
+from __future__ import annotations
+
+import contextlib
+import math
+import os
+import sys
+import threading
+import time
+import warnings
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+
+from fmu_src.bushing_models import BushingModel, DEFAULT_MODEL, resolve_model
+from fmu_src.compiled_kernels import cache_directory
+from fmu_src.parameter_files import ParameterSet
+from identification.forward.population import parameter_matrix
+from identification.fitting.engine import make_engine
+from identification.fitting.ensemble import (PROBES, PROFILE_EVALUATIONS, PROFILE_ROUNDS, PUSH, STEPS, WALKERS,
+                                     identifiability, misfit_threshold, posterior_samples, profile_extremes,
+                                     push_to_boundary, select_members, threshold_scale)
+from identification.errors import CharacterisationWarning, IdentificationError
+from identification.extras import require
+from identification.fitting.result import (FLOOR_FACTOR, MIN_AGREEING, FitNotConvergedWarning, FitResult,  # noqa: F401
+                                       RigTestFit, TableFit, agreeing_starts)
+from identification.measured.kdyn_table import KdynTable, load_kdyn_table
+from identification.fitting.loop_start import LOOP_STARTS, anchored_coordinates, slow_loop_start
+from identification.measured.measurements import Measurement
+from identification.measured.multiaxis import (COUPLED_AXES, MultiAxisMeasurement, coupled_axes, load_multiaxis,
+                                              vector_nrmse)
+from identification.fitting.multistart import (JACOBIANS, Problem, StartRecord, failed_starts, first_records, jacobian,
+                                       run_stages, screen, simulations_per_jacobian)
+from identification.measured.noise import NoiseEstimate, estimate_noise
+from identification.fitting.objectives import Objective, nrmse
+from identification.fitting.presets import PAPER_GA, PRESETS, SearchSettings
+from identification.fitting.progress import SearchProgress
+from identification.fitting.refinement import refine_steps
+from identification.measured.rig_tests import Manifest, RigTest
+from identification.fitting.search_space import SearchSpace
+from identification.forward.simulate import simulate_multiaxis, simulate
+from identification.fitting.table_start import table_start
+
+MIN_FINAL_STARTS = 3
+"""A reduced budget (``starts``) keeps at least this many starts to the end: with two, one
+stray start already makes the agreement fail."""
+
+
+def as_tests(measurements) -> list[RigTest]:
+    """RigTests from a Manifest, RigTests, Measurements (kind ``random``) or file paths."""
+    from identification.measured.measurements import load_measurement
+    if isinstance(measurements, Manifest):
+        return list(measurements.tests)
+    if isinstance(measurements, (RigTest, Measurement, str, Path)):
+        measurements = [measurements]
+    tests = []
+    for item in measurements:
+        if isinstance(item, RigTest):
+            tests.append(item)
+        elif isinstance(item, Measurement):
+            tests.append(RigTest(item))
+        else:
+            tests.append(RigTest(load_measurement(item)))
+    if not tests:
+        raise IdentificationError("no training tests given")
+    return tests
+
+
+def as_multiaxis(multiaxis) -> list[MultiAxisMeasurement]:
+    """MultiAxisMeasurements from MultiAxisMeasurements or file paths (``multiaxis.load_multiaxis``)."""
+    if isinstance(multiaxis, (MultiAxisMeasurement, str, Path)):
+        multiaxis = [multiaxis]
+    return [m if isinstance(m, MultiAxisMeasurement) else load_multiaxis(m) for m in multiaxis or ()]
+
+
+def fit(measurements, model: str | BushingModel = DEFAULT_MODEL, preset: str = "default", seed: int = 0,
+        workers: int | None = None, scheduler=None, engine=None, progress: bool = True, screening: int | None = None,
+        starts: int | None = None, kdyn=None, ensemble: bool = True, jacobian: str = "exact", multiaxis=(),
+        coupling: str | None = None) -> FitResult:
+    """Identify a model's parameters from rig tests, and say how sure the fit is.
+
+    Parameters
+    ----------
+    measurements : Manifest, sequence of RigTest, Measurement, str or Path
+        The training tests (``training_tests``, ``load_manifest``); a Measurement or a CSV path
+        counts as a random-input test. May be empty when ``kdyn`` or ``multiaxis`` is given.
+    model : str or BushingModel
+        A model's name (``fmu_src.bushing_models.MODEL_NAMES``; default ``DEFAULT_MODEL``, the
+        paper's), or the model itself; resolved once and passed on. A model whose force is linear
+        in its parameters (``BushingModel.linear``: Kelvin-Voigt) is fitted by linear least
+        squares, every other by the search.
+    preset : str
+        ``default`` (Sobol screening) or ``paper`` (the paper's GA); see ``presets``.
+    seed : int
+        Root seed (>= 0); the same seed gives the same bits on any engine.
+    workers : int, optional
+        Local worker processes (default: every core).
+    scheduler : str or dask.distributed.Client, optional
+        Run on a Dask cluster instead (the ``dask`` extra).
+    engine : optional
+        An engine to reuse (not closed).
+    progress : bool
+        Progress bars on stderr (drawn only where stderr is a terminal).
+    screening, starts : int, optional
+        Override the preset's Sobol points and first-stage starts (later stages shrink in
+        proportion; at least ``MIN_FINAL_STARTS`` remain, or ``starts`` if fewer).
+    kdyn : str, Path or KdynTable, optional
+        A dynamic-stiffness table (CSV amplitude_mm, frequency_hz, kdyn_N_per_mm,
+        loss_angle_deg) fitted with the tests, or alone.
+    ensemble : bool
+        False skips the profiles and the posterior sampling (a third to half of the time): no
+        band then, and ``FitResult.save(ensemble=...)`` refuses.
+    jacobian : str
+        How the least squares and the identifiability get the residuals' Jacobian: ``exact``
+        (default: the forces' sensitivities, computed with them; ``identification.forward.parameter_jacobian``)
+        or ``difference`` (forward differences, one simulation per coordinate). The multi-axis
+        tests' rows are differences either way (the coupled kernels have no sensitivities).
+    multiaxis : sequence of MultiAxisMeasurement, str or Path, optional
+        Multi-axis tests (CSV time_s,dx_mm,dy_mm,Fx_N,Fy_N[,dz_mm,Fz_N]: ``identification.measured.multiaxis``)
+        fitted with the one-axis tests, or alone: each axis's force at each sample a residual in
+        that axis's noise units.
+    coupling : str, optional
+        How the model runs on the multi-axis tests (required with them): ``none`` (its one-axis
+        model on each axis alone), ``radial`` (its coupled form on x and y, z alone) or
+        ``spherical`` (on x, y and z). The fitted set is the one-axis set either way, which
+        ``assemble --coupling`` turns into a six-axis file.
+
+    Returns
+    -------
+    FitResult
+        The best set with its provenance, each test's NRMSE against its noise level, the
+        agreement of the starts, ``converged`` and, if not, ``warning``; ``summary()``,
+        ``save()``.
+
+    Raises
+    ------
+    IdentificationError
+        No tests, a bad seed or preset, a test whose noise cannot be estimated, multi-axis tests
+        without a coupling or with one they cannot carry (spherical on a plane test).
+    MissingExtraError
+        The ``fit`` extra is not installed.
+
+    Warns
+    -----
+    FitNotConvergedWarning
+        The fit is not at the noise floor or its starts do not agree (the message says which).
+
+    Notes
+    -----
+    Units: time s, displacement mm, force N; parameters in the paper's N-mm-s units. With
+    ``workers`` > 1, guard a script's top level with ``if __name__ == "__main__":``.
+    """
+    require("fit", "identification.fit")
+    from threadpoolctl import threadpool_limits
+    started = time.perf_counter()
+    table = kdyn if kdyn is None or isinstance(kdyn, KdynTable) else load_kdyn_table(kdyn)
+    multi = as_multiaxis(multiaxis)
+    _check_coupling(multi, coupling)
+    empty = measurements is None or (isinstance(measurements, (list, tuple)) and not measurements)
+    tests = [] if (empty and (table is not None or multi)) else as_tests(measurements)
+    bushing = resolve_model(model)
+    if seed < 0:
+        raise IdentificationError(f"seed = {seed}: give an integer >= 0")
+    if jacobian not in JACOBIANS:
+        raise IdentificationError(f"jacobian = {jacobian!r}: choose one of {', '.join(JACOBIANS)}")
+    noise = [_noise_of(t) for t in tests]
+    multi = MultiAxisTraining(multi, [_axis_noise_of(m) for m in multi], coupling or "none")
+    # One BLAS thread here as in every task: a multi-threaded BLAS may sum in another order,
+    # and the scales and the Jacobian's SVD computed here must not depend on the engine.
+    with threadpool_limits(limits=1):
+        if bushing.linear is not None:
+            result = _fit_linear(bushing, tests, noise, started, table, multi)
+        else:
+            if preset not in PRESETS:
+                raise IdentificationError(f"unknown preset {preset!r}; choose one of {', '.join(PRESETS)}")
+            settings = _settings(PRESETS[preset], screening, starts)
+            owned = engine is None
+            engine = engine or make_engine(workers, scheduler)
+            # an engine made here is closed here, and aborted if the search is left by an exception
+            # (Ctrl-C, SIGTERM): see identification.fitting.engine
+            with engine if owned else contextlib.nullcontext():
+                result = _search(tests, noise, bushing, preset, settings, seed, engine, progress, started, table,
+                                 ensemble, jacobian, multi)
+    if not result.converged:
+        warnings.warn(result.warning, FitNotConvergedWarning, stacklevel=2)
+    return result
+
+
+def _noise_of(test: RigTest) -> NoiseEstimate:
+    try:
+        return estimate_noise(test.measurement.force_N)
+    except ValueError as exc:
+        raise IdentificationError(f"{test.measurement.source}: {exc}") from None
+
+
+def _axis_noise_of(m: MultiAxisMeasurement) -> list[NoiseEstimate]:
+    try:
+        return [estimate_noise(m.force_N[:, c]) for c in range(m.force_N.shape[1])]
+    except ValueError as exc:
+        raise IdentificationError(f"{m.source}: {exc}") from None
+
+
+def _check_coupling(multi: list[MultiAxisMeasurement], coupling: str | None) -> None:
+    """Multi-axis tests need a coupling they can carry; a coupling needs multi-axis tests."""
+    if multi and coupling is None:
+        raise IdentificationError(f"the multi-axis tests {', '.join(m.name for m in multi)} need a coupling: "
+                                  f"{', '.join(COUPLED_AXES)} (--coupling)")
+    if coupling is not None and not multi:
+        raise IdentificationError(f"coupling {coupling!r} given without multi-axis tests: it says how the model runs "
+                                  "on them (--multiaxis FILE)")
+    for m in multi:
+        coupled_axes(coupling, m)
+
+
+@dataclass(frozen=True)
+class MultiAxisTraining:
+    """The multi-axis training tests, each axis's noise level and the coupling they are run with."""
+    measurements: list[MultiAxisMeasurement]
+    noise: list[list[NoiseEstimate]]
+    coupling: str
+
+    def objective_arguments(self) -> dict:
+        return {"multiaxis": self.measurements, "multiaxis_noise": self.noise, "coupling": self.coupling}
+
+    def components(self) -> list[Measurement]:
+        return [c for m in self.measurements for c in m.components()]
+
+    def fits(self, parameters: ParameterSet) -> list[RigTestFit]:
+        """Each test's vector NRMSE at ``parameters`` against its noise: the rms of the axes'
+        noise levels over the rms force vector (``multiaxis.vector_nrmse``'s units)."""
+        fits = []
+        for m, levels in zip(self.measurements, self.noise):
+            predicted = simulate_multiaxis(parameters, m.time_s, m.displacement_mm, coupling=self.coupling,
+                                           velocity_mm_s=m.velocity_mm_s)
+            noise = NoiseEstimate(math.sqrt(sum(level.sigma_N ** 2 for level in levels)),
+                                  math.sqrt(float(np.mean(np.sum(m.force_N ** 2, axis=1)))))
+            fits.append(RigTestFit(m.name, f"{len(m.axes)}-axis", noise, vector_nrmse(predicted, m.force_N)))
+        return fits
+
+
+def _settings(base: SearchSettings, screening: int | None, starts: int | None) -> SearchSettings:
+    if starts is not None:
+        if starts < 1:
+            raise IdentificationError(f"starts = {starts}: give 1 or more")
+        first = base.stages[0][0]
+        stages = tuple((max(min(MIN_FINAL_STARTS, starts), round(count * starts / first)) if i else starts, evaluations)
+                       for i, (count, evaluations) in enumerate(base.stages))
+        base = replace(base, stages=stages)
+    if screening is not None:
+        base = replace(base, screening=screening)
+    return SearchSettings(base.screening, base.stages)   # validates
+
+
+def _exact_jacobian_or_why_not(tests, space: SearchSpace, progress: bool) -> tuple[str, str | None]:
+    """("exact", None) with the sensitivity module compiled (or loaded) here first, so that the
+    workers load it from the disk cache instead of each compiling it at once; or ("difference",
+    a note saying why) where the exact Jacobian would not pay: a fit to a dynamic-stiffness table
+    alone (its rows are differences either way), or a cache folder that cannot be written (every
+    process, every worker would compile the module again, a minute or more each)."""
+    from identification.forward.parameter_jacobian import sensitivity_module
+    if not tests:
+        return "difference", None
+    folder = cache_directory()
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        writable = os.access(folder, os.W_OK)
+    except OSError:
+        writable = False
+    if not writable:
+        return "difference", (f"note: the compiled models' cache {folder} cannot be written, so the fit takes "
+                              "forward differences for its Jacobian (the exact one would be compiled again in every "
+                              "process); set BUSHING_CACHE_DIR to a writable folder")
+    # The first fit of a model on a machine compiles the module for a minute or more: say so
+    # if it takes longer than a moment (a load from the cache takes under a second).
+    message = threading.Timer(3.0, lambda: print(
+        f"compiling the fit's exact Jacobian for the {space.bushing.name} model (once per machine: a minute or two; "
+        f"cached in {folder})", file=sys.stderr, flush=True)) if progress else None
+    if message:
+        message.daemon = True
+        message.start()
+    try:
+        sensitivity_module(space.bushing, len(space.names))
+    finally:
+        if message:
+            message.cancel()
+    return "exact", None
+
+
+def _search(tests, noise, model, preset, settings, seed, engine, progress, started, table=None,
+            sample_ensemble=True, jacobian_kind="exact", multi: MultiAxisTraining | None = None) -> FitResult:
+    multi = multi or MultiAxisTraining([], [], "none")
+    measurements = [t.measurement for t in tests] + multi.components()
+    space = SearchSpace.from_measurements(measurements, model, steps=[t.kind == "step" for t in tests]
+                                          + [False] * (len(measurements) - len(tests)), table=table)
+    # with a table, the screening and the early stages run its coarser loop (kdyn_table)
+    notes = []
+    if jacobian_kind == "exact":
+        jacobian_kind, note = _exact_jacobian_or_why_not(tests, space, progress)
+        if note:
+            notes.append(note)
+    problem = Problem(Objective(tests, noise, model=space.bushing, table=table, search=table is not None,
+                                **multi.objective_arguments()), space, jacobian_kind)
+    ga_evaluations = PAPER_GA["population"] * PAPER_GA["generations"]
+    loop = slow_loop_start(tests, space) if preset != "paper" else None
+    if loop is None and preset != "paper":
+        loop = table_start(table, space)
+        if isinstance(loop, str):           # the table gives no start, and why
+            notes.append(loop)
+            loop = None
+    if loop is not None:
+        notes.append(f"note: {LOOP_STARTS} of the screened starts take the {loop.describe()}")
+    bars = SearchProgress(progress, settings, ga_evaluations if preset == "paper" else
+                          settings.screening + (LOOP_STARTS if loop else 0))
+    if preset == "paper":
+        from identification.fitting.multistart import genetic_algorithm
+        theta, misfits = genetic_algorithm(problem, engine, seed, bars.screening, **PAPER_GA)
+    else:
+        theta, misfits = screen(problem, engine, settings.screening, seed, bars.screening,
+                                anchored=loop and anchored_coordinates(loop, space), anchored_count=LOOP_STARTS)
+    evaluations = ga_evaluations if preset == "paper" else len(misfits)
+    n, d = problem.objective.size, len(space.names)
+    *early, last = settings.stages
+    records = run_stages(problem, engine, first_records(theta, misfits, settings.stages[0][0]), early, bars.stage)
+    # The forward model's steps per sample, checked where the result is decided: at the best
+    # start before the last stage, and at the best fit; if that changes them, the last stage
+    # runs once more, and a third check only reports (identification.fitting.refinement). A lone best
+    # start gets company before the check at the best fit (_extend_if_alone).
+    refinement = _check_steps(problem, tests, records, n, d)
+    problem = Problem(refinement.objective.with_fit_loop(tests), space, jacobian_kind)
+    records = run_stages(problem, engine, records, [last], bars.stage, first_stage=len(early))
+    records, added, agreeing = _extend_if_alone(problem, engine, records, last, len(early), n, d, bars)
+    final_count = last[0] + added
+    if added:
+        notes.append(f"note: only {agreeing} of the {last[0]} final starts reached the best misfit, so {added} more "
+                     f"start{'s' if added > 1 else ''} of the earlier stages also ran the last stage")
+    refinement_at_best = _check_steps(problem, tests, records, n, d)
+    evaluations += refinement.evaluations + refinement_at_best.evaluations
+    if refinement_at_best.changed:
+        problem = Problem(refinement_at_best.objective, space, jacobian_kind)
+        records = run_stages(problem, engine, records, [(final_count, last[1])],
+                             lambda s, k: bars.stage(s, k, again=True, total=final_count), first_stage=len(early))
+        final_check = _check_steps(problem, tests, records, n, d)
+        evaluations += final_check.evaluations
+        if final_check.changed:
+            notes.append(f"note: at the best fit the forward model would need "
+                         f"{'/'.join(map(str, final_check.objective.steps_per_sample))} steps per sample (it ran "
+                         f"{'/'.join(map(str, problem.objective.steps_per_sample))}); its own error may take more "
+                         "than a tenth of the confidence region")
+    bars.close()
+    evaluations += sum(r.evaluations - 1 for r in records)
+
+    # scored by the objective used from here on; a failed start is skipped (failed_starts)
+    final = [r for r in records if r.stage == len(early) and not r.failed]
+    best = _best_record(final or records)
+    failed = failed_starts(records)
+    if not final:
+        notes.append(f"note: every start of the last stage failed (residuals or Jacobian not finite); the result is "
+                     f"the best finite point the search found (stage {best.stage + 1 if best.stage >= 0 else 0})")
+    threshold = misfit_threshold(best.misfit, n, d)
+    scaled_jacobian = _identifiability_jacobian(problem, best.theta, notes)
+    ident = identifiability(scaled_jacobian * np.sqrt(n), space.names, threshold * n)
+    evaluations += simulations_per_jacobian(problem, d, known=False)
+    limit = best.misfit + threshold
+    sampler = None
+    members = [best.theta]
+    if sample_ensemble:
+        extremes, extreme_misfits, failed_profiles = profile_extremes(problem, best.theta, best.misfit, ident, limit,
+                                                                      engine)
+        failed += failed_profiles
+        # here, not on a worker: the compiled kernel runs the walkers on every core of this process
+        draws, _, sampler = posterior_samples(problem, best.theta, seed, threshold_scale(best.misfit, n, d))
+        pushed, pushed_misfits = push_to_boundary(problem, best.theta, draws, limit)
+        per_jacobian = simulations_per_jacobian(problem, d, known=False)
+        evaluations += WALKERS * STEPS + len(draws) * len(PUSH) \
+            + len(PROBES) * 2 * per_jacobian * (1 + PROFILE_ROUNDS * PROFILE_EVALUATIONS)
+        members = select_members(best.theta, [(r.theta, r.misfit) for r in final],
+                                 np.vstack([extremes, pushed]), np.concatenate([extreme_misfits, pushed_misfits]),
+                                 limit, space.bounds())
+    rows = space.to_model_parameters(np.array(members))
+    names = space.bushing.parameter_names
+    ensemble = [dict(zip(names, map(float, row))) for row in rows]
+    parameters = ParameterSet(space.bushing, ensemble[0])
+    steps = problem.objective.steps_per_sample
+    fits = _test_fits(tests, noise, parameters, steps) + multi.fits(parameters)
+    steps = steps + [m.driven.steps_per_sample for m in problem.objective.multiaxis]
+    result = FitResult(parameters, float(best.misfit), fits, records, threshold,
+                       ensemble, ident, preset, seed, evaluations, time.perf_counter() - started, engine.description,
+                       space, final_starts=len(final), sampler=sampler, notes=notes, steps_per_sample=steps,
+                       table=table_fit(table, parameters), added_starts=added, agreed_before_added=agreeing,
+                       ensemble_sampled=sample_ensemble, residuals=n, failed_starts=failed,
+                       coupling=multi.coupling if multi.measurements else None)
+    result.parameters.provenance = result.provenance()
+    return result
+
+
+def _best_record(records: list[StartRecord]) -> StartRecord:
+    """The record of the lowest misfit (then the best-screened start) among ``records``; a failed
+    start counts with the last point where it was finite (screened points always are)."""
+    finite = [r for r in records if np.isfinite(r.misfit)] or records
+    return min(finite, key=lambda r: (r.misfit, r.start))
+
+
+def _identifiability_jacobian(problem: Problem, theta: np.ndarray, notes: list[str]) -> np.ndarray:
+    """The residuals' Jacobian at the best fit for the identifiability; entries that are not finite
+    (a difference across a blow-up) are taken as 0, with a note."""
+    scaled_jacobian, _ = jacobian(problem, theta)
+    finite = np.isfinite(scaled_jacobian)
+    if not finite.all():
+        notes.append(f"note: {int(np.count_nonzero(~finite))} entries of the Jacobian at the best fit are not finite "
+                     "and were taken as 0 for the identifiability")
+        scaled_jacobian = np.where(finite, scaled_jacobian, 0.0)
+    return scaled_jacobian
+
+
+def linear_solution(bushing: BushingModel, measurements) -> dict[str, float]:
+    """The parameters of a model whose force is linear in them (``bushing.linear``) by linear
+    least squares on ``measurements`` (scipy's lsq_linear, within each parameter's range), the
+    held ones at their values."""
+    from scipy.optimize import lsq_linear
+    names = [name for name, _ in bushing.linear.regressors]
+    signal = {"displacement": "displacement_mm", "velocity": "velocity_mm_s"}
+    design = np.column_stack([np.concatenate([getattr(m, signal[regressor]) for m in measurements])
+                              for _, regressor in bushing.linear.regressors])
+    force = np.concatenate([m.force_N for m in measurements])
+    solution = lsq_linear(design, force, bounds=_ranges(bushing, names)).x
+    return {**{name: float(value) for name, value in zip(names, solution)}, **dict(bushing.linear.held)}
+
+
+def _ranges(bushing: BushingModel, names) -> tuple[list[float], list[float]]:
+    """(lower, upper) bounds of the parameters ``names``: their allowed ranges (open ends +-inf)."""
+    specs = {spec.name: spec for spec in bushing.specs}
+    return ([-np.inf if specs[name].minimum is None else specs[name].minimum for name in names],
+            [np.inf if specs[name].maximum is None else specs[name].maximum for name in names])
+
+
+def _fit_linear(bushing: BushingModel, tests, noise, started, table=None,
+                multi: MultiAxisTraining | None = None) -> FitResult:
+    """A model whose force is linear in its parameters (``bushing.linear``) by linear least
+    squares (:func:`linear_solution`) on the tests other than steps (a linear spring cannot show
+    the step's relaxation; all tests if there are only steps) and on every axis of the
+    multi-axis tests (such a bushing couples nothing). With a dynamic-stiffness table: scipy's
+    bounded least squares on the whole objective (tests and table), from that solution or, with
+    a table alone, from the table's scales (k_ref for a stiffness, c_ref for a damping)."""
+    from scipy.optimize import least_squares
+    multi = multi or MultiAxisTraining([], [], "none")
+    free = [name for name, _ in bushing.linear.regressors]
+    held = dict(bushing.linear.held)
+    if tests or multi.measurements:
+        values = linear_solution(bushing, ([t.measurement for t in tests if t.kind != "step"]
+                                           or [t.measurement for t in tests]) + multi.components())
+    else:
+        scales = SearchSpace.from_table(table)
+        scale = {"displacement": scales.k_ref, "velocity": scales.c_ref}
+        values = {**{name: scale[regressor] for name, regressor in bushing.linear.regressors}, **held}
+    objective = Objective(tests, noise, model=bushing, table=table, **multi.objective_arguments())
+    if table is not None:
+        def residuals(solved):
+            return objective.residual_matrix(parameter_matrix([{**dict(zip(free, solved)), **held}], bushing))[0]
+        solution = least_squares(residuals, [values[name] for name in free], bounds=_ranges(bushing, free),
+                                 x_scale="jac")
+        values = {**{name: float(value) for name, value in zip(free, solution.x)}, **held}
+    parameters = ParameterSet(bushing, values)
+    misfit = float(objective(parameter_matrix([values], bushing))[0])
+    result = FitResult(parameters, misfit, _test_fits(tests, noise, parameters) + multi.fits(parameters), [], 0.0,
+                       [values], None, "linear", 0, 1, time.perf_counter() - started, table=table_fit(table, parameters),
+                       residuals=objective.size, coupling=multi.coupling if multi.measurements else None)
+    result.parameters.provenance = result.provenance()
+    return result
+
+
+def _extend_if_alone(problem: Problem, engine, records: list[StartRecord], last: tuple[int, int], stage: int,
+                     n: int, d: int, bars) -> tuple[list[StartRecord], int, int]:
+    """If fewer than MIN_AGREEING of the last stage's starts reach the best misfit within the
+    ensemble threshold, up to ``last[0]`` more starts run the last stage too (once): those that
+    stopped in the latest earlier stage first, each group by misfit. A lone best start thus
+    gets its chance to be confirmed, or a better optimum is found, before the fit says it is
+    not converged. Returns the records (sorted as ``run_stages`` sorts them), how many starts
+    were added and how many agreed before."""
+    best = min((r.misfit for r in records if r.stage == stage and not r.failed), default=np.inf)
+    agreeing = agreeing_starts(records, stage, best, misfit_threshold(best, n, d)) if np.isfinite(best) else 0
+    waiting = sorted((r for r in records if r.stage < stage and not r.failed),
+                     key=lambda r: (-r.stage, r.misfit, r.start))[:last[0]]
+    if agreeing >= MIN_AGREEING or not waiting:
+        return records, 0, agreeing
+    run_stages(problem, engine, waiting, [(len(waiting), last[1])],
+               lambda s, k: bars.stage(s, k, more=True, total=len(waiting)), first_stage=stage)
+    records.sort(key=lambda r: (-r.stage, r.misfit, r.start))
+    return records, len(waiting), agreeing
+
+
+def _check_steps(problem: Problem, tests, records, n: int, d: int):
+    """``refinement.refine_steps`` at the best start of the latest stage (its misfit sets the
+    region's delta chi^2)."""
+    best = _best_record([r for r in records if r.stage == records[0].stage and not r.failed] or records)
+    return refine_steps(problem.objective, tests, problem.space.to_parameters(best.theta[None, :]),
+                        misfit_threshold(best.misfit, n, d) * n)
+
+
+def _test_fits(tests, noise, parameters: ParameterSet, steps=None) -> list[RigTestFit]:
+    """Each test's noise and NRMSE at ``parameters``, simulated with ``steps`` per sample (per
+    test; default: chosen from the signal)."""
+    fits = []
+    for test, level, m_steps in zip(tests, noise, steps or [None] * len(tests)):
+        m = test.measurement
+        predicted = simulate(parameters, m.time_s, m.displacement_mm, m.measured_velocity_mm_s,
+                             steps_per_sample=m_steps)
+        fits.append(RigTestFit(test.name, test.kind, level, nrmse(predicted, m.force_N)))
+    return fits
+
+
+def table_fit(table: KdynTable | None, parameters: ParameterSet) -> TableFit | None:
+    """The table's rows (weight > 0) against the converged characterisation of ``parameters``,
+    and how far the fit's fixed-cycle loop is from it (its largest relative |K*| difference):
+    a fitted table, or one held out (``compare``)."""
+    if table is None:
+        return None
+    from identification.forward.dynamic_stiffness import MAX_CYCLES, STEPS_PER_CYCLE, TOLERANCE, run_sines, stiffness_from_sums
+    from identification.fitting.objectives import PreparedTable
+    model = parameters.model
+    prepared = PreparedTable.of(table, model)
+    rows = prepared.rows
+    matrix = parameter_matrix([parameters.parameters], model)
+
+    def steady(steps):
+        result, _ = run_sines(matrix, model, rows.amplitude_mm, rows.frequency_hz, rows.preload_mm, steps, MAX_CYCLES,
+                              TOLERANCE)
+        if np.any(result[:, 3] == 1):
+            warnings.warn(f"{table.name}: some cases of the fitted set reach no steady state within {MAX_CYCLES} "
+                          "cycles", CharacterisationWarning, stacklevel=4)
+        if np.any(result[:, 3] == 2):
+            warnings.warn(f"{table.name}: the fitted set fails on some cases (overflow or too many substeps); their "
+                          "errors are NaN", CharacterisationWarning, stacklevel=4)
+        return stiffness_from_sums(result, rows.amplitude_mm)[2:]
+
+    kdyn, angle = steady(STEPS_PER_CYCLE)
+    # the fit loop against the steady state at the fit loop's own steps: what its few cycles leave
+    fixed, _ = prepared.stiffness(matrix, model)
+    converged_fit_steps, _ = steady(prepared.steps_per_cycle)
+    return TableFit(table.name, kdyn / rows.kdyn_N_per_mm - 1.0, angle - rows.loss_angle_deg, rows.weight,
+                    float(np.max(np.abs(fixed[0] / converged_fit_steps - 1.0))))

@@ -1,0 +1,135 @@
+"""Starts from the data: a fluid track's tuning, read off a dynamic-stiffness table.
+
+A model whose box declares ``SearchBox.table_start`` (a ``model_definition.TrackStart``: the
+names of its static spring, bulge stiffness, lower-chamber stiffness, track mass and damping and
+decoupler travel) has a fluid column that resonates against its chambers, in parallel with the
+rubber. Its data sheet shows the column, and the linear form of the model,
+
+    K*(omega) = rubber + kb*(kc - mf*omega^2 + i*omega*cf)/(kb + kc - mf*omega^2 + i*omega*cf),
+
+reads back from it (at the table's largest amplitude, where the decoupler rests on its cage):
+
+- the resonance f_r, where the loss stiffness K'' = |K*|*sin(delta) peaks (a parabola through the
+  peak and its neighbours in log f; the loss angle itself peaks below the resonance, where the
+  storage stiffness dips);
+- the bulge stiffness kb from the rise of the storage stiffness K' = |K*|*cos(delta) from the
+  lowest frequency to the highest (the fluid path goes from kb*kc/(kb + kc) to kb, a rise of
+  kb^2/(kb + kc), 0.91*kb with the bellows below; the rubber's Maxwell element adds to the rise
+  about as much, so the rise itself is taken);
+- kc as a tenth of kb (a soft bellows: the notch that would give it moves with the rubber's
+  damping and the track's, too much to read);
+- the mass mf = (kb + kc)/(2*pi*f_r)^2;
+- the track damping from the loss stiffness K'' = |K*|*sin(delta) at the peak, which the
+  column's kb^2/(omega_r*cf) dominates there;
+- the static spring k0 = K'(lowest frequency) - kb*kc/(kb + kc) (at least 1 % of it);
+- the decoupler's travel from the amplitudes: the peak appears once the pressure kb*X exceeds
+  what the membrane takes, (kb + kc + kd)*gap with kd its stiffness, taken as small against
+  kb + kc (a soft membrane), so gap is about kb/(kb + kc) times the smallest
+  amplitude whose peak loss angle reaches half the largest amplitude's (the geometric mean of it
+  and the largest amplitude below it, where the table has one).
+
+Read at one preload: the table's most common one among the largest amplitude's rows (the one
+nearest 0 of equally common ones). What the table cannot give (no peak of the loss stiffness
+inside its frequencies, fewer than three frequencies, a single amplitude for the travel) is left
+to the box, and :func:`table_start` says so.
+The fit's screening then adds ``loop_start.LOOP_STARTS`` candidates anchored at these values
+(``multistart.screen``), as it does for a slow loop's.
+
+Units: mm, Hz, N/mm, N.s/mm, N.s^2/mm.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from identification.measured.kdyn_table import KdynTable
+from identification.fitting.search_space import SearchSpace
+
+MIN_FREQUENCIES = 3
+"""Frequencies at the largest amplitude below which no resonance is read."""
+
+
+@dataclass(frozen=True)
+class TableStart:
+    """What the table gives: the parameters, the table and what it could not give."""
+    parameters: dict[str, float]
+    source: str
+    missing: str = ""
+
+    def describe(self) -> str:
+        values = ", ".join(f"{name} = {value:.4g}" for name, value in self.parameters.items())
+        return (f"fluid track from the data sheet {self.source}: {values}"
+                + (f" ({self.missing})" if self.missing else ""))
+
+
+def _peak_frequency(frequency: np.ndarray, values: np.ndarray) -> float | None:
+    """Where ``values`` peak over ``frequency`` [Hz], refined by a parabola in log f; None at either end."""
+    k = int(np.argmax(values))
+    if k == 0 or k == frequency.size - 1:
+        return None
+    u = np.log(frequency[k - 1:k + 2])
+    a, b, _ = np.polyfit(u, values[k - 1:k + 2], 2)
+    peak = -b / (2.0 * a) if a < 0 else u[1]
+    return float(math.exp(np.clip(peak, u[0], u[2])))
+
+
+def table_start(table: KdynTable | None, space: SearchSpace) -> TableStart | str | None:
+    """The track's starting values from ``table`` (module docstring): a TableStart; a sentence
+    saying why the table gives none (the fit then starts from its box); None where the model
+    declares no track start or no table is given."""
+    track = space.bushing.search.table_start if space.bushing.search is not None else None
+    if track is None or table is None:
+        return None
+    kept = table.weight > 0
+    largest = float(table.amplitude_mm[kept].max())
+    preloads, counts = np.unique(table.preload_mm[kept & (table.amplitude_mm == largest)], return_counts=True)
+    preload = min(preloads[counts == counts.max()], key=abs)
+    kept &= table.preload_mm == preload
+    amplitude, frequency = table.amplitude_mm[kept], table.frequency_hz[kept]
+    kdyn, angle = table.kdyn_N_per_mm[kept], table.loss_angle_deg[kept]
+    rows = np.flatnonzero(amplitude == largest)
+    rows = rows[np.argsort(frequency[rows])]
+    at = f"at its largest amplitude ({largest:g} mm" + (f", preload {preload:g} mm)" if preload else ")")
+    if rows.size < MIN_FREQUENCIES:
+        count = "a single frequency" if rows.size == 1 else f"{rows.size} frequencies"
+        return (f"note: the table has {count} {at}, fewer than {MIN_FREQUENCIES}: no resonance to read, the fit "
+                "starts from the default box")
+    f, k, d = frequency[rows], kdyn[rows], np.radians(angle[rows])
+    storage, loss = k * np.cos(d), k * np.sin(d)
+    resonance = _peak_frequency(f, loss)
+    if resonance is None:
+        return (f"note: the table's loss stiffness {at} has no peak inside its frequencies "
+                f"({f[0]:g}-{f[-1]:g} Hz): no resonance to read, the fit starts from the default box")
+    bulge = max(storage[-1] - storage[0], 0.01 * storage[0])
+    chamber = 0.1 * bulge
+    omega = 2.0 * math.pi * resonance
+    peak_loss = float(np.interp(math.log(resonance), np.log(f), loss))
+    values = {track.mass: (bulge + chamber) / omega ** 2,
+              track.stiffness: bulge, track.compliance: chamber,
+              track.damping: bulge ** 2 / (omega * max(peak_loss, 1e-6 * bulge)),
+              track.static: max(storage[0] - bulge * chamber / (bulge + chamber), 0.01 * storage[0])}
+    missing = ""
+    if track.travel:
+        travel = _travel(amplitude, angle, largest, bulge / (bulge + chamber))
+        if travel is None:
+            missing = (f"the table has a single amplitude ({largest:g} mm): the decoupler's travel is left to "
+                       "the box")
+        else:
+            values[track.travel] = travel
+    return TableStart(values, table.source, missing)
+
+
+def _travel(amplitude: np.ndarray, angle: np.ndarray, largest: float, share: float) -> float | None:
+    """The decoupler's travel [mm] from the smallest amplitude whose peak loss angle reaches half
+    the largest amplitude's (module docstring); None with a single amplitude."""
+    amplitudes = np.unique(amplitude)
+    if amplitudes.size < 2:
+        return None
+    peaks = np.array([angle[amplitude == a].max() for a in amplitudes])
+    top = peaks[amplitudes == largest][0]
+    showing = amplitudes[peaks >= 0.5 * top]
+    on = float(showing.min())
+    quiet = amplitudes[amplitudes < on]
+    return share * (math.sqrt(on * float(quiet.max())) if quiet.size else on)
