@@ -45,6 +45,7 @@ def write_tests(folder, tests):
     return folder / "tests.json"
 
 
+@pytest.mark.slow      # 45 s, a third of the README's command on two cores: run in CI's slow phase
 @pytest.mark.optimizer
 def test_a_starved_budget_prints_the_warning_and_stores_converged_false(tmp_path, capsys):
     # one start from 8 screened points: one final start cannot agree with another, on any path
