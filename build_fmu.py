@@ -9,8 +9,8 @@ FMI 2.0 or 3.0, co-simulation and model exchange, see ``fmu_src/native``) of the
 (``proposed``, the default: ``BoucWenBushing.fmu``; ``spencer``: ``SpencerBushing``;
 ``single_bouc_wen``: ``SingleBoucWenBushing``; ``berg``: ``BergBushing``; ``fractional``:
 ``FractionalBushing``; ``kelvin_voigt``: ``KelvinVoigtBushing``; every model of
-``fmu_src/bushing_models``; ``six_axis``: ``SixAxisBushing``, six uncoupled axes each one of the
-models, see ``fmu_src/axes.py``) whose parameter start values are the set in FILE, project JSON
+``fmu_src/model/registry.py``; ``six_axis``: ``SixAxisBushing``, six uncoupled axes each one of the
+models, see ``fmu_src/fmi/axes.py``) whose parameter start values are the set in FILE, project JSON
 or SSP 1.0 ``.ssv`` (default: the model's file in ``data/``: the paper's Table 5 for the proposed
 model, the baselines' fits to the synthetic Table 5 tests, an illustrative filled rubber for Berg's
 and the fractional model, ``data/params_six_axis_illustrative.json`` for six axes).
@@ -45,13 +45,14 @@ from xml.dom.minidom import parseString
 from xml.etree import ElementTree as ET
 
 REPO = Path(__file__).resolve().parent
-SLAVE_MODULE = "bushing_slave.py"
+SLAVE_MODULE = "fmi/pythonfmu_slave.py"
 
 sys.path.insert(0, str(REPO))
 import fmu_src  # noqa: E402
-from fmu_src import __version__, bushing_params  # noqa: E402
-from fmu_src.axes import ONE_AXIS, SIX_AXIS_IDENTIFIER, SIX_AXIS_NAMES, Coupling  # noqa: E402
-from fmu_src.bushing_models import MODEL_CHOICES, MODEL_NAMES, get_model  # noqa: E402
+from fmu_src import __version__  # noqa: E402
+from fmu_src.model import parameter_specs  # noqa: E402
+from fmu_src.fmi.axes import ONE_AXIS, SIX_AXIS_IDENTIFIER, SIX_AXIS_NAMES, Coupling  # noqa: E402
+from fmu_src.model.registry import MODEL_CHOICES, MODEL_NAMES, get_model  # noqa: E402
 from fmu_src.parameter_files import (parameter_document, read_parameter_set, read_six_axis,  # noqa: E402
                                      save_parameters, save_six_axis, six_axis_document)
 
@@ -59,12 +60,15 @@ from fmu_src.parameter_files import (parameter_document, read_parameter_set, rea
 PACKED_LIBRARY_INIT = '''"""Packed library of the bushing FMU (written by build_fmu.py)."""
 from pathlib import Path
 
-from . import axes, bushing_models, compiled_kernels, integration, model_definition, parameter_files, variables
+from . import parameter_files
+from .fmi import axes, variables
+from .kernels import numba_binding
+from .model import integration
 
 # Compiled here, once per process, while the extracted files surely exist (a host may delete them
 # after the first instance); STEP_AXES holds the compiled batched step of each model ({} for the
 # pure-Python step); STEP says which step runs (logged by every instance).
-AXES, STEP_AXES, STEP = compiled_kernels.compile_axes(
+AXES, STEP_AXES, STEP = numba_binding.compile_axes(
     parameter_files.fmu_axes(Path(__file__).with_name("default_parameters.json")))
 GROUPS = parameter_files.fmu_groups(Path(__file__).with_name("default_parameters.json"))
 '''
@@ -73,10 +77,15 @@ SIX_AXIS_DEFAULT_FILE = "params_six_axis_illustrative.json"
 
 
 SOURCE_DIR = Path(fmu_src.__file__).resolve().parent
-LIBRARY_MODULES = tuple(sorted(path.name for path in SOURCE_DIR.glob("*.py")
-                               if path.name not in ("__init__.py", SLAVE_MODULE)))
-"""What the pythonfmu FMU packs beside its slave module: every module of fmu_src (the models and
-what they share; its __init__ is PACKED_LIBRARY_INIT), so a model module added there is packed too."""
+NOT_PACKED = ("fmi/native/",)
+"""What the pythonfmu FMU leaves out of fmu_src: the native FMU's generator (C, compilers)."""
+LIBRARY_MODULES = tuple(sorted(path.relative_to(SOURCE_DIR).as_posix() for path in SOURCE_DIR.rglob("*.py")
+                               if path.relative_to(SOURCE_DIR).as_posix() not in ("__init__.py", SLAVE_MODULE)
+                               and not path.relative_to(SOURCE_DIR).as_posix().startswith(NOT_PACKED)))
+"""What the pythonfmu FMU packs beside its slave module, as paths under fmu_src: every module of
+it but the native FMU's generator (the models, the contract, the kernels' machinery, the FMI
+layer, the parameter files; its __init__ is PACKED_LIBRARY_INIT), so a model module added to
+fmu_src/models/ is packed too."""
 
 
 class BuildError(RuntimeError):
@@ -101,10 +110,10 @@ def model_of_file(params_file: str | Path) -> str:
     """The model a parameter file is for: the one it names (a one-axis set) or ``six_axis``."""
     try:
         return read_parameter_set(params_file).model.name
-    except bushing_params.ParameterError as one_axis_error:
+    except parameter_specs.ParameterError as one_axis_error:
         try:
             read_six_axis(params_file)
-        except bushing_params.ParameterError:
+        except parameter_specs.ParameterError:
             raise one_axis_error from None
         return SIX_AXIS
 
@@ -158,7 +167,7 @@ def build_native_fmu(params_file: str | Path | None = None, out_dir: str | Path 
         The FMU fails fmpy's validation; ``ParameterError`` for an invalid parameter file.
     """
     from fmpy.validation import validate_fmu
-    from fmu_src.native.build import build_native
+    from fmu_src.fmi.native.build import build_native
     identifier, _, axes, document = fmu_axes(params_file, model)
     build = build_native(axes, identifier, out_dir, fmi_version, platforms, groups_of(document))
     problems = validate_fmu(str(build.path))
@@ -216,6 +225,7 @@ def build_fmu(params_file: str | Path | None = None, out_dir: str | Path = "dist
         library.mkdir()
         (library / "__init__.py").write_text(PACKED_LIBRARY_INIT)
         for name in LIBRARY_MODULES:
+            (library / name).parent.mkdir(parents=True, exist_ok=True)
             shutil.copy2(SOURCE_DIR / name, library / name)
         (library / "default_parameters.json").write_text(defaults_text)
 
@@ -281,7 +291,7 @@ def _add_units(root: ET.Element, units: dict[str, str]) -> None:
     definitions = ET.Element("UnitDefinitions")
     for unit in sorted(units_used):
         element = ET.SubElement(definitions, "Unit", name=unit)
-        base = bushing_params.UNIT_DEFINITIONS[unit]
+        base = parameter_specs.UNIT_DEFINITIONS[unit]
         if base is not None:
             ET.SubElement(element, "BaseUnit", base)
     # FMI 2.0 schema order: CoSimulation, UnitDefinitions, TypeDefinitions, LogCategories, ...
@@ -398,7 +408,7 @@ def build_release(out_dir: str | Path = RELEASE_DIR, allow_missing_platforms: bo
         A platform's compiler is missing (and not ``allow_missing_platforms``), or no platform
         can be built at all; an FMU fails fmpy's validation.
     """
-    from fmu_src.native.build import NO_COMPILER, missing_platforms, platform_compilers
+    from fmu_src.fmi.native.build import NO_COMPILER, missing_platforms, platform_compilers
     started = time.perf_counter()
     models = tuple(models or release_models())
     missing = {version: why for version in fmi_versions if (why := missing_platforms(version))}
@@ -547,7 +557,7 @@ def main(argv: list[str] | None = None) -> int:
                         help="with --release: make the bundle without a platform whose compiler is missing "
                              "(the README names it) instead of refusing")
     args = parser.parse_args(argv)
-    from fmu_src.native.build import NativeBuildError
+    from fmu_src.fmi.native.build import NativeBuildError
     if args.release and (args.model or args.params or args.fmi_version or args.native):
         parser.error("--release builds every model, FMI 2 and 3, with its default parameter set: it takes "
                      "no --model, --params, --fmi-version or --native")
@@ -573,7 +583,7 @@ def main(argv: list[str] | None = None) -> int:
             raise BuildError("--fmi-version 3 needs --native (pythonfmu builds FMI 2.0 FMUs only)")
         else:
             path = build_fmu(args.params, out, args.model)
-    except (bushing_params.ParameterError, BuildError, NativeBuildError) as exc:
+    except (parameter_specs.ParameterError, BuildError, NativeBuildError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     except OSError as exc:   # an output directory that cannot be made or written

@@ -35,7 +35,7 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
 import build_fmu  # noqa: E402
-from fmu_src.axes import SIX_AXES  # noqa: E402
+from fmu_src.fmi.axes import SIX_AXES  # noqa: E402
 from fmu_src.parameter_files import save_six_axis  # noqa: E402
 from identification import fit, training_tests  # noqa: E402
 from identification.measured.measurements import write_measurement  # noqa: E402

@@ -31,7 +31,7 @@ sys.path.insert(0, str(REPO))
 
 import build_fmu  # noqa: E402
 from bench_fmu_step import _c_master  # noqa: E402
-from fmu_src.native.build import fmi_header_directory  # noqa: E402
+from fmu_src.fmi.native.build import fmi_header_directory  # noqa: E402
 from fmu_src.parameter_files import load_parameters, read_six_axis, save_six_axis  # noqa: E402
 
 AXES = ("x", "y", "z", "rx", "ry", "rz")

@@ -144,7 +144,7 @@ def main() -> None:
     exact_j, _ = jacobian(problem, theta)
     # one numba thread, as in a fit's worker (a worker takes a start's Jacobians): the forward
     # differences' 15 simulations would otherwise run on every core of this process
-    from fmu_src.jit import numba
+    from fmu_src.kernels.jit import numba
     numba.set_num_threads(1)
     timings = {}
     for label, function in (("exact", lambda: jacobian(problem, theta)),

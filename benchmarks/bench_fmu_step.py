@@ -126,9 +126,9 @@ def time_fmu(fmu_path, inputs, ports=ONE_AXIS_PORTS):
 
 
 def time_core(inputs_mm):
-    from fmu_src.integration import advance
+    from fmu_src.model.integration import advance
     from fmu_src.parameter_files import load_parameters
-    from fmu_src.proposed_model import MODEL
+    from fmu_src.models.proposed_model import MODEL
     params = load_parameters(REPO / "data" / "params_table5_combined.json")
     constants = MODEL.constants(params)
     state, state_x = MODEL.initial_state(constants, 0.0), 0.0
@@ -195,7 +195,7 @@ def measure_native(steps: int, repeats: int) -> dict:
     import statistics
 
     import build_fmu
-    from fmu_src.native.build import fmi_header_directory
+    from fmu_src.fmi.native.build import fmi_header_directory
     from fmu_src.parameter_files import load_parameters, save_parameters, save_six_axis
 
     with tempfile.TemporaryDirectory() as work:
@@ -262,7 +262,7 @@ def measure_native_against(revision: str, steps: int, repeats: int) -> dict:
     """{model: (this tree's, ``revision``'s seconds per step)} in the C master, the two FMUs of a
     model timed alternately (each repeat one run of each)."""
     import build_fmu
-    from fmu_src.native.build import fmi_header_directory
+    from fmu_src.fmi.native.build import fmi_header_directory
 
     models = ("proposed", *FILLED_RUBBER)
     with tempfile.TemporaryDirectory() as work:

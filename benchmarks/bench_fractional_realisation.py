@@ -2,7 +2,7 @@
 
     python benchmarks/bench_fractional_realisation.py
 
-The fractional element of ``fmu_src/fractional_model.py`` is MODES Maxwell elements on a fixed
+The fractional element of ``fmu_src/models/fractional_model.py`` is MODES Maxwell elements on a fixed
 grid of rates, one for the rates below the grid and a dashpot for those above it (its module
 docstring). Its dynamic stiffness is sum(k_j*s/(s + r_j)) + c*s at s = i*omega, from the model's
 own ``prepare``; this prints, for orders alpha from 0.05 to 0.95 and three frequency bands, the
@@ -22,7 +22,7 @@ import numpy as np
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
-from fmu_src.fractional_model import ELEMENTS, MODEL  # noqa: E402
+from fmu_src.models.fractional_model import ELEMENTS, MODEL  # noqa: E402
 
 BANDS_HZ = ((0.01, 300.0), (0.001, 1000.0), (1.0, 100.0))
 ORDERS = (0.05, 0.1, 0.2, 0.22, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 0.95)

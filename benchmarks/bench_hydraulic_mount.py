@@ -1,4 +1,4 @@
-"""The hydraulic mount (fmu_src/hydraulic_model.py): its data sheet against the closed form, and
+"""The hydraulic mount (fmu_src/models/hydraulic_model.py): its data sheet against the closed form, and
 the default set's data sheet drawn for the docs.
 
     python benchmarks/bench_hydraulic_mount.py [--figure docs/img/hydraulic_data_sheet.png]
@@ -151,7 +151,7 @@ def speed() -> None:
 
     import build_fmu
     from bench_fmu_step import _c_master
-    from fmu_src.native.build import fmi_header_directory
+    from fmu_src.fmi.native.build import fmi_header_directory
     from fmu_src.parameter_files import save_parameters
     with tempfile.TemporaryDirectory() as work:
         work = Path(work)

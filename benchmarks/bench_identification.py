@@ -33,8 +33,8 @@ def main() -> None:
     args = parser.parse_args()
 
     from scipy.integrate import solve_ivp
-    from fmu_src.integration import StepError
-    from fmu_src.proposed_model import MODEL, PARAMETER_NAMES
+    from fmu_src.model.integration import StepError
+    from fmu_src.models.proposed_model import MODEL, PARAMETER_NAMES
     from fmu_src.parameter_files import load_parameters
     from identification.forward.population import simulate_population_held
     from identification.measured.measurements import load_measurement

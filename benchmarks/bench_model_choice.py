@@ -34,7 +34,7 @@ import numpy as np
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
-from fmu_src.bushing_models import MODEL_NAMES  # noqa: E402
+from fmu_src.model.registry import MODEL_NAMES  # noqa: E402
 from identification.analysis.compare import compare_models  # noqa: E402
 from identification.measured.kdyn_table import load_kdyn_table  # noqa: E402
 from identification.measured.measurements import load_measurement  # noqa: E402

@@ -2,7 +2,7 @@
 
     python data/generate_hydraulic.py [--seed N] [--out-dir DIR]
 
-Truth: the project's hydraulic model (``fmu_src/hydraulic_model.py``) with the illustrative set
+Truth: the project's hydraulic model (``fmu_src/models/hydraulic_model.py``) with the illustrative set
 ``params_hydraulic_mount.json`` (a 10 Hz inertia track, a 0.1 mm decoupler): the model's own
 synthetic data, on which a fit of that model must reach the noise floor. Its equations are
 checked independently elsewhere (scipy's Radau, ``tests/references/``; the closed form,

@@ -28,9 +28,9 @@ from pathlib import Path
 from typing import Mapping
 from xml.etree import ElementTree as ET
 
-from .axes import ONE_AXIS, SIX_AXES, SIX_AXIS_IDENTIFIER, SIX_AXIS_NAMES, Coupling, model_on_axis
-from .bushing_models import BushingModel, DEFAULT_MODEL, MODELS, get_model
-from .bushing_params import UNIT_DEFINITIONS, UNIT_SYSTEM, ParameterError
+from .fmi.axes import ONE_AXIS, SIX_AXES, SIX_AXIS_IDENTIFIER, SIX_AXIS_NAMES, Coupling, model_on_axis
+from .model.registry import BushingModel, DEFAULT_MODEL, MODELS, get_model
+from .model.parameter_specs import UNIT_DEFINITIONS, UNIT_SYSTEM, ParameterError
 
 SSV_NAMESPACES = {"ssv": "http://ssp-standard.org/SSP1/SystemStructureParameterValues",
                   "ssc": "http://ssp-standard.org/SSP1/SystemStructureCommon"}

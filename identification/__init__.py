@@ -23,7 +23,7 @@ Units: s, mm, mm/s, N; parameters in the paper's N-mm-s units. With ``workers`` 
 starts worker processes: guard a script's top level with ``if __name__ == "__main__":``.
 
 A ``model`` (``fit``, ``simulate``, ``predict``, ``characterise``, ``compare.compare_models``) is a
-model's name or the model itself (a ``BushingModel``, ``fmu_src.bushing_models.get_model``):
+model's name or the model itself (a ``BushingModel``, ``fmu_src.model.registry.get_model``):
 resolved once at the front door, the model object is what the modules below pass on.
 
 The subpackages, in the order of the workflow (each ``__init__`` names its modules and what
@@ -47,7 +47,7 @@ from identification.interrupt import exit_quietly_on_early_ctrl_c
 
 exit_quietly_on_early_ctrl_c()   # first: before the imports below take their second or two
 
-from fmu_src.bushing_params import ParameterError  # noqa: E402
+from fmu_src.model.parameter_specs import ParameterError  # noqa: E402
 from fmu_src.parameter_files import (ParameterEnsemble, ParameterSet, read_ensemble, read_parameter_set,  # noqa: E402
                                      save_ensemble, save_parameters)
 from identification.forward.dynamic_stiffness import characterise  # noqa: E402

@@ -1,6 +1,6 @@
 """The identification's error and warning types, all of them: input it cannot use, as opposed to a bug.
 
-The command line turns the errors (and ``fmu_src.bushing_params.ParameterError``) into a
+The command line turns the errors (and ``fmu_src.model.parameter_specs.ParameterError``) into a
 one-line ``error: ...`` with exit status 2; anything else is a bug and keeps its traceback. The
 warnings say what a result's reader must know; the command line prints them as one line each.
 

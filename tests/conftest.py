@@ -143,7 +143,7 @@ def native_fmu_path(tmp_path_factory) -> Path:
 @pytest.fixture(scope="session")
 def native_model_fmus(tmp_path_factory) -> dict:
     """Each model's native FMU (FMI 2.0), and the six-axis one, with their default parameters."""
-    from fmu_src.bushing_models import MODELS
+    from fmu_src.model.registry import MODELS
     folder = tmp_path_factory.mktemp("native")
     return {name: build_fmu.build_native_fmu(out_dir=folder, model=name).path for name in (*MODELS, "six_axis")}
 
@@ -151,7 +151,7 @@ def native_model_fmus(tmp_path_factory) -> dict:
 @pytest.fixture(scope="session")
 def native_model_fmi3_fmus(tmp_path_factory) -> dict:
     """Each model's native FMU as FMI 3.0, and the six-axis one, with their default parameters."""
-    from fmu_src.bushing_models import MODELS
+    from fmu_src.model.registry import MODELS
     folder = tmp_path_factory.mktemp("native_fmi3")
     return {name: build_fmu.build_native_fmu(out_dir=folder, model=name, fmi_version=3).path
             for name in (*MODELS, "six_axis")}
@@ -160,7 +160,7 @@ def native_model_fmi3_fmus(tmp_path_factory) -> dict:
 @pytest.fixture(scope="session")
 def pythonfmu_model_fmus(tmp_path_factory) -> dict:
     """Each model's pythonfmu FMU, and the six-axis one, with their default parameters."""
-    from fmu_src.bushing_models import MODELS
+    from fmu_src.model.registry import MODELS
     folder = tmp_path_factory.mktemp("pythonfmu")
     return {name: build_fmu.build_fmu(out_dir=folder, model=name) for name in (*MODELS, "six_axis")}
 

@@ -10,13 +10,13 @@ from typing import Mapping
 
 import numpy as np
 
-from fmu_src.bushing_models import get_model
-from fmu_src.integration import advance
+from fmu_src.model.registry import get_model
+from fmu_src.model.integration import advance
 
 
 def simulate_python_core(params: Mapping[str, float], time_s, displacement_mm, velocity_mm_s,
              substeps_per_sample: int = 1, model: str = "proposed") -> np.ndarray:
-    """Force [N] at every sample time of the bushing ``model`` (``bushing_models``) with ``params``,
+    """Force [N] at every sample time of the bushing ``model`` (``registry``) with ``params``,
     through ``integration.advance`` and the model's own kernels, as the FMU calls them.
 
     Between samples k and k+1 the displacement is x_k + v_k*(t - t_k) and the velocity v_k,

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from fmu_src.bushing_models import MODELS, get_model
-from fmu_src.bushing_params import ParameterError
+from fmu_src.model.registry import MODELS, get_model
+from fmu_src.model.parameter_specs import ParameterError
 from fmu_src.parameter_files import load_parameters, read_parameter_set, save_parameters
 from identification.forward.population import simulate_model_held
 from identification.measured.signals import Sine, Step, sample_times

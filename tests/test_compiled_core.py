@@ -3,8 +3,8 @@ import numpy as np
 import pytest
 
 from conftest import paper_parameters
-from fmu_src.bushing_models import MODELS
-from fmu_src.proposed_model import PARAMETER_NAMES
+from fmu_src.model.registry import MODELS
+from fmu_src.models.proposed_model import PARAMETER_NAMES
 from identification.forward.population import simulate_population_held
 from identification.measured.signals import Random, Sine, sample_times
 from test_fmu_numerics import simulate_with_fmpy
@@ -51,7 +51,7 @@ def test_parameter_matrix_rejects_wrong_shapes():
 
 def random_population(model: str, count: int, seed: int):
     """``count`` sets of ``model``: its default set with each value scaled by 0.7-1.3."""
-    from fmu_src.bushing_models import get_model
+    from fmu_src.model.registry import get_model
     from fmu_src.parameter_files import read_parameter_set
     from conftest import REPO
     bushing = get_model(model)

@@ -1,4 +1,4 @@
-"""The coupled (vector) form of every model with hysteresis (``model_definition.CoupledKernels``):
+"""The coupled (vector) form of every model with hysteresis (``definition.CoupledKernels``):
 along any line it is the one-axis model, it turns with the path, and in the plane it follows the
 equations typed independently in ``tests/references/generate_coupled_references.py`` (scipy's
 Radau on the same straight pieces).
@@ -13,8 +13,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from fmu_src.bushing_models import MODELS, get_model
-from fmu_src.integration import DEFAULT_MAX_SUBSTEPS, OK, vector_friction_force, vector_gain
+from fmu_src.model.registry import MODELS, get_model
+from fmu_src.model.integration import DEFAULT_MAX_SUBSTEPS, OK, vector_friction_force, vector_gain
 from fmu_src.parameter_files import read_parameter_set
 
 REFERENCES = Path(__file__).resolve().parent / "references"
@@ -138,8 +138,8 @@ def test_the_friction_in_the_plane_is_berg_along_a_line_and_heads_for_its_limit_
 
 @pytest.mark.parametrize("name", COUPLED)
 def test_the_coupled_kernels_are_in_the_kernel_language_of_the_c_translation_and_the_tangents(name):
-    from fmu_src.native.python_to_c import DOUBLE, INT, Translation
-    from fmu_src.tangents import tangent
+    from fmu_src.kernels.python_to_c import DOUBLE, INT, Translation
+    from fmu_src.kernels.tangents import tangent
     model = get_model(name)
     kernels, vector = model.coupled, (DOUBLE,) * 3
     translation = Translation(prefix="bw")
@@ -156,7 +156,7 @@ def test_the_coupled_kernels_are_in_the_kernel_language_of_the_c_translation_and
 @pytest.mark.slow
 @pytest.mark.parametrize("name", COUPLED)
 def test_the_compiled_coupled_step_is_the_python_step_bit_for_bit(name):
-    from fmu_src.compiled_kernels import compiled_module
+    from fmu_src.kernels.numba_binding import compiled_module
     model = get_model(name)
     module, kernels = compiled_module(model), model.coupled
     m = model.constants(default_parameters(model))

@@ -10,7 +10,7 @@ import pytest
 import build_fmu
 import test_fmu_directional_derivatives as derivatives
 from fmu_harness import BushingFmu
-from fmu_src.axes import SIX_AXES
+from fmu_src.fmi.axes import SIX_AXES
 from fmu_src.parameter_files import read_six_axis
 from test_coupled_six_axis import (PORTS, STEP_S, assert_state_round_trip, plane_path, run_fmu, run_group,
                                    six_axis_file)
@@ -182,7 +182,7 @@ def test_a_sanitizer_build_of_the_coupled_groups_survives_runs_refusals_and_stat
     import sys
     import zipfile
     from pathlib import Path
-    from fmu_src.native.build import FLAGS, WARNINGS, write_sources
+    from fmu_src.fmi.native.build import FLAGS, WARNINGS, write_sources
     from test_native_fmu import sanitizers_work
     if shutil.which("gcc") is None or not sanitizers_work(tmp_path):
         pytest.skip("gcc here cannot build and run with -fsanitize=address,undefined (libasan, libubsan)")

@@ -12,9 +12,9 @@ from fmpy import read_model_description
 import build_fmu
 from conftest import DATA
 from fmu_harness import BushingFmu
-from fmu_src.axes import SIX_AXES, Coupling
-from fmu_src.bushing_params import ParameterError
-from fmu_src.integration import DEFAULT_MAX_SUBSTEPS, OK
+from fmu_src.fmi.axes import SIX_AXES, Coupling
+from fmu_src.model.parameter_specs import ParameterError
+from fmu_src.model.integration import DEFAULT_MAX_SUBSTEPS, OK
 from fmu_src.parameter_files import read_six_axis, save_six_axis, six_axis_document
 
 DEFAULT = DATA / "params_six_axis_illustrative.json"

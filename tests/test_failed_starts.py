@@ -15,7 +15,7 @@ from identification.__main__ import main
 from identification.fitting.engine import SerialEngine
 from identification.fitting.ensemble import ProfileProblem, _profile_task, identifiability
 from identification.fitting.multistart import (EXACT_JACOBIAN_LIMIT, StartRecord, _least_squares_task, exact_usable,
-                                       failed_starts, jacobian, run_stages)
+                                               failed_starts, jacobian, run_stages)
 
 DATA = Path(__file__).resolve().parents[1] / "data"
 TABLE2 = DATA / "synthetic_table2_noise1pct"

@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 import build_fmu
-from fmu_src import integration
-from fmu_src.bushing_models import MODELS
-from fmu_src.bushing_params import ParameterError
+from fmu_src.model import integration
+from fmu_src.model.registry import MODELS
+from fmu_src.model.parameter_specs import ParameterError
 from fmu_src.parameter_files import load_parameters
 from identification.forward.population import simulate_model_held
 from identification.forward.dynamic_stiffness import characterise
@@ -186,7 +186,7 @@ ROTATIONAL = {"berg": {"k0": 3e5, "k3": 1e6, "Ff_max": 2e3, "x2": 0.004, "k1": 1
 
 def test_the_filled_rubber_models_are_axes_of_the_six_axis_fmu_in_both_kinds(tmp_path):
     from fmpy import simulate_fmu
-    from fmu_src.axes import SIX_AXES
+    from fmu_src.fmi.axes import SIX_AXES
     from fmu_src.parameter_files import save_six_axis
     axes = {"x": ("berg", defaults("berg")), "y": ("fractional", defaults("fractional")),
             "z": ("kelvin_voigt", {"k": 900.0, "c": 2.0, "preload": 0.0}), "rx": ("berg", ROTATIONAL["berg"]),

@@ -83,7 +83,7 @@ def test_a_model_that_cannot_describe_the_data_stays_above_the_floor_and_says_so
 def test_agreeing_starts_above_the_floor_blame_the_model_not_the_search():
     # The hint's logic on records made by hand: two of three final starts within the threshold
     # of the best, every test far above its noise level, the best fit inside the box.
-    from fmu_src.bushing_models import get_model
+    from fmu_src.model.registry import get_model
     from fmu_src.parameter_files import ParameterSet
     from identification.fitting.result import FitResult, RigTestFit
     from identification.fitting.multistart import StartRecord
@@ -267,7 +267,7 @@ def test_fit_many_fits_each_bushing_and_reports_a_broken_one(tmp_path, capsys):
 
 
 def test_the_front_door_simulates_every_model(tmp_path):
-    from fmu_src.bushing_models import MODELS
+    from fmu_src.model.registry import MODELS
     from fmu_src.parameter_files import read_parameter_set
     t = sample_times(0.2, 1000.0)
     x, v = Sine(1.0, 10.0).signals(t)
@@ -281,8 +281,8 @@ def test_a_fit_stuck_on_the_box_says_where():
     # A truth outside the box (block 2's shape coordinates beyond their bounds, as for a
     # bushing with n2 = 1.14): the best fit that the box allows sits on its bound, and the
     # warning names the coordinate instead of blaming the model.
-    from fmu_src.bushing_models import get_model
-    from fmu_src.proposed_model import PARAMETER_NAMES
+    from fmu_src.model.registry import get_model
+    from fmu_src.models.proposed_model import PARAMETER_NAMES
     from fmu_src.parameter_files import ParameterSet
     from identification.fitting.result import FitResult, RigTestFit
     from identification.measured.noise import estimate_noise

@@ -1,4 +1,4 @@
-"""The fit's exact Jacobian (identification/forward/parameter_jacobian.py, fmu_src/vector_tangents.py): the
+"""The fit's exact Jacobian (identification/forward/parameter_jacobian.py, fmu_src/kernels/vector_tangents.py): the
 forces computed with their sensitivities are the plain forces bit for bit, every lane of the vector
 tangents is the one-direction tangent of the kernels, the sensitivities and the residuals'
 Jacobian equal central differences of the plain forward model, the search space's derivatives
@@ -13,10 +13,10 @@ import numpy as np
 import pytest
 
 import build_fmu
-from fmu_src import tangents
-from fmu_src.bushing_models import MODELS, get_model
+from fmu_src.kernels import tangents
+from fmu_src.model.registry import MODELS, get_model
 from fmu_src.parameter_files import load_parameters
-from fmu_src.vector_tangents import vectorize
+from fmu_src.kernels.vector_tangents import vectorize
 from identification.forward.population import _step_sizes, simulate_population_at
 from identification.errors import IdentificationError
 from identification.forward.parameter_jacobian import _tangent_names, population_sensitivities, python_sensitivities
@@ -272,7 +272,7 @@ def test_the_generated_module_is_named_after_its_source_and_the_compilers(monkey
     source and so the same module (numba's cache holds its machine code); another compiler
     version, another name."""
     import identification.forward.parameter_jacobian as fit_jacobian
-    from fmu_src import compiled_kernels
+    from fmu_src.kernels import numba_binding as compiled_kernels
     module = fit_jacobian.sensitivity_module("proposed", 14)
     model = get_model("proposed")
     machinery = compiled_kernels.integration_module()

@@ -8,7 +8,7 @@ from fmpy.validation import validate_fmu
 
 import build_fmu
 from fmu_harness import BushingFmu
-from fmu_src.bushing_models import MODELS
+from fmu_src.model.registry import MODELS
 from fmu_src.parameter_files import load_parameters
 from identification.forward.population import simulate_model_held
 from identification.measured.signals import Sine, sample_times

@@ -20,7 +20,7 @@ from fmpy.fmi2 import FMU2Model, FMU2Slave
 from fmpy.fmi3 import FMU3Model, FMU3Slave
 
 from fmu_harness import logging_callbacks
-from fmu_src.bushing_models import MODELS
+from fmu_src.model.registry import MODELS
 
 FMUS = (*MODELS, "six_axis")
 VERSIONS = (2, 3)

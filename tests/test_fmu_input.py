@@ -175,7 +175,7 @@ def test_a_six_axis_fmus_compiled_batch_counts_jumps_as_the_native_fmu_does(pyth
     """The six-axis FMU steps x and y (both the proposed model) in one compiled call, which counts
     their jumps itself: a velocity 30 % off dy/dt on axis y alone is warned about once, naming y,
     with the native FMU's words."""
-    from fmu_src.axes import SIX_AXES
+    from fmu_src.fmi.axes import SIX_AXES
     t = np.arange(200) * 1e-3
     warnings = {}
     for name, path in (("pythonfmu", pythonfmu_model_fmus["six_axis"]), ("native", native_model_fmus["six_axis"])):

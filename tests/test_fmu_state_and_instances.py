@@ -80,8 +80,8 @@ def test_tunable_parameter_change_continues_from_the_current_state(fmu_path):
     fmu.free()
 
     # Reference: the core with Table 5 for 50 steps, then Table 2 from that state.
-    from fmu_src.integration import advance
-    from fmu_src.proposed_model import MODEL
+    from fmu_src.model.integration import advance
+    from fmu_src.models.proposed_model import MODEL
     table5 = paper_parameters("table5")
     t = sample_times(0.1, 1000.0)
     x, v = SINE.signals(t)

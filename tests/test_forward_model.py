@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from conftest import paper_force, paper_parameters
-from fmu_src.bushing_models import MODELS
+from fmu_src.model.registry import MODELS
 from identification.forward.population import simulate_model_held
 from identification.forward.input_path import prepare_input
 from identification.measured.signals import Random, Sine, Step, sample_times

@@ -24,14 +24,14 @@ def run_without_numba(code: str, timeout: float = 300) -> subprocess.CompletedPr
 
 
 def test_simulate_runs_without_numba_and_equals_the_compiled_forward_model():
-    """The base install's simulate (the models' kernels as plain Python, fmu_src.jit) gives the
+    """The base install's simulate (the models' kernels as plain Python, fmu_src.kernels.jit) gives the
     compiled forward model's forces: the same source, run two ways."""
     from identification import load_measurement, simulate
     m = load_measurement(SINE)
     keep = slice(0, 200)     # 0.2 s: two cycles, enough to leave the initial state
     compiled = simulate(DATA / "params_table5_combined.json", m.time_s[keep], m.displacement_mm[keep])
     code = ("import json, numpy as np\n"
-            "from fmu_src import jit\n"
+            "from fmu_src.kernels import jit\n"
             "assert not jit.AVAILABLE\n"
             "from identification import load_measurement, simulate\n"
             f"m = load_measurement({str(SINE)!r})\n"
@@ -100,7 +100,7 @@ def test_the_same_parameters_in_any_form_give_the_same_forces(tmp_path):
 
 
 def test_the_single_bouc_wen_model_keeps_its_old_name_as_an_alias(tmp_path):
-    from fmu_src.bushing_models import MODEL_NAMES, get_model
+    from fmu_src.model.registry import MODEL_NAMES, get_model
     from fmu_src.parameter_files import read_parameter_set
     single = get_model("single_bouc_wen")
     assert "single_bouc_wen" in MODEL_NAMES and "bouc_wen" not in MODEL_NAMES
@@ -188,58 +188,72 @@ def test_the_cosimulation_examples_name_the_extra_they_lack(script, tmp_path):
     assert not (tmp_path / "out").exists()
 
 
-SUBPACKAGES = ("measured", "forward", "fitting", "analysis", "cli")
-"""identification's subpackages, in the order they may import each other: each only those before it."""
+SUBPACKAGES = {"identification": ("measured", "forward", "fitting", "analysis", "cli"),
+               "fmu_src": ("model", "models", "kernels", "fmi")}
+"""Each package's subpackages, in the order they may import each other: each only those before it."""
 
 
-def test_the_package_docstrings_name_every_subpackage_and_module():
+@pytest.mark.parametrize("name", SUBPACKAGES)
+def test_the_package_docstrings_name_every_subpackage_and_module(name):
     import importlib
     import pkgutil
 
-    import identification
-    top = [m.name for m in pkgutil.iter_modules(identification.__path__) if m.name != "__main__"]
-    missing = [name for name in top if f"``{name}``" not in identification.__doc__]
-    assert not missing, f"identification/__init__.py's module map does not name {missing}"
-    assert sorted(m.name for m in pkgutil.iter_modules(identification.__path__) if m.ispkg) == sorted(SUBPACKAGES)
-    for name in SUBPACKAGES:
-        package = importlib.import_module(f"identification.{name}")
+    top = importlib.import_module(name)
+    modules = [m.name for m in pkgutil.iter_modules(top.__path__) if m.name != "__main__"]
+    missing = [module for module in modules if f"``{module}``" not in top.__doc__]
+    assert not missing, f"{name}/__init__.py's module map does not name {missing}"
+    assert sorted(m.name for m in pkgutil.iter_modules(top.__path__) if m.ispkg) == sorted(SUBPACKAGES[name])
+    for subpackage in SUBPACKAGES[name]:
+        package = importlib.import_module(f"{name}.{subpackage}")
         modules = [m.name for m in pkgutil.iter_modules(package.__path__)]
-        assert 0 < len(modules) <= 15, f"identification/{name} holds {len(modules)} modules"
+        assert 0 < len(modules) <= 15, f"{name}/{subpackage} holds {len(modules)} modules"
         missing = [module for module in modules if f"``{module}``" not in package.__doc__]
-        assert not missing, f"identification/{name}/__init__.py does not name {missing}"
+        assert not missing, f"{name}/{subpackage}/__init__.py does not name {missing}"
         assert "May import" in package.__doc__
 
 
-def test_identifications_subpackages_import_only_those_before_them():
-    """Every import, at a module's top or inside a function, runs down the order of SUBPACKAGES;
-    the top-level modules (errors, extras, interrupt) import no subpackage."""
+def _imports(path, package: str):
+    """(line, absolute module name) of every import of ``path`` (a module of ``package``), at its top
+    or inside a function, relative ones resolved."""
     import ast
-    order = {name: i for i, name in enumerate(SUBPACKAGES)}
+    parts = path.relative_to(REPO).with_suffix("").parts
+    here = list(parts[:-1])
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                base = ".".join(here[:len(here) - node.level + 1] + ([node.module] if node.module else []))
+            yield from ((node.lineno, f"{base}.{alias.name}") for alias in node.names)
+            yield node.lineno, base
+        elif isinstance(node, ast.Import):
+            yield from ((node.lineno, alias.name) for alias in node.names)
+
+
+@pytest.mark.parametrize("name", SUBPACKAGES)
+def test_subpackages_import_only_those_before_them(name):
+    """Every import, at a module's top or inside a function, runs down the order of SUBPACKAGES; a
+    module beside them (identification's errors, extras, interrupt) imports none of them, and
+    fmu_src's parameter_files, above them all, any."""
+    order = {subpackage: i for i, subpackage in enumerate(SUBPACKAGES[name])}
     wrong = []
-    for path in sorted((REPO / "identification").rglob("*.py")):
+    for path in sorted((REPO / name).rglob("*.py")):
         parts = path.relative_to(REPO).with_suffix("").parts
-        if parts[-1] in ("__init__", "__main__") and len(parts) == 2:
-            continue                                   # the front doors hand names on
+        if len(parts) == 2 and (parts[-1] in ("__init__", "__main__") or name == "fmu_src"):
+            continue                                   # the front doors hand names on; parameter_files is on top
         here = parts[1] if len(parts) > 2 else None
-        for node in ast.walk(ast.parse(path.read_text())):
-            if isinstance(node, ast.ImportFrom) and node.module:
-                names = [node.module] + [f"{node.module}.{alias.name}" for alias in node.names]
-            elif isinstance(node, ast.Import):
-                names = [alias.name for alias in node.names]
-            else:
+        for line, imported in _imports(path, name):
+            target = imported.split(".")
+            if target[0] != name or len(target) < 2 or target[1] not in order:
                 continue
-            for name in names:
-                target = name.split(".")
-                if target[0] != "identification" or len(target) < 2 or target[1] not in order:
-                    continue
-                if here is None or order[target[1]] > order[here]:
-                    wrong.append(f"{path.relative_to(REPO)}:{node.lineno} imports {name}")
+            if here is None or order[target[1]] > order[here]:
+                wrong.append(f"{path.relative_to(REPO)}:{line} imports {imported}")
     assert not wrong, wrong
 
 
 def test_the_docs_layout_names_every_module_of_fmu_src():
     from conftest import REPO
     layout = (REPO / "docs" / "index.md").read_text()
-    modules = sorted(p.name for p in [*(REPO / "fmu_src").glob("*.py"), *(REPO / "fmu_src" / "native").glob("*.py")])
+    modules = sorted({p.name for p in (REPO / "fmu_src").rglob("*.py")} | {p.name + "/" for p in (REPO / "fmu_src").iterdir()
+                                                                          if p.is_dir() and p.name != "__pycache__"})
     missing = [name for name in modules if f"`{name}`" not in layout]
     assert not missing, f"docs/index.md's Layout does not name {missing}"

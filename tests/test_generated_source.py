@@ -1,10 +1,10 @@
 """Generated modules are checked when generated: a function reading a name the module does not
-bind is refused, naming the function and the name (fmu_src/generated_source.py)."""
+bind is refused, naming the function and the name (fmu_src/kernels/generated_source.py)."""
 import pytest
 
-from fmu_src import compiled_kernels
-from fmu_src.bushing_models import get_model
-from fmu_src.generated_source import GenerationError, unbound_names
+from fmu_src.kernels import numba_binding as compiled_kernels
+from fmu_src.model.registry import get_model
+from fmu_src.kernels.generated_source import GenerationError, unbound_names
 from identification.forward import population as compiled_core
 
 TEMPLATE = '''

@@ -1,4 +1,4 @@
-"""The hydraulic mount (fmu_src/hydraulic_model.py) against its linear closed form and the
+"""The hydraulic mount (fmu_src/models/hydraulic_model.py) against its linear closed form and the
 decoupler's physics.
 
 The closed form K*(omega) is typed in tests/references/hydraulic_closed_form.py (numpy only);
@@ -13,8 +13,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from fmu_src.bushing_models import MODELS
-from fmu_src.integration import OK
+from fmu_src.model.registry import MODELS
+from fmu_src.model.integration import OK
 
 REFERENCES = Path(__file__).resolve().parent / "references"
 _spec = importlib.util.spec_from_file_location("hydraulic_closed_form", REFERENCES / "hydraulic_closed_form.py")

@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 
 from conftest import DATA, paper_parameters
-from fmu_src.bushing_params import ParameterError
-from fmu_src.proposed_model import PARAMETER_NAMES
+from fmu_src.model.parameter_specs import ParameterError
+from fmu_src.models.proposed_model import PARAMETER_NAMES
 from fmu_src.parameter_files import load_parameters, save_parameters
 from identification.forward.population import simulate_population_held
-from fmu_src.bushing_models import MODELS
+from fmu_src.model.registry import MODELS
 from identification.forward.input_path import prepare_input
 from identification.measured.measurements import Measurement, MeasurementError, MeasurementWarning, load_measurement
 from identification.measured.noise import NoiseEstimate

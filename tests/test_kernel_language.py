@@ -1,4 +1,4 @@
-"""The kernel language's calls (fmu_src/kernel_language.py): every entry of the table is taken by
+"""The kernel language's calls (fmu_src/kernels/kernel_language.py): every entry of the table is taken by
 every tool that reads the kernels, and means the same in each.
 
 - Python, numba and the C translation give the same result bit for bit (the C compiled with the
@@ -15,10 +15,10 @@ from pathlib import Path
 
 import pytest
 
-from fmu_src import kernel_language
-from fmu_src.jit import numba
-from fmu_src.native.python_to_c import Translation, TranslationError
-from fmu_src.tangents import TangentError, tangent
+from fmu_src.kernels import kernel_language
+from fmu_src.kernels.jit import numba
+from fmu_src.kernels.python_to_c import Translation, TranslationError
+from fmu_src.kernels.tangents import TangentError, tangent
 from test_python_to_c import python_lines, run_in_c, value_type
 
 REPO = Path(__file__).resolve().parents[1]
@@ -269,7 +269,7 @@ def test_the_model_authors_guide_names_every_call():
 def test_the_jump_test_is_one_kernel_in_python_numba_and_c(tmp_path):
     # integration.displacement_jumped: the pythonfmu slave calls it, the compiled batched step
     # calls it compiled, the native C calls it translated; at and around its threshold all agree
-    from fmu_src import integration
+    from fmu_src.model import integration
     cases = []
     for v, h in ((250.0, 1e-3), (0.0, 1e-3), (-80.0, 5e-4)):
         threshold = integration.JUMP_RELATIVE * (abs(v) * h) + integration.JUMP_FLOOR

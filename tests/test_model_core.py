@@ -5,10 +5,10 @@ import numpy as np
 import pytest
 
 from conftest import paper_eq5, paper_equations, paper_parameters, reference_force, reference_jump
-from fmu_src.integration import StepError, advance, apply_displacement_jump
-from fmu_src.proposed_model import MODEL as PROPOSED
-from fmu_src.bushing_models import MODELS
-from fmu_src.bushing_params import ParameterError
+from fmu_src.model.integration import StepError, advance, apply_displacement_jump
+from fmu_src.models.proposed_model import MODEL as PROPOSED
+from fmu_src.model.registry import MODELS
+from fmu_src.model.parameter_specs import ParameterError
 from identification.measured.signals import Random, Sine, Step, sample_times
 from python_core import simulate_python_core
 

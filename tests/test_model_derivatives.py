@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from conftest import paper_equations, paper_parameters
-from fmu_src.bushing_models import MODELS
+from fmu_src.model.registry import MODELS
 from test_baseline_models import BOUC_WEN, SPENCER, bouc_wen_rhs, spencer_rhs
 
 def berg_rhs(p, s, x, v):

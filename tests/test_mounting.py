@@ -9,9 +9,9 @@ import pytest
 
 from conftest import DATA
 from fmu_harness import BushingFmu
-from fmu_src.axes import SIX_AXES
-from fmu_src.bushing_models import MODELS, get_model
-from fmu_src.integration import DEFAULT_MAX_SUBSTEPS, OK
+from fmu_src.fmi.axes import SIX_AXES
+from fmu_src.model.registry import MODELS, get_model
+from fmu_src.model.integration import DEFAULT_MAX_SUBSTEPS, OK
 from fmu_src.parameter_files import read_parameter_set, read_six_axis
 from identification.forward.simulate import simulate
 
@@ -137,7 +137,7 @@ def test_predict_takes_each_members_mounting():
 
 
 def test_a_mounting_that_is_not_a_finite_number_is_refused_by_name():
-    from fmu_src.bushing_params import ParameterError
+    from fmu_src.model.parameter_specs import ParameterError
     with pytest.raises(ParameterError, match=r"offset = nan \[mm\] must be a finite number"):
         get_model("proposed").check(dict(read_parameter_set(DATA / "params_table5_combined.json").parameters,
                                          offset=math.nan))

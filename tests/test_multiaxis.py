@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from fmu_src.bushing_models import get_model
+from fmu_src.model.registry import get_model
 from identification.__main__ import main
 from identification.errors import IdentificationError
 from fmu_src.parameter_files import save_parameters

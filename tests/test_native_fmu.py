@@ -12,7 +12,7 @@ from fmpy.validation import validate_fmu
 
 import build_fmu
 from conftest import paper_force, paper_parameters
-from fmu_src.bushing_models import MODELS
+from fmu_src.model.registry import MODELS
 from identification.measured.signals import Random, Sine, Step, sample_times
 from model_exchange import simulate_model_exchange
 from test_fmu_numerics import simulate_with_fmpy
@@ -297,7 +297,7 @@ def sanitizers_work(tmp_path) -> bool:
 
 @pytest.mark.skipif(shutil.which("gcc") is None, reason="needs gcc")
 def test_a_sanitizer_build_survives_bad_inputs_state_restores_and_1000_instances(tmp_path):
-    from fmu_src.native.build import FLAGS, WARNINGS, write_sources
+    from fmu_src.fmi.native.build import FLAGS, WARNINGS, write_sources
     from test_c_host import HOST_SOURCE
     if not sanitizers_work(tmp_path):
         pytest.skip("gcc here cannot build and run with -fsanitize=address,undefined (libasan, libubsan)")
@@ -311,7 +311,7 @@ def test_a_sanitizer_build_survives_bad_inputs_state_restores_and_1000_instances
     master = tmp_path / "native_checks"
     subprocess.run(["gcc", "-std=c99", "-Wall", "-Wextra", "-Werror", *sanitize, "-I", str(tmp_path / "sources"), "-o",
                     str(master), str(HOST_SOURCE.with_name("native_checks.c")), "-ldl", "-lm"], check=True)
-    refs = {v.name: v.value_reference for v in __import__("fmu_src.native.generate", fromlist=["all_variables"])
+    refs = {v.name: v.value_reference for v in __import__("fmu_src.fmi.native.generate", fromlist=["all_variables"])
             .all_variables(axes)}
     result = subprocess.run([str(master), str(library), generated.token, str(refs["x"]), str(refs["v"]),
                              str(refs["F"]), str(refs["c1"])], capture_output=True, text=True, timeout=300,

@@ -9,8 +9,8 @@ import sys
 
 import pytest
 
-from fmu_src import compiled_kernels
-from fmu_src.bushing_models import MODELS
+from fmu_src.kernels import numba_binding as compiled_kernels
+from fmu_src.model.registry import MODELS
 
 MODEL = MODELS["kelvin_voigt"]
 AXES = [("x", MODEL, {})]

@@ -1,4 +1,4 @@
-"""The Python -> C translator (fmu_src/native/python_to_c.py) as a compiler: every construct it
+"""The Python -> C translator (fmu_src/kernels/python_to_c.py) as a compiler: every construct it
 translates, compiled by the system's C compiler with the native FMU's flags and run, gives the
 Python function's result bit for bit; every construct whose C meaning differs from Python's is
 refused with a TranslationError naming the function and the line; every registered model's
@@ -17,10 +17,10 @@ from math import exp  # noqa: F401  the refused case `exp_imported_by_name` call
 
 import pytest
 
-from fmu_src.bushing_models import MODELS
-from fmu_src.native.build import FLAGS, WARNINGS
-from fmu_src.native.generate import ModelCode
-from fmu_src.native.python_to_c import DOUBLE, INT, Translation, TranslationError
+from fmu_src.model.registry import MODELS
+from fmu_src.fmi.native.build import FLAGS, WARNINGS
+from fmu_src.fmi.native.generate import ModelCode
+from fmu_src.kernels.python_to_c import DOUBLE, INT, Translation, TranslationError
 
 COMPILER = os.environ.get("CC", "cc")   # what build_native compiles the linux binary with
 SCALE = 2.5       # a module-level float constant the kernels read

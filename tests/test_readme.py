@@ -21,7 +21,7 @@ def test_interface_table_matches_the_model_description(fmu_path):
 
 
 def test_interface_table_states_each_parameters_allowed_range():
-    from fmu_src.proposed_model import MODEL
+    from fmu_src.models.proposed_model import MODEL
     rows = re.findall(r"^\| `(\w+)` \| parameter \| [^|]+ \| [^|]+ \| ([^|]+) \|", (REPO / "README.md").read_text(), re.M)
     allowed = {name: value.strip() for name, value in rows}
     assert allowed == {spec.name: spec.allowed.replace("any finite value", "any") for spec in MODEL.specs} | \

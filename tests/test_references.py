@@ -44,7 +44,7 @@ PROJECT_TOLERANCE = {
     ("kelvin_voigt", "sine_2mm_10Hz"): 2e-9,        # observed 1.3e-10: closed form, the CSV's rounding
     ("kelvin_voigt", "step_2mm_rise0.4s"): 2e-9,    # observed 1.3e-10
     # observed 2026-11-25: the friction's reversal between communication points, and for the
-    # fractional model its realisation by relaxation modes (fmu_src/fractional_model.py)
+    # fractional model its realisation by relaxation modes (fmu_src/models/fractional_model.py)
     ("berg", "sine_2mm_10Hz"): 1e-3,                # observed 1.22e-4
     ("berg", "step_2mm_rise0.4s"): 3e-4,            # observed 2.6e-5 (the forward model's interpolant)
     ("fractional", "sine_2mm_10Hz"): 1e-3,          # observed 1.98e-4
@@ -192,7 +192,7 @@ def test_the_docs_quote_these_figures():
 def test_every_registered_model_has_an_independent_reference():
     # a model module added to fmu_src is found by the registry; its equations must also be typed
     # into the generator (independently of the module) and its forward path bounded here
-    from fmu_src.bushing_models import MODELS
+    from fmu_src.model.registry import MODELS
     assert set(generator.MODELS) == set(MODELS), \
         f"type the equations of {sorted(set(MODELS) - set(generator.MODELS))} into {REFERENCES / 'generate_references.py'}"
     assert {model for model, _ in PROJECT_TOLERANCE} == set(MODELS)

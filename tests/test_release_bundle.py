@@ -20,7 +20,7 @@ from fmpy.validation import validate_fmu
 import build_fmu
 from conftest import DATA
 from fmu_src import __version__
-from fmu_src.native import build as native_build
+from fmu_src.fmi.native import build as native_build
 from fmu_src.parameter_files import load_parameters, read_parameter_set, read_six_axis, save_parameters
 from identification.measured.signals import Random, sample_times
 from test_fmu_numerics import simulate_with_fmpy

@@ -1,4 +1,4 @@
-"""The search coordinates' kinds (fmu_src/search_coordinates.py): each kind's map and inverse
+"""The search coordinates' kinds (fmu_src/model/search_coordinates.py): each kind's map and inverse
 agree, its complex-step derivative is a derivative, the order respects what each reads, and no
 generic module names a model."""
 import ast
@@ -8,9 +8,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from fmu_src.bushing_models import ALIASES, MODELS
-from fmu_src.model_definition import SearchCoordinate
-from fmu_src.search_coordinates import KIND, evaluation_order
+from fmu_src.model.registry import ALIASES, MODELS
+from fmu_src.model.definition import SearchCoordinate
+from fmu_src.model.search_coordinates import KIND, evaluation_order
 from identification.fitting.search_space import SearchSpace
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -109,7 +109,7 @@ def test_a_cycle_of_reads_is_refused_with_the_coordinates_named():
 
 
 GENERIC = [p for p in sorted((ROOT / "identification").rglob("*.py")) + sorted((ROOT / "fmu_src").rglob("*.py"))
-           if not p.name.endswith("_model.py") and p.name != "bushing_models.py"]
+           if not p.name.endswith("_model.py") and p.name != "registry.py"]
 
 
 def _code_strings(path: Path):

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from conftest import paper_parameters
-from fmu_src.proposed_model import PARAMETER_NAMES
+from fmu_src.models.proposed_model import PARAMETER_NAMES
 from identification.forward.population import parameter_matrix
 from identification.forward.input_path import prepare_input
 from identification.measured.measurements import Measurement

@@ -11,8 +11,8 @@ from fmpy.validation import validate_fmu
 import build_fmu
 from conftest import DATA
 from fmu_harness import BushingFmu
-from fmu_src.axes import SIX_AXES, SIX_AXIS_NAMES
-from fmu_src.bushing_params import ParameterError
+from fmu_src.fmi.axes import SIX_AXES, SIX_AXIS_NAMES
+from fmu_src.model.parameter_specs import ParameterError
 from fmu_src.parameter_files import read_six_axis, save_six_axis
 from identification.forward.population import simulate_model_held
 

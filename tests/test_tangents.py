@@ -1,4 +1,4 @@
-"""The generated tangents (fmu_src/tangents.py) of every registered model's force and derivatives:
+"""The generated tangents (fmu_src/kernels/tangents.py) of every registered model's force and derivatives:
 the value bit for bit the kernel's, the directional derivative equal to complex-step
 differentiation of the plain kernel (central differences where the kernel cannot run on complex
 numbers), finite on the switches, refusals named, and the generated source translatable to C."""
@@ -12,11 +12,11 @@ import types
 import pytest
 
 import build_fmu
-from fmu_src import integration
-from fmu_src.bushing_models import MODELS, get_model
-from fmu_src.native.python_to_c import DOUBLE, INT, Translation
+from fmu_src.model import integration
+from fmu_src.model.registry import MODELS, get_model
+from fmu_src.kernels.python_to_c import DOUBLE, INT, Translation
 from fmu_src.parameter_files import load_parameters
-from fmu_src.tangents import SLOPE_CAP, TangentError, tangent, tangent_pow_slope, tangent_source
+from fmu_src.kernels.tangents import SLOPE_CAP, TangentError, tangent, tangent_pow_slope, tangent_source
 
 KERNELS = ("force", "derivatives")
 POINTS = 200

@@ -1,7 +1,7 @@
 """The kernels' source as numba and the C translation read it: tuple(...) and sum(...) over a
-constant range written out term by term (fmu_src/unrolling.py), with the plain-Python result bit
+constant range written out term by term (fmu_src/kernels/unrolling.py), with the plain-Python result bit
 for bit; the compiled path's contract on a model module's imports and step kernels
-(fmu_src/compiled_kernels.py), checked on its syntax tree."""
+(fmu_src/kernels/numba_binding.py), checked on its syntax tree."""
 import ast
 import dataclasses
 import math
@@ -11,11 +11,11 @@ import textwrap
 
 import pytest
 
-from fmu_src import compiled_kernels
-from fmu_src.bushing_models import MODELS
-from fmu_src.model_definition import ModelContractError
-from fmu_src.native.python_to_c import DOUBLE, Translation, TranslationError
-from fmu_src.unrolling import UnrollError, unroll
+from fmu_src.kernels import numba_binding as compiled_kernels
+from fmu_src.model.registry import MODELS
+from fmu_src.model.definition import ModelContractError
+from fmu_src.kernels.python_to_c import DOUBLE, Translation, TranslationError
+from fmu_src.kernels.unrolling import UnrollError, unroll
 
 MODES = 4
 SOURCE = textwrap.dedent('''
@@ -114,34 +114,39 @@ ALLOWED_IMPORTS = textwrap.dedent('''
 
     import math
 
-    from .bushing_params import SPRING, ParameterSpec
-    from .integration import OK, maxwell_step as step_of_a_maxwell_element
+    from ..model.parameter_specs import SPRING, ParameterSpec
+    from ..model.integration import OK, maxwell_step as step_of_a_maxwell_element
+    from .berg_model import CUBIC
 ''')
 
 
 def test_a_model_modules_allowed_imports_are_pointed_at_the_compiled_machinery_and_the_package():
-    tree = compiled_kernels.checked_imports(ast.parse(ALLOWED_IMPORTS), "pkg.some_model", "machinery_0123", "pkg")
+    tree = compiled_kernels.checked_imports(ast.parse(ALLOWED_IMPORTS), "pkg.models.some_model", "machinery_0123",
+                                            "pkg.models")
     assert ast.unparse(tree).splitlines() == [
-        "from __future__ import annotations", "import math", "from pkg.bushing_params import SPRING, ParameterSpec",
-        "from machinery_0123 import OK, maxwell_step as step_of_a_maxwell_element"]
+        "from __future__ import annotations", "import math", "from pkg.model.parameter_specs import SPRING, ParameterSpec",
+        "from machinery_0123 import OK, maxwell_step as step_of_a_maxwell_element",
+        "from pkg.models.berg_model import CUBIC"]
 
 
 @pytest.mark.parametrize("statement", [
     "from math import exp", "import numpy as np", "import math as m", "import math, os", "from . import integration",
-    "from ..integration import OK", "from .integration import *", "from .native.build import FLAGS",
-    "from numpy import exp"])
+    "from ..integration import OK", "from ..model.integration import *", "from .native.build import FLAGS",
+    "from numpy import exp", "from ..model import integration", "from ...fmi.axes import Axis",
+    "from ..kernels.tangents import tangent", "from ..model.native.build import FLAGS"])
 def test_any_other_import_form_is_refused_naming_module_and_line(statement):
     source = f"import math\n\n{statement}\n"
-    expected = rf"^pkg\.some_model, line 3: {re.escape(repr(statement))} is not allowed.*may import only: from __future__"
+    expected = rf"^pkg\.models\.some_model, line 3: {re.escape(repr(statement))} is not allowed.*may import only: " \
+        "from __future__"
     with pytest.raises(ModelContractError, match=expected):
-        compiled_kernels.checked_imports(ast.parse(source), "pkg.some_model", "machinery_0123", "pkg")
+        compiled_kernels.checked_imports(ast.parse(source), "pkg.models.some_model", "machinery_0123", "pkg.models")
 
 
 def test_an_import_inside_a_kernel_is_refused():
-    source = "import math\n\n\ndef force(m, state, x, v):\n    from .integration import OK\n    return OK\n"
-    with pytest.raises(ModelContractError, match=r"pkg.some_model, line 5: 'from \.integration import OK' is inside a "
-                                                 "function or block"):
-        compiled_kernels.checked_imports(ast.parse(source), "pkg.some_model", "machinery_0123", "pkg")
+    source = "import math\n\n\ndef force(m, state, x, v):\n    from ..model.integration import OK\n    return OK\n"
+    with pytest.raises(ModelContractError, match=r"pkg.models.some_model, line 5: 'from \.\.model\.integration import OK' "
+                                                 "is inside a function or block"):
+        compiled_kernels.checked_imports(ast.parse(source), "pkg.models.some_model", "machinery_0123", "pkg.models")
 
 
 @pytest.mark.parametrize("name", list(MODELS))

@@ -86,7 +86,7 @@ def kelvin_voigt_axes() -> dict:
 
 
 def build_fmus(out_dir: Path, bushing_params: Path = BUSHING_SET, native: bool = False) -> tuple[Path, Path]:
-    """The six-axis bushing FMU (defaults from ``bushing_params``; ``native``: the compiled one)
+    """The six-axis bushing FMU (defaults from ``parameter_specs``; ``native``: the compiled one)
     and the body FMU."""
     import build_fmu
     if native:

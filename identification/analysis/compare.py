@@ -39,7 +39,7 @@ from typing import Sequence
 
 import numpy as np
 
-from fmu_src.bushing_models import BushingModel, resolve_model
+from fmu_src.model.registry import BushingModel, resolve_model
 from identification.fitting.engine import make_engine
 from identification.errors import FitNotConvergedWarning
 from identification.fitting.result import FLOOR_FACTOR, FitResult, TableFit, information_criterion

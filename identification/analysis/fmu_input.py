@@ -62,7 +62,7 @@ def _driven(signals: tuple, steps_per_sample: int | None) -> DrivenInput:
 
 
 def _axis(axis: str | None):
-    from fmu_src.axes import ONE_AXIS, six_axis
+    from fmu_src.fmi.axes import ONE_AXIS, six_axis
     return ONE_AXIS if axis is None else six_axis(axis)
 
 

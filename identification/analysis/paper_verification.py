@@ -14,7 +14,7 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
-from fmu_src.bushing_models import DEFAULT_MODEL, LINEAR_BASELINE
+from fmu_src.model.registry import DEFAULT_MODEL, LINEAR_BASELINE
 from identification.measured.measurements import Measurement
 from identification.fitting.objectives import nrmse, rms_level_error
 from identification.measured.signals import Random, Sine, Step, sample_times

@@ -18,7 +18,7 @@ from typing import Mapping
 
 import numpy as np
 
-from fmu_src.proposed_model import PARAMETER_NAMES, PARAMETER_UNITS
+from fmu_src.models.proposed_model import PARAMETER_NAMES, PARAMETER_UNITS
 from identification.errors import IdentificationError
 from identification.forward.input_path import prepare_input
 from identification.measured.signals import Sine, Step, sample_times

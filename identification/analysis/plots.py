@@ -7,7 +7,7 @@ from typing import Sequence
 
 import numpy as np
 
-from fmu_src.bushing_models import get_model
+from fmu_src.model.registry import get_model
 from identification.interrupt import writing
 from identification.measured.measurements import Measurement
 from identification.fitting.objectives import nrmse

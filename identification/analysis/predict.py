@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fmu_src.bushing_models import BushingModel
+from fmu_src.model.registry import BushingModel
 from identification.forward.population import parameter_matrix
 from identification.errors import IdentificationError
 from identification.forward.input_path import prepare_input

@@ -14,9 +14,10 @@ import sys
 import warnings
 from pathlib import Path
 
-from fmu_src import __version__, jit
-from fmu_src.bushing_models import DEFAULT_MODEL, MODEL_CHOICES, MODEL_NAMES, MODELS
-from fmu_src.bushing_params import ParameterError
+from fmu_src import __version__
+from fmu_src.kernels import jit
+from fmu_src.model.registry import DEFAULT_MODEL, MODEL_CHOICES, MODEL_NAMES, MODELS
+from fmu_src.model.parameter_specs import ParameterError
 from identification.cli import commands
 from identification.forward.dynamic_stiffness import DEFAULT_AMPLITUDES_MM, DEFAULT_FREQUENCIES_HZ
 from identification.errors import EngineError, IdentificationError, MissingExtraError, UsageError
@@ -244,7 +245,7 @@ COMMANDS = {"fit": commands.fit_command, "sensitivity": commands.sensitivity_com
             "characterise": commands.characterise_command}
 NEEDS_FIT_EXTRA = ("fit", "compare", "fit-many")
 """Commands that fit: they need numba and the optimizers (the ``fit`` extra). The others only
-simulate, which the base install does too, as plain Python (``fmu_src.jit``), slower."""
+simulate, which the base install does too, as plain Python (``fmu_src.kernels.jit``), slower."""
 
 
 def _require_extras(args) -> None:

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fmu_src.bushing_models import DEFAULT_MODEL, MODEL_CHOICES, MODEL_NAMES, get_model
+from fmu_src.model.registry import DEFAULT_MODEL, MODEL_CHOICES, MODEL_NAMES, get_model
 from fmu_src.parameter_files import read_parameter_set
 from identification.errors import FitNotConvergedWarning, UsageError
 from identification.measured.measurements import load_measurement, measurement_name
@@ -345,7 +345,7 @@ def assemble_command(args) -> int:
 def coupling_of(text: str | None):
     """``axes.Coupling`` of --coupling: a group's name, or two (a translation's and a rotation's)
     separated by a comma; UsageError naming what is allowed."""
-    from fmu_src.axes import GROUPS, Coupling
+    from fmu_src.fmi.axes import GROUPS, Coupling
     if text is None:
         return Coupling()
     chosen = {}

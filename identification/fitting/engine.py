@@ -49,7 +49,7 @@ Dask client to close."""
 def _run_chunk(function: Callable, shared, chunk: Sequence, single_threaded: bool) -> list:
     from threadpoolctl import threadpool_limits
     if single_threaded:
-        from fmu_src.jit import numba
+        from fmu_src.kernels.jit import numba
         numba.set_num_threads(1)
     with threadpool_limits(limits=1):
         return [function(shared, item) for item in chunk]

@@ -36,25 +36,25 @@ from pathlib import Path
 
 import numpy as np
 
-from fmu_src.bushing_models import BushingModel, DEFAULT_MODEL, resolve_model
-from fmu_src.compiled_kernels import cache_directory
+from fmu_src.model.registry import BushingModel, DEFAULT_MODEL, resolve_model
+from fmu_src.kernels.numba_binding import cache_directory
 from fmu_src.parameter_files import ParameterSet
 from identification.forward.population import parameter_matrix
 from identification.fitting.engine import make_engine
 from identification.fitting.ensemble import (PROBES, PROFILE_EVALUATIONS, PROFILE_ROUNDS, PUSH, STEPS, WALKERS,
-                                     identifiability, misfit_threshold, posterior_samples, profile_extremes,
-                                     push_to_boundary, select_members, threshold_scale)
+                                             identifiability, misfit_threshold, posterior_samples, profile_extremes,
+                                             push_to_boundary, select_members, threshold_scale)
 from identification.errors import CharacterisationWarning, IdentificationError
 from identification.extras import require
 from identification.fitting.result import (FLOOR_FACTOR, MIN_AGREEING, FitNotConvergedWarning, FitResult,  # noqa: F401
-                                       RigTestFit, TableFit, agreeing_starts)
+                                           RigTestFit, TableFit, agreeing_starts)
 from identification.measured.kdyn_table import KdynTable, load_kdyn_table
 from identification.fitting.loop_start import LOOP_STARTS, anchored_coordinates, slow_loop_start
 from identification.measured.measurements import Measurement
 from identification.measured.multiaxis import (COUPLED_AXES, MultiAxisMeasurement, coupled_axes, load_multiaxis,
-                                              vector_nrmse)
+                                               vector_nrmse)
 from identification.fitting.multistart import (JACOBIANS, Problem, StartRecord, failed_starts, first_records, jacobian,
-                                       run_stages, screen, simulations_per_jacobian)
+                                               run_stages, screen, simulations_per_jacobian)
 from identification.measured.noise import NoiseEstimate, estimate_noise
 from identification.fitting.objectives import Objective, nrmse
 from identification.fitting.presets import PAPER_GA, PRESETS, SearchSettings
@@ -109,7 +109,7 @@ def fit(measurements, model: str | BushingModel = DEFAULT_MODEL, preset: str = "
         The training tests (``training_tests``, ``load_manifest``); a Measurement or a CSV path
         counts as a random-input test. May be empty when ``kdyn`` or ``multiaxis`` is given.
     model : str or BushingModel
-        A model's name (``fmu_src.bushing_models.MODEL_NAMES``; default ``DEFAULT_MODEL``, the
+        A model's name (``fmu_src.model.registry.MODEL_NAMES``; default ``DEFAULT_MODEL``, the
         paper's), or the model itself; resolved once and passed on. A model whose force is linear
         in its parameters (``BushingModel.linear``: Kelvin-Voigt) is fitted by linear least
         squares, every other by the search.

@@ -26,8 +26,8 @@ import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from fmu_src.bushing_models import DEFAULT_MODEL, MODEL_CHOICES
-from fmu_src.bushing_params import ParameterError
+from fmu_src.model.registry import DEFAULT_MODEL, MODEL_CHOICES
+from fmu_src.model.parameter_specs import ParameterError
 from fmu_src.parameter_files import parameter_document
 from identification.fitting.engine import make_engine
 from identification.errors import FitNotConvergedWarning, MeasurementError

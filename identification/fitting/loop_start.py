@@ -1,6 +1,6 @@
 """Starts from the data: the spring and the friction of a filled-rubber model from a slow loop.
 
-A model whose box declares ``SearchBox.loop_start`` (a ``model_definition.SlowLoop``: the
+A model whose box declares ``SearchBox.loop_start`` (a ``definition.SlowLoop``: the
 names of its spring's k0, k3, its friction's Ff_max and x2) has a progressive spring
 k0*x + k3*x^3 and Berg's friction in parallel with its rate-dependent part. On the training
 test whose loop is slowest (the sine of lowest frequency) that rate-dependent part is

@@ -30,10 +30,10 @@ from typing import Sequence
 
 import numpy as np
 
-from fmu_src.bushing_models import BushingModel, DEFAULT_MODEL, resolve_model
+from fmu_src.model.registry import BushingModel, DEFAULT_MODEL, resolve_model
 from identification.forward.input_path import DrivenInput, DrivenVectorInput, prepare_input, prepare_vector_input
 from identification.measured.kdyn_table import (FIT_CYCLES, FIT_STEPS_PER_CYCLE, KDYN_UNCERTAINTY, LOSS_ANGLE_UNCERTAINTY_DEG,
-                                       SEARCH_CYCLES, SEARCH_STEPS_PER_CYCLE, KdynTable)
+                                                SEARCH_CYCLES, SEARCH_STEPS_PER_CYCLE, KdynTable)
 from identification.measured.multiaxis import MultiAxisMeasurement, coupled_axes
 from identification.measured.noise import NoiseEstimate, estimate_noise
 from identification.measured.rig_tests import RigTest

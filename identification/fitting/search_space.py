@@ -13,8 +13,8 @@ F = k*x + c*v of the tests other than steps (of the steps if there are no others
 their peak force, tau_ref = c_ref/k_ref [s].
 
 Coordinates, each with bounds (the box; each model declares its own in its module,
-``BushingModel.search``, a ``model_definition.SearchBox``): each coordinate's kind
-(``fmu_src.search_coordinates``: stiffness, gain, damping, time constant, slower, shape, shape
+``BushingModel.search``, a ``definition.SearchBox``): each coordinate's kind
+(``fmu_src.model.search_coordinates``: stiffness, gain, damping, time constant, slower, shape, shape
 sum, exponent, force, travel, cubic, power law) holds its map to the parameter, its inverse and
 its bounds; this module scales them by the data and runs them in order. The time constants'
 lower bound is TIME_CONSTANT_FLOOR times the sample interval: faster modes are invisible in the
@@ -34,9 +34,9 @@ from typing import Mapping, Sequence
 import numpy as np
 from scipy.optimize import lsq_linear
 
-from fmu_src.bushing_models import BushingModel, DEFAULT_MODEL, MODELS, resolve_model
-from fmu_src.model_definition import SearchCoordinate
-from fmu_src.search_coordinates import evaluation_order
+from fmu_src.model.registry import BushingModel, DEFAULT_MODEL, MODELS, resolve_model
+from fmu_src.model.definition import SearchCoordinate
+from fmu_src.model.search_coordinates import evaluation_order
 from identification.errors import IdentificationError
 from identification.measured.measurements import Measurement
 

@@ -1,6 +1,6 @@
 """Assemble a six-axis parameter file from one fit per axis (``python -m identification assemble``).
 
-Each axis of ``SixAxisBushing`` (``fmu_src/axes.py``) is fitted on its own, from its own tests,
+Each axis of ``SixAxisBushing`` (``fmu_src/fmi/axes.py``) is fitted on its own, from its own tests,
 with ``fit`` as for a one-axis bushing. A rotational axis (rx, ry, rz) is fitted from a torsion or
 tilt test with the angle in the displacement column and the moment in the force column, in
 rad and N.mm: its parameters then read in N.mm, rad, s, as the six-axis FMU takes them.
@@ -10,9 +10,9 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Mapping
 
-from fmu_src.axes import SIX_AXES, SIX_AXIS_NAMES, six_axis
-from fmu_src.bushing_models import LINEAR_BASELINE
-from fmu_src.bushing_params import ParameterError
+from fmu_src.fmi.axes import SIX_AXES, SIX_AXIS_NAMES, six_axis
+from fmu_src.model.registry import LINEAR_BASELINE
+from fmu_src.model.parameter_specs import ParameterError
 from fmu_src.parameter_files import read_parameter_set, read_six_axis, save_six_axis
 
 RIGID_STIFFNESS = 1e7

@@ -1,6 +1,6 @@
 """Starts from the data: a fluid track's tuning, read off a dynamic-stiffness table.
 
-A model whose box declares ``SearchBox.table_start`` (a ``model_definition.TrackStart``: the
+A model whose box declares ``SearchBox.table_start`` (a ``definition.TrackStart``: the
 names of its static spring, bulge stiffness, lower-chamber stiffness, track mass and damping and
 decoupler travel) has a fluid column that resonates against its chambers, in parallel with the
 rubber. Its data sheet shows the column, and the linear form of the model,

@@ -32,10 +32,10 @@ from typing import Sequence
 
 import numpy as np
 
-from fmu_src.bushing_models import BushingModel, DEFAULT_MODEL
+from fmu_src.model.registry import BushingModel, DEFAULT_MODEL
 from identification.errors import CharacterisationWarning, IdentificationError
 from identification.measured.kdyn_table import (PLAUSIBLE_AMPLITUDE_MM, PLAUSIBLE_FREQUENCY_HZ, SHEET_COLUMNS,
-                                       SHEET_RESULT_COLUMNS, ensemble_columns, write_kdyn_table)
+                                                SHEET_RESULT_COLUMNS, ensemble_columns, write_kdyn_table)
 
 DEFAULT_AMPLITUDES_MM = (0.1, 0.5, 1.0, 2.0, 3.0)
 DEFAULT_FREQUENCIES_HZ = (1.0, 2.0, 5.0, 10.0, 20.0, 30.0, 50.0)

@@ -10,13 +10,13 @@ K directions: forward-mode sensitivities propagated through the model's own kern
     F_k = force(m, state, x_k, v_out_k),
 
 with p, m, ms and the state active and the input (x, v, h) constant. No derivative is typed here:
-``fmu_src.tangents`` generates each kernel's tangent from its source (the kernels' own
+``fmu_src.kernels.tangents`` generates each kernel's tangent from its source (the kernels' own
 statements, so the forces are bit for bit those of ``population``'s population loop: tested),
 ``tangents.Generator(lanes=K)`` makes them carry the K directions at once (the value, the
 expensive part of a step, is computed once), and this module binds them to the population loop
 that the forces run too (``population._population_loop``) in a generated module that numba
 compiles and caches on disk like the plain kernels
-(``fmu_src.compiled_kernels``; the first process compiles, later ones load).
+(``fmu_src.kernels.numba_binding``; the first process compiles, later ones load).
 
 What the derivative is where the forward model is not differentiable: the derivative of the
 branch the kernels take (a Bouc-Wen block's sgn switches, the substep count of a step, which is
@@ -37,11 +37,12 @@ from typing import Callable
 
 import numpy as np
 
-from fmu_src import compiled_kernels as _kernels, integration, tangents
-from fmu_src.bushing_models import BushingModel, DEFAULT_MODEL, resolve_model
-from fmu_src.jit import numba
+from fmu_src.kernels import numba_binding as _kernels, tangents
+from fmu_src.model import integration
+from fmu_src.model.registry import BushingModel, DEFAULT_MODEL, resolve_model
+from fmu_src.kernels.jit import numba
 from identification.forward.population import (_input_arrays, _population_loop, _step_sizes, output_points,
-                                          parameter_matrix)
+                                               parameter_matrix)
 
 _MAX_SUBSTEPS = integration.DEFAULT_MAX_SUBSTEPS
 
@@ -123,7 +124,7 @@ _compiled: dict[tuple[str, int], types.ModuleType] = {}
 def _generated_module(model: BushingModel, lanes: int) -> types.ModuleType:
     """The generated module, its source made in every process (the tangents and their vector
     rewrite: about a second for the proposed model's 14 directions) and loaded by its name, a
-    hash of that source and the compiler versions (``compiled_kernels.module_name``, the one
+    hash of that source and the compiler versions (``numba_binding.module_name``, the one
     cache key): numba's disk cache holds its machine code from the machine's first process on."""
     machinery = _kernels.integration_module()      # loaded first: the module imports it by name
     source = _kernels.model_source(model, machinery, _appendix(model, lanes, machinery))

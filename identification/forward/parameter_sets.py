@@ -11,7 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Mapping
 
-from fmu_src.bushing_models import BushingModel, DEFAULT_MODEL, get_model, resolve_model
+from fmu_src.model.registry import BushingModel, DEFAULT_MODEL, get_model, resolve_model
 from fmu_src.parameter_files import ParameterEnsemble, ParameterSet, read_ensemble
 from identification.errors import IdentificationError
 

@@ -1,7 +1,7 @@
 """The bushing models compiled with numba, for simulating whole populations of parameter sets.
 
 One definition. Each model's own source (``fmu_src/<name>_model.py``) is compiled by
-``fmu_src/compiled_kernels.py`` (a generated module named after its content, in the cache
+``fmu_src/kernels/numba_binding.py`` (a generated module named after its content, in the cache
 folder, its kernels and the shared machinery compiled), with the population loop below
 appended. The FMU runs the same functions, as plain Python or compiled the same way;
 ``tests/test_compiled_core.py`` checks the two agree bitwise for every model. Compilation
@@ -18,12 +18,13 @@ import inspect
 import types
 from typing import Mapping
 
-from fmu_src.jit import numba
+from fmu_src.kernels.jit import numba
 import numpy as np
 
-from fmu_src import compiled_kernels as _kernels, integration
-from fmu_src.bushing_models import BushingModel, DEFAULT_MODEL, resolve_model
-from fmu_src.proposed_model import PARAMETER_NAMES  # noqa: F401  (the proposed model's order, for callers)
+from fmu_src.kernels import numba_binding as _kernels
+from fmu_src.model import integration
+from fmu_src.model.registry import BushingModel, DEFAULT_MODEL, resolve_model
+from fmu_src.models.proposed_model import PARAMETER_NAMES  # noqa: F401  (the proposed model's order, for callers)
 from identification.forward import steady_state
 
 _MAX_SUBSTEPS = integration.DEFAULT_MAX_SUBSTEPS
@@ -321,7 +322,7 @@ def parameter_matrix(parameter_sets, model: str | BushingModel = DEFAULT_MODEL) 
 
 def simulate_model_held(model: str | BushingModel, params: Mapping[str, float], time_s, displacement_mm,
                         velocity_mm_s) -> np.ndarray:
-    """Force [N] of one parameter set of any model of ``bushing_models`` (the model or its name)
+    """Force [N] of one parameter set of any model of ``registry`` (the model or its name)
     under the FMU's input convention (:func:`simulate_population_held`). Raises ParameterError
     for an invalid set."""
     model = resolve_model(model)

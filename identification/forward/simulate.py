@@ -3,7 +3,7 @@ it drives the kernels with is ``identification.forward.input_path``'s).
 
 ``simulate(parameters, time_s, displacement_mm, velocity_mm_s=None, model=None, steps_per_sample=None)``
 returns the force [N] at every sample of a parameter set of any of the models
-(``fmu_src.bushing_models``), driven by a smooth
+(``fmu_src.model.registry``), driven by a smooth
 interpolant of the sampled displacement (``identification.forward.input_path``): the
 continuous-time model, which the fit compares with measurements. The FMU, a co-simulation
 slave, sees its inputs held over each communication step instead
@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from fmu_src.bushing_models import BushingModel, DEFAULT_MODEL, resolve_model
+from fmu_src.model.registry import BushingModel, DEFAULT_MODEL, resolve_model
 from identification.forward.population import parameter_matrix, simulate_coupled_at, simulate_population_at
 from identification.forward.input_path import DrivenInput, DrivenVectorInput, prepare_input, prepare_vector_input
 from identification.forward.parameter_sets import parameter_sets
@@ -81,7 +81,7 @@ def simulate_driven_vector(matrix: np.ndarray, driven: DrivenVectorInput, max_su
                            model: str | BushingModel = DEFAULT_MODEL, coupled_axes: int = 0) -> np.ndarray:
     """Force vectors [N], shape (P, outputs, d), of a (P, m) matrix of ``model``'s parameters on a
     prepared multi-axis input, at its output samples: the first ``coupled_axes`` axes (2 or 3) run
-    the model's coupled form on their displacement vector (``model_definition.CoupledKernels``),
+    the model's coupled form on their displacement vector (``definition.CoupledKernels``),
     every other axis its one-axis model alone (0: every axis alone; so does Kelvin-Voigt, whose
     linear elements couple nothing). NaN from where a candidate fails."""
     bushing = resolve_model(model)

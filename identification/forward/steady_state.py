@@ -2,7 +2,7 @@
 
 :func:`_sine_steady_state` is written here and never called here: like the population loop of
 ``population``, its source is appended to each model's generated module, where ``prepare``,
-``prepare_step``, ``step_prepared`` (``fmu_src.integration``) and ``force`` are that model's
+``prepare_step``, ``step_prepared`` (``fmu_src.model.integration``) and ``force`` are that model's
 compiled kernels and ``_VALUES(row)`` a parameter row's values; the step's constants are made once
 per case, whose steps all have the same size.
 
@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import math
 
-from fmu_src.jit import numba
+from fmu_src.kernels.jit import numba
 
 ROUNDING = 1e-13
 

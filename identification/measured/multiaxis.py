@@ -13,7 +13,7 @@ used is refused with its name, the line or the column, and what is allowed.
 A model predicts a multi-axis test (``identification.forward.simulate.simulate_multiaxis``) as the fit's forward model drives a
 one-axis test (``identification.forward.input_path``): each axis's interpolant of its samples (the
 Hermite one where the velocity was measured), on one grid of communication points for every axis;
-coupled (the model's coupled form on the displacement vector, ``model_definition.CoupledKernels``)
+coupled (the model's coupled form on the displacement vector, ``definition.CoupledKernels``)
 or not (its one-axis model on each axis alone): :data:`COUPLED_AXES`. Compiled with numba
 (``population``). The six-axis FMU, a co-simulation slave, holds the secant velocity over each
 communication step instead (``population.simulate_coupled_held``); at 1 kHz on a 10 Hz circle the
@@ -33,7 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fmu_src.bushing_models import BushingModel
+from fmu_src.model.registry import BushingModel
 from identification.errors import IdentificationError
 
 AXIS_NAMES = ("x", "y", "z")

@@ -21,7 +21,7 @@ d/dt is a factor i*omega, and K* = F/X:
     K*(omega) = k0 + i*omega*c0 + k1*i*omega*c1/(k1 + i*omega*c1)
                 + kb*(kc - mf*omega^2 + i*omega*cf)/(kb + kc - mf*omega^2 + i*omega*cf)
 
-which is the form fmu_src/hydraulic_model.py's docstring states. Limits: at omega -> 0 it is
+which is the form fmu_src/models/hydraulic_model.py's docstring states. Limits: at omega -> 0 it is
 k0 + kb*kc/(kb + kc) (the static stiffness, the bulge in series with the bellows), at
 omega -> oo k0 + k1 + kb + i*omega*c0 (the fluid cannot move, the Maxwell spring is rigid).
 tests/test_hydraulic_model.py checks this algebra against a direct solve of the 3x3 system.

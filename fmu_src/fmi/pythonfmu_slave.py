@@ -1,0 +1,597 @@
+"""pythonfmu adapter: the FMI 2.0 co-simulation face of the bushing models.
+
+A thin layer: it declares the variables of its axes (one axis of one model of
+``registry``, or the six axes of ``SixAxisBushing``, each one of the models; see
+``axes``), converts SI ports to the kernels' units, validates every value it is given and steps
+each axis's model through ``integration``. Nothing here knows the equations, and this error
+policy is the same for every model and every axis.
+
+The FMU's class is a subclass of :class:`BushingSlave` named after the FMI identifier, which
+build_fmu.py appends to the packed copy of this module (pythonfmu takes the class with the
+longest hierarchy), so every model has its own modelIdentifier.
+
+Error policy. pythonfmu 0.7 knows three outcomes of a call: fmi2OK, fmi2Discard (do_step
+returns False) and fmi2Fatal (any Python exception); it cannot return fmi2Error.
+- Start values with which the simulation cannot start (a parameter outside its range) are
+  logged at exitInitializationMode with category ``logStatusError``; if they are still invalid
+  at the first doStep, it fails with fmi2Fatal (an exception) and the reasons also go to stderr
+  (pythonfmu passes log messages only with debug logging on), so that every master stops
+  visibly: fmpy raises, libcosim reports a failed step. (exitInitializationMode itself does not
+  fail: libcosim aborts the process on that.)
+- During the run, a setter stores the value and logs a problem at once; a doStep that cannot
+  succeed (a parameter made invalid, a non-finite input, overflow, too many substeps, on any
+  axis) logs the reason, naming the axis, and returns False: fmi2Discard, with the committed
+  state of every axis untouched, so the master can fix the value and step again.
+An output is never NaN or Inf: it falls back to the last finite value.
+
+Packaging. Inside an FMU this module is renamed to a name unique to the build, and its
+siblings live in the package ``<that name>_lib``, so several FMUs of this project (even
+with different code or defaults) can share one Python interpreter without running each
+other's modules.
+"""
+import ctypes
+import importlib
+import math
+import sys
+from functools import partial
+
+from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Real
+from pythonfmu.default_experiment import DefaultExperiment
+from pythonfmu.enums import Fmi2Status
+
+# pythonfmu 0.7 re-executes this module's source at every instantiation (in the cached
+# module's namespace), possibly after the host deleted the first extracted copy of the FMU
+# (fmpy's simulate_fmu does). So module-level code here must touch no files: the packed
+# library, imported once and then cached, reads the default parameters.
+if __package__:
+    from . import axes, variables
+    from ..model import integration
+    AXES = None   # only an FMU built by build_fmu.py has axes, models and defaults
+    GROUPS = ()
+    STEP_AXES = {}
+    STEP = None
+else:
+    _library = importlib.import_module(__name__ + "_lib")
+    axes = _library.axes
+    integration = _library.integration
+    variables = _library.variables
+    AXES = _library.AXES   # [(axes.Axis, BushingModel on that axis, default parameters)]
+    GROUPS = _library.GROUPS   # coupled groups: tuples of positions in AXES
+    STEP_AXES = _library.STEP_AXES   # {model name: compiled step of all its axes}; {} for pure Python
+    STEP = _library.STEP   # which step runs: compiled (numba) or pure Python, and why
+# numpy only where the compiled step runs (numba needs it anyway); the plain-Python step needs none
+np = importlib.import_module("numpy") if STEP_AXES else None
+
+
+# Jumping inputs (integration.JUMP_*, which say why; logging only, the force is the same)
+JUMP_WINDOW, JUMP_COUNT = integration.JUMP_WINDOW, integration.JUMP_COUNT
+_JUMP_MASK = (1 << JUMP_WINDOW) - 1
+
+
+class InitializationError(RuntimeError):
+    """Start values with which the simulation cannot start (fmi2Fatal at the first doStep)."""
+
+
+class _AxisState:
+    """One axis of the slave: its model, parameters as set, inputs, and committed state (in the
+    kernels' units: mm or rad, N or N.mm)."""
+
+    def __init__(self, axis, model, defaults):
+        self.axis = axis
+        self.model = model
+        # the axis's unit factors and travel limit, read at every step (plain attributes: fast)
+        self.to_kernel, self.from_kernel, self.travel_limit = axis.to_kernel, axis.from_kernel, axis.plausible_travel
+        # the model's parameters and its mounting's (offset, preload: 0 where the defaults have none)
+        self.values = {spec.name: float(defaults.get(spec.name, 0.0)) for spec in model.fmu_specs}
+        self.units = model.fmu_units
+        self.offset, self.preload = model.mounting(self.values)   # kernel units, as last set
+        self.preload_port = self.preload * self.from_kernel      # of the parameters in force
+        self.x = 0.0                   # port displacement as set (m or rad)
+        self.v = 0.0                   # port velocity as set (m/s or rad/s)
+        self.constants = None          # model.prepare of the parameters in force
+        self.parameters_changed = True
+        self.state = tuple(0.0 for _ in model.states)
+        self.state_x = 0.0             # kernel displacement the committed state belongs to
+        self.x_now = -self.offset      # the model's displacement: x as last set less the offset, else x_k + v_k*h
+        self.last_output = 0.0         # last finite output, port units (N or N.m)
+        self.output_is_current = False  # last_output belongs to the current inputs and state
+        self.travel_warned = False     # the implausible-travel warning is given once
+        self.output_bound = math.inf   # port units; above it the output is implausible (warned once)
+        self.output_warned = False
+        self.stale_output_logged = False   # the stale-output error is given once per episode
+        self.last_errors = []          # the parameter errors of the last validation
+        self.step_one = None           # the compiled step of this axis's model, if compiled
+        self.params_row = None         # the parameters in force as an array (for step_one)
+        self.jump_history = 0          # bit i: the step i steps ago started with a jump (JUMP_*;
+                                       # for an axis of a compiled batch: the batch's array)
+        self.group = None              # the coupled group it belongs to, if any
+
+
+class _GroupState:
+    """A coupled group of axes (``axes.Coupling``): one model's coupled form
+    (``definition.CoupledKernels``) on the vector of its members' displacements, padded with 0
+    to three components; its state is the group's, each member keeps its ports, parameters, mounting
+    and output. The members' parameters must be equal (checked at every change)."""
+
+    def __init__(self, members, name):
+        self.members = members
+        self.model = members[0].model
+        self.kernels = self.model.coupled
+        self.label = f"the {name} group ({', '.join(a.axis.name for a in members)}): "
+        self.state = tuple(0.0 for _ in range(self.kernels.size)) if self.kernels else ()
+        self.state_x = (0.0, 0.0, 0.0)    # kernel displacement (a 3-vector) the state belongs to
+        self.constants = None
+        self.usable = False
+        self.errors = []                  # why its members' parameters cannot make one set, if so
+
+    def inputs(self):
+        """The members' model displacements and velocities as 3-vectors [mm or rad, per s]."""
+        x, v = [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]
+        for c, a in enumerate(self.members):
+            x[c], v[c] = a.x_now, a.v * a.to_kernel
+        return tuple(x), tuple(v)
+
+
+class BushingSlave(Fmi2Slave):
+    author = "Bouc-Wen bushing project"
+    description = variables.fmu_description(AXES)
+    version = None  # the project's version, written into each FMU's class by build_fmu.py
+    license = "MIT"
+    default_experiment = DefaultExperiment(start_time=0.0, stop_time=1.0, step_size=1e-3)
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        if AXES is None:
+            raise RuntimeError("the bushing slave runs inside an FMU built by build_fmu.py")
+        self._axes = [_AxisState(axis, model, defaults) for axis, model, defaults in AXES]
+        # coupled groups whose model has a coupled form (Kelvin-Voigt's is its axes as they are)
+        self._groups = []
+        for positions in GROUPS:
+            members = [self._axes[i] for i in positions]
+            if members[0].model.coupled is not None:
+                group = _GroupState(members, axes.group_name(tuple(a.axis.name for a in members)))
+                self._groups.append(group)
+                for a in members:
+                    a.group = group
+        # The compiled step of all axes of a model in one call, where a model has two or more:
+        # per model its step, axes and parameter rows (rebuilt on a change). For a single axis the
+        # arrays cost more than the two calls into numba they save (measured 2026-11-24).
+        groups = {}
+        for a in self._axes:
+            if a.group is None:
+                groups.setdefault(a.model.name, []).append(a)
+        # [step, axes, parameter rows, jump histories, the next step's jump histories]
+        self._batches = [[STEP_AXES[name][0], group, None, np.zeros(len(group), dtype=np.int64),
+                          np.zeros(len(group), dtype=np.int64)]
+                         for name, group in groups.items() if name in STEP_AXES and len(group) > 1]
+        for a in self._axes:
+            a.step_one = STEP_AXES[a.model.name][1] if a.model.name in STEP_AXES else None
+        batched = {id(a) for batch in self._batches for a in batch[1]}
+        self._unbatched = [a for a in self._axes if id(a) not in batched and a.group is None]
+        self._single = [a for a in self._axes if a.group is None]
+        self._initial_state_pending = True  # set at exit of initialization, or first valid step
+        self._parameters_changed = True     # some axis's parameters were set since the last check
+        self._parameters_usable = False
+        self._jump_warned = False           # the jumping-inputs warning is given once per instance
+        for variable in variables.fmu_variables(AXES, GROUPS):
+            self._register(variable)
+        self.log(STEP, Fmi2Status.ok, "logAll")
+
+    def _register(self, variable):
+        """Register one variable of the FMU's table (``variables``), with its getter and setter."""
+        a = self._axes[variable.axis]
+        kind, name, index = variable.kind, variable.name, variable.index
+        if kind == "parameter":
+            spec_name = a.model.fmu_specs[index].name
+            getter, setter = self._parameter_getter(a, spec_name), self._parameter_setter(a, spec_name)
+        elif kind == "displacement":
+            getter, setter = partial(getattr, a, "x"), partial(self._set_displacement, a)
+        elif kind == "velocity":
+            getter, setter = partial(getattr, a, "v"), partial(self._set_velocity, a)
+        elif kind == "output":
+            getter, setter = partial(self._output, a), None
+        elif a.group is not None:   # a state of its coupled group's (its component)
+            scale, group = variable.scale, a.group
+            getter, setter = (lambda: group.state[index] * scale), None
+        else:
+            scale = variable.scale
+            getter, setter = (lambda: a.state[index] * scale), None
+        self.register_variable(Real(name, causality=getattr(Fmi2Causality, variable.causality),
+                                    variability=getattr(Fmi2Variability, variable.variability),
+                                    description=variable.description, getter=getter, setter=setter))
+
+    # ---------------------------------------------------------------- variable access
+    @staticmethod
+    def _parameter_getter(a, name):
+        return lambda: a.values[name]
+
+    def _parameter_setter(self, a, name):
+        def set_parameter(value):
+            a.values[name] = value
+            a.parameters_changed = self._parameters_changed = True
+            a.output_is_current = False
+            if not math.isfinite(value):
+                self._error(f"{a.axis.label}parameter {name} = {value} [{a.units[name]}] is not "
+                            "a finite number; the next doStep will be refused until it is")
+            elif name == "offset":
+                # the model's displacement moves with the offset (a displacement jump if it
+                # changes during the run, which the dashpots carry)
+                a.offset = value
+                a.x_now = a.x * a.to_kernel - value
+        return set_parameter
+
+    def _set_displacement(self, a, value):
+        axis = a.axis
+        a.x = value
+        a.x_now = value * a.to_kernel - a.offset
+        a.output_is_current = False
+        if not math.isfinite(value):
+            self._error(f"input {axis.displacement} = {value} {axis.displacement_unit} is not a finite number; "
+                        "the next doStep will be refused")
+        elif abs(value) > a.travel_limit and not a.travel_warned:
+            a.travel_warned = True
+            if axis.rotational:
+                message = (f"input {axis.displacement} = {value} rad exceeds {axis.plausible_travel} rad: the "
+                           "bushing takes rotations as small angles (each component of the rotation vector about "
+                           "its own axis), which is approximate beyond about 20 degrees")
+            else:
+                message = (f"input {axis.displacement} = {value} m exceeds {axis.plausible_travel} m, far beyond a "
+                           f"bushing's travel; the FMU takes metres (2 mm is {axis.displacement} = 0.002)")
+            self.log(message, Fmi2Status.warning, "logStatusWarning")
+
+    def _set_velocity(self, a, value):
+        a.v = value
+        a.output_is_current = False
+        if not math.isfinite(value):
+            self._error(f"input {a.axis.velocity} = {value} {a.axis.velocity_unit} is not a finite number; "
+                        "the next doStep will be refused")
+
+    def _output(self, a):
+        """The axis's output at the current time and displacement. If the displacement was set
+        away from the one of the committed state, it includes the model's instantaneous
+        response to that jump."""
+        if a.output_is_current:
+            return a.last_output
+        if a.group is not None:
+            return self._group_output(a)
+        if self._refresh_parameters(a):
+            try:
+                state = a.state
+                if a.x_now != a.state_x:
+                    state = integration.apply_displacement_jump(a.model, a.constants, state, a.x_now - a.state_x)
+                output = a.model.force(a.constants, state, a.x_now, a.v * a.to_kernel) * a.from_kernel + a.preload_port
+            except (ArithmeticError, ValueError):
+                output = math.nan
+            if math.isfinite(output):
+                a.last_output = output
+                a.output_is_current = True
+                a.stale_output_logged = False
+                return output
+            reason = (f"it is not finite ({output}) at {a.axis.displacement} = {a.x} {a.axis.displacement_unit}, "
+                      f"{a.axis.velocity} = {a.v} {a.axis.velocity_unit}")
+        else:
+            reason = f"the parameters{' of axis ' + a.axis.name if a.axis.name else ''} are invalid (see the errors above)"
+        if not a.stale_output_logged:   # once until a current output can be computed again
+            a.stale_output_logged = True
+            self._error(f"{a.axis.output} cannot be computed: {reason}; {a.axis.output} keeps its last finite "
+                        f"value {a.last_output} {a.axis.output_unit}")
+        return a.last_output
+
+    def _group_output(self, a):
+        """A coupled group member's output (``_output``): the group's force vector at the members'
+        current inputs, through the displacement jump from the committed state."""
+        group = a.group
+        reason = f"the parameters of {group.label[:-2]} are invalid (see the errors above)"
+        if self._refresh_group(group):
+            kernels = group.kernels
+            x, v = group.inputs()
+            try:
+                state, status = group.state, integration.OK
+                if x != group.state_x:
+                    state, status = kernels.jump(group.constants, state, tuple(x[i] - group.state_x[i]
+                                                                              for i in range(3)))
+                forces = kernels.force(group.constants, state, x, v)
+            except (ArithmeticError, ValueError):
+                status, forces = integration.NOT_FINITE, (math.nan,) * 3
+            if status == integration.OK and all(math.isfinite(f) for f in forces):
+                for c, member in enumerate(group.members):
+                    member.last_output = forces[c] * member.from_kernel + member.preload_port
+                    member.output_is_current = True
+                    member.stale_output_logged = False
+                return a.last_output
+            reason = "it is not finite at the inputs set (check their units: the FMU takes metres and m/s)"
+        if not a.stale_output_logged:
+            a.stale_output_logged = True
+            self._error(f"{a.axis.output} cannot be computed: {reason}; {a.axis.output} keeps its last finite "
+                        f"value {a.last_output} {a.axis.output_unit}")
+        return a.last_output
+
+    def _refresh_group(self, group) -> bool:
+        """Its members' parameters refreshed (``_refresh_parameters``) and equal: a group carries one
+        parameter set (its members' offset and preload may differ); True if usable, else the
+        difference is logged."""
+        changed = any(a.parameters_changed for a in group.members)
+        usable = all([self._refresh_parameters(a) for a in group.members])
+        if changed or group.constants is None:
+            first = group.members[0]
+            differing = [name for name in group.model.parameter_names
+                         if any(a.values[name] != first.values[name] for a in group.members[1:])]
+            group.errors = []
+            if usable and differing:
+                group.errors = [group.label + "; ".join(
+                    ", ".join(f"{a.axis.name}.{name} = {a.values[name]}" for a in group.members)
+                    + f" [{first.units[name]}]" for name in differing)
+                    + " differ: the axes of a coupled group carry one parameter set (set them alike)"]
+                self._error(group.errors[0])
+            group.usable = usable and not differing
+            group.constants = first.constants if group.usable else None
+        return group.usable
+
+    # ---------------------------------------------------------------- FMI life cycle
+    def exit_initialization_mode(self):
+        # Never raise here: libcosim aborts the whole process on a failed exitInitializationMode,
+        # while it reports a failed step. Invalid start values are logged now and fail the first step.
+        usable = [self._refresh_parameters(a) for a in self._single] + [self._refresh_group(g) for g in self._groups]
+        if all(usable) and all(math.isfinite(a.x_now) for a in self._axes):
+            self._set_initial_state()
+
+    def _fail_to_start(self):
+        """The first doStep with start values that cannot run: fail visibly in every master.
+        pythonfmu 0.7 can return no fmi2Error: a Python exception is its only way to fail a call
+        other than fmi2Discard, and it makes fmi2Fatal (fmpy raises, libcosim reports a failed
+        step). fmi2Discard would not do: fmpy ends the run silently on it. pythonfmu passes log
+        messages to the host only with debug logging on, so the reasons also go to stderr."""
+        reasons = [a.axis.label + error for a in self._axes for error in a.last_errors] \
+            + [error for group in self._groups for error in group.errors] or ["the parameters are invalid"]
+        for message in reasons:
+            print(f"{self.instance_name}: {message}", file=sys.stderr)
+        self._error("the simulation cannot start: " + "; ".join(reasons))
+        # pythonfmu 0.7 releases the instance, its class and its log queue once when an
+        # exception is raised and once more when the instance is freed (PySlaveInstance's
+        # cleanPyObject, twice): freeing a failed instance then corrupts memory and crashes the
+        # host (libcosim at its exit; tests/test_fmu_bad_values.py). One extra reference each,
+        # never given back, absorbs the second release: a few kB leaked per failed instance.
+        for kept in (self, type(self), self._get_log_queue()):
+            ctypes.pythonapi.Py_IncRef(ctypes.py_object(kept))
+        raise InitializationError("; ".join(reasons))
+
+    def _set_initial_state(self):
+        """Each axis at relaxed equilibrium at its current displacement (its model's initial_state),
+        each coupled group at its members' displacement vector."""
+        for a in self._single:
+            a.state = a.model.initial_state(a.constants, a.x_now)
+            a.state_x = a.x_now
+            a.output_is_current = False
+        for group in self._groups:
+            x, _ = group.inputs()
+            group.state, group.state_x = group.kernels.initial_state(group.constants, x), x
+            for a in group.members:
+                a.state_x = a.x_now
+                a.output_is_current = False
+        self._initial_state_pending = False
+
+    def do_step(self, current_time, step_size):
+        if not 0.0 < step_size < math.inf:
+            return self._refuse(f"communication step size {step_size} s must be a finite number > 0")
+        if self._parameters_changed or not self._parameters_usable:
+            self._parameters_changed = False
+            self._parameters_usable = all([self._refresh_parameters(a) for a in self._single]
+                                          + [self._refresh_group(group) for group in self._groups])
+        if not self._parameters_usable:
+            if self._initial_state_pending:   # never started: nothing a master can do in the run
+                self._fail_to_start()
+            return self._refuse("doStep refused: the parameters are invalid (see the errors above)")
+        # one sum is finite if every input is (and a huge but finite sum just takes the long way)
+        if not math.isfinite(sum([a.x for a in self._axes] + [a.v for a in self._axes])):
+            for a in self._axes:
+                axis = a.axis
+                if not (math.isfinite(a.x) and math.isfinite(a.v)):
+                    name, value, unit = ((axis.displacement, a.x, axis.displacement_unit) if not math.isfinite(a.x)
+                                         else (axis.velocity, a.v, axis.velocity_unit))
+                    return self._refuse(f"doStep refused: input {name} = {value} {unit} is not a finite number")
+        if self._initial_state_pending:  # the values at initialization could not be used
+            self._set_initial_state()
+        # every axis first, then commit all: a refusal leaves every axis as it was
+        compiled = self._step_compiled(step_size) if self._batches else None
+        # None: no compiled call, or an axis failed in it: every axis one by one (for the message)
+        steps, crossings = compiled if compiled is not None else ([], ())
+        for a in (self._unbatched if compiled is not None else self._single):
+            step = self._step_axis(a, current_time, step_size)
+            if step is None:
+                return False
+            steps.append(step)
+        group_states = []
+        for group in self._groups:
+            step = self._step_group(group, current_time, step_size)
+            if step is None:
+                return False
+            group_states.append(step[0])
+            steps += step[1]
+        for batch, crossed in crossings:   # the compiled step counted its axes' jumps: keep them
+            batch[3], batch[4] = batch[4], batch[3]
+            if crossed >= 0 and not self._jump_warned:
+                self._warn_jumping(batch[1][crossed], current_time, step_size, int(batch[3][crossed]))
+        for a, state, x_end, output, jumps_counted in steps:
+            if abs(output) > a.output_bound and not a.output_warned:
+                self._warn_implausible(a, output, current_time + step_size)
+            if not (jumps_counted or self._jump_warned):
+                jumped = integration.displacement_jumped(a.x_now, a.state_x, a.v * a.to_kernel, step_size)
+                a.jump_history = ((a.jump_history << 1) | jumped) & _JUMP_MASK
+                if jumped and a.jump_history.bit_count() > JUMP_COUNT:
+                    self._warn_jumping(a, current_time, step_size, a.jump_history)
+            if state is not None:     # a coupled group's member: the group's state is committed below
+                a.state = state
+            a.state_x = a.x_now = x_end
+            a.last_output = output
+            a.output_is_current = True
+        for group, (state, x_end) in zip(self._groups, group_states):
+            group.state, group.state_x = state, x_end
+        return True
+
+    def _step_group(self, group, current_time, step_size):
+        """((the group's new state, its displacement vector at the end), [each member's entry as
+        ``_step_axis`` gives it, its state None]) of one coupled group's step, or None after logging
+        why it cannot be taken."""
+        x, v = group.inputs()
+        label = group.label
+        try:
+            state, _, status = group.kernels.step(group.constants, group.state, group.state_x, x, v, step_size,
+                                                  integration.DEFAULT_MAX_SUBSTEPS)
+            x_end = tuple(x[i] + v[i] * step_size for i in range(3))
+            forces = group.kernels.force(group.constants, state, x_end, v) if status == integration.OK else None
+        except (ArithmeticError, ValueError) as exc:
+            status, forces, x_end = integration.NOT_FINITE, None, x
+            label += f"the step overflowed ({exc}); "
+        inputs = ", ".join(f"{a.axis.displacement} = {a.x} {a.axis.displacement_unit}, {a.axis.velocity} = {a.v} "
+                           f"{a.axis.velocity_unit}" for a in group.members)
+        if status == integration.TOO_MANY_SUBSTEPS:
+            return self._refuse(f"doStep at t = {current_time} s refused: {label}the step of {step_size:g} s would "
+                                f"need more than {integration.DEFAULT_MAX_SUBSTEPS} substeps ({inputs}); check the "
+                                "units of the inputs (the FMU takes metres and m/s) or shorten the communication "
+                                "step") or None
+        if status != integration.OK or not all(math.isfinite(f) for f in forces):
+            return self._refuse(f"doStep at t = {current_time} s refused: {label}the step gave a non-finite state or "
+                                f"force ({inputs}); check the units of the inputs (the FMU takes metres and m/s) "
+                                "and the parameters") or None
+        members = [(a, None, x_end[c], forces[c] * a.from_kernel + a.preload_port, False)
+                   for c, a in enumerate(group.members)]
+        return (state, x_end), members
+
+    def _step_axis(self, a, current_time, step_size):
+        """(axis, new state, displacement at the end, output, False: its jumps not yet counted) of
+        one axis's step, or None after logging why it cannot be taken."""
+        axis = a.axis
+        x, v = a.x_now, a.v * a.to_kernel
+        if a.step_one is not None:   # compiled: one call (the same kernels as advance and force)
+            state, output, x_end, status = a.step_one(a.params_row, a.state, a.state_x, x, v, step_size,
+                                                      integration.DEFAULT_MAX_SUBSTEPS)
+            output = output * a.from_kernel + a.preload_port
+            if status == integration.OK and math.isfinite(output):
+                return a, state, x_end, output, False
+        try:
+            state, _ = integration.advance(a.model, a.constants, a.state, a.state_x, x, v, step_size)
+        except integration.StepError as exc:
+            return self._refuse(f"doStep at t = {current_time} s refused: {axis.label}{exc}") or None
+        x_end = x + v * step_size
+        output = a.model.force(a.constants, state, x_end, v) * a.from_kernel + a.preload_port
+        if not math.isfinite(output):
+            return self._refuse(f"doStep at t = {current_time} s refused: {axis.output} would be {output} "
+                                f"{axis.output_unit} ({axis.displacement} = {a.x} {axis.displacement_unit}, "
+                                f"{axis.velocity} = {a.v} {axis.velocity_unit}); check the units of the inputs") or None
+        return a, state, x_end, output, False
+
+    def _step_compiled(self, step_size):
+        """(steps, [(batch, the first axis whose jumps crossed JUMP_COUNT or -1)]): every axis's
+        step in one compiled call per model (``numba_binding._step_axes``, the same kernels and
+        arithmetic as :meth:`_step_axis`, and the same jump count as :meth:`do_step`'s); None if
+        any axis's step fails, so that the axis-by-axis step redoes it and words the refusal."""
+        steps, crossings = [], []
+        for batch in self._batches:
+            step_axes, group, params, histories, next_histories = batch
+            if params is None:
+                params = batch[2] = np.array([a.model.values(a.values) for a in group])
+            rows = np.array([(a.x_now, a.v * a.to_kernel, a.state_x, *a.state) for a in group])
+            out, failures, crossed = step_axes(params, rows, step_size, integration.DEFAULT_MAX_SUBSTEPS,
+                                               histories, next_histories)
+            if failures:
+                return None
+            crossings.append((batch, crossed))
+            for a, row in zip(group, out.tolist()):   # (*state, force, x + v*h)
+                steps.append((a, tuple(row[:-2]), row[-1], row[-2] * a.from_kernel + a.preload_port, True))
+        return steps, crossings
+
+    def _warn_jumping(self, a, current_time, step_size, history):
+        """Warn, once per instance, that more than JUMP_COUNT of the axis's last JUMP_WINDOW steps
+        started with a displacement jump (``history``, JUMP_*; this step is one of them, not yet
+        committed)."""
+        mismatch = abs(a.x_now - a.state_x)
+        travel = abs(a.v * a.to_kernel) * step_size
+        count = history.bit_count()
+        self._jump_warned = True
+        axis = a.axis
+        unit = axis.displacement_unit
+        self.log(f"{axis.label}the displacement input {axis.displacement} jumps in {count} of the last "
+                 f"{JUMP_WINDOW} steps (at t = {current_time:.6g} s by {mismatch / a.to_kernel:.3g} {unit} per "
+                 f"step against |{axis.velocity}|*h = {travel / a.to_kernel:.3g} {unit}): {axis.velocity} is "
+                 f"probably not the time derivative of the sampled {axis.displacement}, and the dashpots carry "
+                 f"every jump; build the input with identification.fmu_input (a continuous path, "
+                 f"{axis.velocity} = the secant velocity of {axis.displacement}) or set {axis.velocity} = "
+                 f"({axis.displacement}(t + h) - {axis.displacement}(t))/h",
+                 Fmi2Status.warning, "logStatusWarning")
+
+    def _warn_implausible(self, a, output, time):
+        """Warn, once per axis, of an output above the plausible bound (units most likely wrong)."""
+        a.output_warned = True
+        axis = a.axis
+        speed = ("rotation and angular velocity" if axis.rotational else "travel and speed")
+        self.log(f"{axis.output} = {output:.4g} {axis.output_unit} at t = {time} s exceeds "
+                 f"{a.output_bound:.3g} {axis.output_unit}, the {'moment' if axis.rotational else 'force'} of "
+                 f"all the bushing's springs and dashpots at the largest plausible {speed}: check the units of "
+                 f"the inputs ({axis.displacement} = {a.x} {axis.displacement_unit}, {axis.velocity} = {a.v} "
+                 f"{axis.velocity_unit}; the FMU takes {'radians' if axis.rotational else 'metres'})",
+                 Fmi2Status.warning, "logStatusWarning")
+
+    def _refresh_parameters(self, a) -> bool:
+        """Validate and prepare an axis's parameters once after they change, logging errors and
+        warnings; True if the parameters in force are usable."""
+        if a.parameters_changed:
+            a.parameters_changed = False
+            errors, warnings = a.model.validate(a.values)
+            a.last_errors = errors
+            for message in errors:
+                self._error(a.axis.label + message)
+            if errors:
+                a.constants = None
+            else:
+                for message in warnings:
+                    self.log(f"{a.axis.label}accepted, but {message}", Fmi2Status.warning, "logStatusWarning")
+                if a.axis.rotational:   # 1 rad and the plausible angular velocity, in N.mm -> N.m
+                    bound = a.model.plausible_force_bound(a.values, 1.0, axes.PLAUSIBLE_ANGULAR_VELOCITY_RAD_S)
+                else:
+                    bound = a.model.plausible_force_bound(a.values)
+                a.output_bound = bound * a.axis.from_kernel
+                a.constants = a.model.constants(a.values)
+                a.preload_port = a.model.mounting(a.values)[1] * a.from_kernel
+                if np is not None:
+                    a.params_row = np.array(a.model.values(a.values))
+            for batch in self._batches:
+                batch[2] = None
+        return a.constants is not None
+
+    def _error(self, message):
+        self.log(message, Fmi2Status.error, "logStatusError")
+
+    def _refuse(self, message) -> bool:
+        self._error(message)
+        return False
+
+    # ---------------------------------------------------------------- FMU state
+    # pythonfmu's default state holds the registered variables only; each axis's committed
+    # state, its reported displacement and its last output must travel with it too.
+    def _get_fmu_state(self):
+        return {
+            "axes": [{"parameters": dict(a.values), "x": a.x, "v": a.v, "state": list(a.state),
+                      "state_x": a.state_x, "x_now": a.x_now, "last_output": a.last_output}
+                     for a in self._axes],
+            "groups": [{"state": list(group.state), "state_x": list(group.state_x)} for group in self._groups],
+            "initial_state_pending": self._initial_state_pending,
+        }
+
+    def _set_fmu_state(self, state):
+        for a, saved in zip(self._axes, state["axes"]):
+            a.values.update(saved["parameters"])
+            a.offset = a.model.mounting(a.values)[0]
+            a.x, a.v = saved["x"], saved["v"]
+            a.state = tuple(saved["state"])
+            a.state_x, a.x_now = saved["state_x"], saved["x_now"]
+            a.last_output = saved["last_output"]
+            a.output_is_current = False
+            a.parameters_changed = True
+            self._refresh_parameters(a)
+        for group, saved in zip(self._groups, state.get("groups", [])):
+            group.state, group.state_x = tuple(saved["state"]), tuple(saved["state_x"])
+            group.constants = None     # refreshed with its members' restored parameters
+            self._refresh_group(group)
+        self._parameters_changed = True
+        self._initial_state_pending = state["initial_state_pending"]
+

@@ -1,0 +1,13 @@
+"""The model contract: what every model module gives and the machinery all of them share.
+
+- ``definition``: ``BushingModel`` and its parts (states, search box, coupled kernels, slow loop,
+  track start), checked when a model is defined;
+- ``parameter_specs``: a parameter's spec (name, unit, meaning, range), constraints, unit
+  definitions and validation;
+- ``search_coordinates``: the fit's coordinate kinds (map, inverse, bounds);
+- ``integration``: the shared integration machinery (the Bouc-Wen block, friction, Maxwell
+  elements, vector algebra) and the step protocol, written in the kernel language;
+- ``registry``: every model of ``fmu_src.models``, by name and identifier.
+
+May import: nothing of fmu_src but itself (``registry`` finds ``models`` by name, at import).
+"""

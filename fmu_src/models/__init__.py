@@ -1,0 +1,12 @@
+"""The models, one module each (``<name>_model.py``): parameters in the paper's N-mm-s units,
+states, equations as kernels, search box. No FMI, no fitting.
+
+- ``proposed_model``: the paper's model, eqs. 1-5, 16 parameters;
+- ``spencer_model``, ``single_bouc_wen_model``: the paper's baselines;
+- ``berg_model``, ``fractional_model``: filled rubber;
+- ``hydraulic_model``: a hydraulic bushing or mount;
+- ``kelvin_voigt_model``: the linear bushing of the multibody tools.
+
+May import: ``..model`` (the contract and the shared machinery) and one another, in the forms
+``kernels.numba_binding`` allows; ``model.registry`` finds every module here.
+"""
