@@ -41,7 +41,6 @@ import time
 import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
-from xml.dom.minidom import parseString
 from xml.etree import ElementTree as ET
 
 REPO = Path(__file__).resolve().parent
@@ -51,6 +50,7 @@ sys.path.insert(0, str(REPO))
 import fmu_src  # noqa: E402
 from fmu_src import __version__  # noqa: E402
 from fmu_src.model import parameter_specs  # noqa: E402
+from fmu_src.fmi import model_description  # noqa: E402
 from fmu_src.fmi.axes import ONE_AXIS, SIX_AXIS_IDENTIFIER, SIX_AXIS_NAMES, Coupling  # noqa: E402
 from fmu_src.model.registry import MODEL_CHOICES, MODEL_NAMES, get_model  # noqa: E402
 from fmu_src.parameter_files import (parameter_document, read_parameter_set, read_six_axis,  # noqa: E402
@@ -239,7 +239,7 @@ def build_fmu(params_file: str | Path | None = None, out_dir: str | Path = "dist
             for loaded in [m for m in sys.modules if m.startswith(module_name)]:
                 del sys.modules[loaded]
 
-    _rewrite_model_description(fmu_path, axes, groups_of(defaults_json))
+    _write_model_description(fmu_path, identifier, axes, groups_of(defaults_json))
     from fmpy.validation import validate_fmu
     problems = validate_fmu(str(fmu_path))
     if problems:
@@ -253,76 +253,21 @@ def groups_of(document: dict) -> tuple[tuple[int, ...], ...]:
                  for group in Coupling.of(document.get("coupling")).groups)
 
 
-def _rewrite_model_description(fmu_path: Path, axes: list, groups=()) -> None:
-    """``axes``: [(axes.Axis, model on it, parameters)], what the packed library reads back from
-    the defaults it is given (parameter_files.fmu_axes); ``groups``: its coupled groups."""
+def _write_model_description(fmu_path: Path, identifier: str, axes: list, groups=()) -> None:
+    """Replace pythonfmu's modelDescription.xml by the project's one writer's
+    (``fmu_src.fmi.model_description``, as for the native FMU), keeping the guid pythonfmu gave it.
+    ``axes``: [(axes.Axis, model on it, parameters)], what the packed library reads back from the
+    defaults it is given (parameter_files.fmu_axes); ``groups``: its coupled groups."""
+    from pythonfmu import __version__ as pythonfmu_version
     with zipfile.ZipFile(fmu_path) as archive:
         entries = {info.filename: archive.read(info.filename) for info in archive.infolist()}
-    root = ET.fromstring(entries["modelDescription.xml"])
-    root.set("generationTool", f"boucwen-bushing {__version__} (build_fmu.py) with {root.get('generationTool')}")
-    units, starts = {}, {}
-    grouped = {position for group in groups for position in group}
-    for position, (axis, model, parameters) in enumerate(axes):
-        units.update({axis.displacement: axis.displacement_unit, axis.velocity: axis.velocity_unit,
-                      axis.output: axis.output_unit})
-        units.update({axis.prefix + name: unit for name, unit in model.fmu_units.items()})
-        states = model.coupled.states if position in grouped and model.coupled is not None else model.states
-        units.update({axis.prefix + s.name: axis.state_port(s.unit)[0] for s in states})
-        starts.update({axis.prefix + name: value for name, value in parameters.items()})
-    _add_units(root, units)
-    _set_parameter_starts(root, starts)
-    _add_model_structure(root, [axis for axis, _, _ in axes], groups)
-    text = parseString(ET.tostring(root, encoding="UTF-8")).toprettyxml(indent="  ", encoding="UTF-8")
-    entries["modelDescription.xml"] = b"\n".join(line for line in text.splitlines() if line.strip())
+    guid = ET.fromstring(entries["modelDescription.xml"]).get("guid")
+    entries["modelDescription.xml"] = model_description.fmi2(axes, identifier, guid,
+                                                             model_description.pythonfmu_face(pythonfmu_version),
+                                                             groups=groups)
     with zipfile.ZipFile(fmu_path, "w", zipfile.ZIP_DEFLATED) as archive:
         for name, data in entries.items():
             archive.writestr(name, data)
-
-
-def _add_units(root: ET.Element, units: dict[str, str]) -> None:
-    units_used = set()
-    for variable in root.iter("ScalarVariable"):
-        name = variable.get("name")
-        unit = units.get(name)
-        if unit is None:
-            raise BuildError(f"no unit declared for variable {name!r}")
-        variable.find("Real").set("unit", unit)
-        units_used.add(unit)
-    definitions = ET.Element("UnitDefinitions")
-    for unit in sorted(units_used):
-        element = ET.SubElement(definitions, "Unit", name=unit)
-        base = parameter_specs.UNIT_DEFINITIONS[unit]
-        if base is not None:
-            ET.SubElement(element, "BaseUnit", base)
-    # FMI 2.0 schema order: CoSimulation, UnitDefinitions, TypeDefinitions, LogCategories, ...
-    position = list(root).index(root.find("CoSimulation")) + 1
-    root.insert(position, definitions)
-
-
-def _set_parameter_starts(root: ET.Element, parameters: dict[str, float]) -> None:
-    """pythonfmu writes starts with %.16g, which need not round-trip; repr() does."""
-    for variable in root.iter("ScalarVariable"):
-        if variable.get("name") in parameters:
-            variable.find("Real").set("start", repr(parameters[variable.get("name")]))
-
-
-def _add_model_structure(root: ET.Element, axes, groups=()) -> None:
-    index = {v.get("name"): str(i + 1) for i, v in enumerate(root.iter("ScalarVariable"))}
-    structure = root.find("ModelStructure")
-    for child in list(structure):
-        structure.remove(child)
-    # F = k0*y + c0*(c2*v + k2*(x - w) + alpha2*z2)/(c0 + c2) (+ a constant for the
-    # baselines): direct feedthrough of its own axis's x and v, and of nothing else (the axes
-    # are uncoupled), or of every member's of its coupled group (the force vector turns with them).
-    outputs = ET.SubElement(structure, "Outputs")
-    for position, axis in enumerate(axes):
-        group = next((g for g in groups if position in g), (position,))
-        inputs = [index[name] for i in group for name in (axes[i].displacement, axes[i].velocity)]
-        ET.SubElement(outputs, "Unknown", index=index[axis.output], dependencies=" ".join(inputs),
-                      dependenciesKind=" ".join(["dependent"] * len(inputs)))
-    initial = ET.SubElement(structure, "InitialUnknowns")
-    for axis in axes:
-        ET.SubElement(initial, "Unknown", index=index[axis.output])
 
 
 # ---------------------------------------------------------------------------- the release bundle

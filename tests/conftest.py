@@ -1,4 +1,6 @@
 import functools
+import json
+import os
 from pathlib import Path
 
 import numpy as np
@@ -122,47 +124,73 @@ def reference_force(params, time_s, x_mm, v_mm_s, rtol=1e-10, atol=1e-9):
     return np.array(forces)
 
 
+def built_once(tmp_path_factory, name: str, build):
+    """``build(folder)`` (a path, or {name: path}) run once per test run: with pytest-xdist, by the
+    first worker that asks, in a folder every worker of the run shares; the others wait for it and
+    take its FMUs (a build is the same whichever process makes it). Without fcntl (Windows), per
+    worker."""
+    try:
+        import fcntl
+    except ImportError:
+        return build(tmp_path_factory.mktemp(name))
+    root = tmp_path_factory.getbasetemp()
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        root = root.parent                      # the run's folder, above each worker's own
+    folder, record = root / f"built_{name}", root / f"built_{name}.json"
+    with open(root / f"built_{name}.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if record.is_file():
+            paths = json.loads(record.read_text())
+            return Path(paths) if isinstance(paths, str) else {key: Path(path) for key, path in paths.items()}
+        folder.mkdir(exist_ok=True)
+        built = build(folder)
+        record.write_text(json.dumps(str(built) if isinstance(built, Path) else
+                                     {key: str(path) for key, path in built.items()}))
+        return built
+
+
 @pytest.fixture(scope="session")
 def fmu_path(tmp_path_factory) -> Path:
     """The FMU built with the default parameters (Table 5)."""
-    return build_fmu.build_fmu(out_dir=tmp_path_factory.mktemp("fmu_table5"))
+    return built_once(tmp_path_factory, "fmu_table5", lambda folder: build_fmu.build_fmu(out_dir=folder))
 
 
 @pytest.fixture(scope="session")
 def fmu_path_table2(tmp_path_factory) -> Path:
     """An FMU built with the paper's Table 2 as default parameters."""
-    return build_fmu.build_fmu(DATA / "params_table2_sine.json", tmp_path_factory.mktemp("fmu_table2"))
+    return built_once(tmp_path_factory, "fmu_table2",
+                      lambda folder: build_fmu.build_fmu(DATA / "params_table2_sine.json", folder))
 
 
 @pytest.fixture(scope="session")
 def native_fmu_path(tmp_path_factory) -> Path:
     """The native FMU (compiled C, FMI 2.0) built with the default parameters (Table 5)."""
-    return build_fmu.build_native_fmu(out_dir=tmp_path_factory.mktemp("native_table5")).path
+    return built_once(tmp_path_factory, "native_table5", lambda folder: build_fmu.build_native_fmu(out_dir=folder).path)
 
 
 @pytest.fixture(scope="session")
 def native_model_fmus(tmp_path_factory) -> dict:
     """Each model's native FMU (FMI 2.0), and the six-axis one, with their default parameters."""
     from fmu_src.model.registry import MODELS
-    folder = tmp_path_factory.mktemp("native")
-    return {name: build_fmu.build_native_fmu(out_dir=folder, model=name).path for name in (*MODELS, "six_axis")}
+    return built_once(tmp_path_factory, "native", lambda folder: {
+        name: build_fmu.build_native_fmu(out_dir=folder, model=name).path for name in (*MODELS, "six_axis")})
 
 
 @pytest.fixture(scope="session")
 def native_model_fmi3_fmus(tmp_path_factory) -> dict:
     """Each model's native FMU as FMI 3.0, and the six-axis one, with their default parameters."""
     from fmu_src.model.registry import MODELS
-    folder = tmp_path_factory.mktemp("native_fmi3")
-    return {name: build_fmu.build_native_fmu(out_dir=folder, model=name, fmi_version=3).path
-            for name in (*MODELS, "six_axis")}
+    return built_once(tmp_path_factory, "native_fmi3", lambda folder: {
+        name: build_fmu.build_native_fmu(out_dir=folder, model=name, fmi_version=3).path
+        for name in (*MODELS, "six_axis")})
 
 
 @pytest.fixture(scope="session")
 def pythonfmu_model_fmus(tmp_path_factory) -> dict:
     """Each model's pythonfmu FMU, and the six-axis one, with their default parameters."""
     from fmu_src.model.registry import MODELS
-    folder = tmp_path_factory.mktemp("pythonfmu")
-    return {name: build_fmu.build_fmu(out_dir=folder, model=name) for name in (*MODELS, "six_axis")}
+    return built_once(tmp_path_factory, "pythonfmu", lambda folder: {
+        name: build_fmu.build_fmu(out_dir=folder, model=name) for name in (*MODELS, "six_axis")})
 
 
 def is_native(fmu_path) -> bool:

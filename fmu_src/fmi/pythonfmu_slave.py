@@ -202,6 +202,13 @@ class BushingSlave(Fmi2Slave):
 
     # ---------------------------------------------------------------- variable access
     @staticmethod
+    def _outputs_stale(a):
+        """An input or parameter of axis ``a`` changed: its output, and every member's of its coupled
+        group (the group's force vector turns with each member's displacement), is computed anew."""
+        for member in (a.group.members if a.group is not None else (a,)):
+            member.output_is_current = False
+
+    @staticmethod
     def _parameter_getter(a, name):
         return lambda: a.values[name]
 
@@ -209,7 +216,7 @@ class BushingSlave(Fmi2Slave):
         def set_parameter(value):
             a.values[name] = value
             a.parameters_changed = self._parameters_changed = True
-            a.output_is_current = False
+            self._outputs_stale(a)
             if not math.isfinite(value):
                 self._error(f"{a.axis.label}parameter {name} = {value} [{a.units[name]}] is not "
                             "a finite number; the next doStep will be refused until it is")
@@ -224,7 +231,7 @@ class BushingSlave(Fmi2Slave):
         axis = a.axis
         a.x = value
         a.x_now = value * a.to_kernel - a.offset
-        a.output_is_current = False
+        self._outputs_stale(a)
         if not math.isfinite(value):
             self._error(f"input {axis.displacement} = {value} {axis.displacement_unit} is not a finite number; "
                         "the next doStep will be refused")
@@ -241,7 +248,7 @@ class BushingSlave(Fmi2Slave):
 
     def _set_velocity(self, a, value):
         a.v = value
-        a.output_is_current = False
+        self._outputs_stale(a)
         if not math.isfinite(value):
             self._error(f"input {a.axis.velocity} = {value} {a.axis.velocity_unit} is not a finite number; "
                         "the next doStep will be refused")

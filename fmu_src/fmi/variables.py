@@ -16,6 +16,15 @@ from dataclasses import dataclass
 from ..model.registry import DEFAULT_MODEL, get_model
 
 
+NOMINAL_DISPLACEMENT = {"m": 1e-3, "rad": 1e-2}
+"""Nominal values of displacement states (a bushing's travel: millimetres, or 0.6 degrees), so
+that a host's error control sees them at their size in m or rad."""
+NOMINAL_FORCE = {"N": 1000.0, "N.m": 1.0}
+"""Nominal values of hysteretic-force states: a kilonewton (a newton metre on rotational axes)."""
+NOMINAL_VELOCITY = {"m/s": 0.1, "rad/s": 1.0}
+"""Nominal values of velocity states (a hydraulic mount's fluid column: 100 mm/s, 1 rad/s)."""
+
+
 @dataclass(frozen=True)
 class FmuVariable:
     name: str
@@ -112,3 +121,30 @@ def fmu_description(axis_models) -> str:
     return ("Six-axis rubber bushing between markers I and J (uncoupled axes, small rotations; "
             "inputs and outputs in J's axes): " + ", ".join(f"{axis.name} {model.title}" for axis, model, _ in axis_models)
             + ". Ports in SI; translational parameters in N-mm-s units, rotational in N.mm, rad, s.")
+
+
+def all_variables(axis_models, groups=()) -> list[FmuVariable]:
+    """The variables of an FMU with model exchange (the native FMU): :func:`fmu_variables`, then
+    the states' derivatives, the event indicators and the time (FMI 3 requires the independent
+    variable)."""
+    variables = fmu_variables(axis_models, groups)
+    variables += derivative_variables(variables)
+    variables += indicator_variables(len(variables), axis_models, groups)
+    return variables + [FmuVariable("time", len(variables), "independent", "continuous", "s",
+                                    "simulation time [s]", 0, "time", 0)]
+
+
+def nominal(variable: FmuVariable) -> float:
+    """A state's nominal value (1.0 for the other variables and for dimensionless states)."""
+    if variable.kind != "state" or variable.unit == "1":
+        return 1.0
+    return {**NOMINAL_DISPLACEMENT, **NOMINAL_VELOCITY, **NOMINAL_FORCE}[variable.unit]
+
+
+def exact_text(value: float) -> str:
+    """The shortest text that reads back as ``value`` (a start value in the model description, a
+    constant in the generated C); ValueError for a value no FMU can start from."""
+    if value != value or value in (float("inf"), float("-inf")):
+        raise ValueError(f"{value} cannot be a start value")
+    text = repr(float(value))
+    return text if any(c in text for c in ".e") else text + ".0"

@@ -23,7 +23,7 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from . import model_description
+from .. import model_description
 from .generate import model_source
 
 C_LAYER = Path(__file__).resolve().parent / "c"
@@ -139,8 +139,8 @@ def build_native(axis_models, identifier: str, out_dir: str | Path, fmi_version:
         generated = write_sources(sources, axis_models, identifier, fmi_version, groups)
         if fmi_version == 2:
             xml = model_description.fmi2(axis_models, identifier, generated.token,
-                                         event_indicators=generated.event_indicators, source_file=f"{identifier}.c",
-                                         groups=groups)
+                                         model_description.native_face(identifier),
+                                         event_indicators=generated.event_indicators, groups=groups)
         else:
             xml = model_description.fmi3(axis_models, identifier, generated.token, groups)
             (sources / "buildDescription.xml").write_bytes(model_description.build_description(identifier))

@@ -28,30 +28,15 @@ from ...model import integration
 from ..axes import group_name as axis_group_name
 from ...kernels.tangents import tangent
 from ...model.definition import BushingModel
-from ..variables import FmuVariable, derivative_variables, fmu_variables, indicator_variables
+from ..variables import FmuVariable, all_variables, exact_text, nominal
 from ...kernels.python_to_c import DOUBLE, INT, Translation, describe
 
 KINDS = {"parameter": "BW_PARAMETER", "displacement": "BW_DISPLACEMENT", "velocity": "BW_VELOCITY",
          "output": "BW_OUTPUT", "state": "BW_STATE", "derivative": "BW_DERIVATIVE", "indicator": "BW_INDICATOR",
          "time": "BW_TIME"}
-NOMINAL_DISPLACEMENT = {"m": 1e-3, "rad": 1e-2}
-"""Nominal values of displacement states (a bushing's travel: millimetres, or 0.6 degrees), so
-that a host's error control sees them at their size in m or rad."""
-NOMINAL_FORCE = {"N": 1000.0, "N.m": 1.0}
-"""Nominal values of hysteretic-force states: a kilonewton (a newton metre on rotational axes)."""
-NOMINAL_VELOCITY = {"m/s": 0.1, "rad/s": 1.0}
-"""Nominal values of velocity states (a hydraulic mount's fluid column: 100 mm/s, 1 rad/s)."""
-
 
 def c_string(text: str) -> str:
     return json.dumps(text)      # a C string literal for ASCII text (json escapes as C does)
-
-
-def c_double(value: float) -> str:
-    if value != value or value in (float("inf"), float("-inf")):
-        raise ValueError(f"{value} cannot be a start value")
-    text = repr(float(value))
-    return text if any(c in text for c in ".e") else text + ".0"
 
 
 class ModelCode:
@@ -192,16 +177,16 @@ class ModelCode:
             weight = index.get(model.gain_weight(spec.name), -1)
             powers = model.bound_powers(spec)
             specs.append(f"    {{{c_string(spec.name)}, {c_string(spec.unit)}, {int(spec.minimum is not None)}, "
-                         f"{c_double(spec.minimum or 0.0)}, {int(spec.maximum is not None)}, "
-                         f"{c_double(spec.maximum or 0.0)}, {int(spec.exclusive)}, {c_string(spec.allowed)}, "
+                         f"{exact_text(spec.minimum or 0.0)}, {int(spec.maximum is not None)}, "
+                         f"{exact_text(spec.maximum or 0.0)}, {int(spec.exclusive)}, {c_string(spec.allowed)}, "
                          f"{c_string(spec.why)}, {int(powers is not None)}, {(powers or (0, 0))[0]}, "
                          f"{(powers or (0, 0))[1]}, {weight}}}")
         constraints = []
         for c in model.constraints:
             terms = list(c.terms)
             parameters = ", ".join(str(index[name]) for name, _ in terms) or "0"
-            coefficients = ", ".join(c_double(coefficient) for _, coefficient in terms) or "0.0"
-            constraints.append(f"    {{{len(terms)}, {{{parameters}}}, {{{coefficients}}}, {c_double(c.bound)}, "
+            coefficients = ", ".join(exact_text(coefficient) for _, coefficient in terms) or "0.0"
+            constraints.append(f"    {{{len(terms)}, {{{parameters}}}, {{{coefficients}}}, {exact_text(c.bound)}, "
                                f"{int(c.strict)}, {int(c.error)}, {c_string(c.expression)}, {c_string(c.unit)}, "
                                f"{c_string(c.why)}}}")
         name = f"{self.name}{suffix}"
@@ -334,23 +319,6 @@ class CoupledCode:
         return "\n".join(lines)
 
 
-def all_variables(axis_models, groups=()) -> list[FmuVariable]:
-    """The native FMU's variables: the pythonfmu FMU's, then the states' derivatives, the event
-    indicators and the time (FMI 3 requires the independent variable)."""
-    variables = fmu_variables(axis_models, groups)
-    variables += derivative_variables(variables)
-    variables += indicator_variables(len(variables), axis_models, groups)
-    return variables + [FmuVariable("time", len(variables), "independent", "continuous", "s",
-                                    "simulation time [s]", 0, "time", 0)]
-
-
-def nominal(variable: FmuVariable) -> float:
-    """A state's nominal value (1.0 for the other variables and for dimensionless states)."""
-    if variable.kind != "state" or variable.unit == "1":
-        return 1.0
-    return {**NOMINAL_DISPLACEMENT, **NOMINAL_VELOCITY, **NOMINAL_FORCE}[variable.unit]
-
-
 @dataclass(frozen=True)
 class GeneratedModel:
     source: str               # bushing_model.c
@@ -387,14 +355,14 @@ def model_source(axis_models, identifier: str, groups=()) -> GeneratedModel:
             parts.append(models[model.name].tables(suffix, model))
     axis_lines = []
     for position, (axis, model, parameters) in enumerate(axis_models):
-        values = ", ".join(c_double(parameters.get(spec.name, 0.0)) for spec in model.fmu_specs)
+        values = ", ".join(exact_text(parameters.get(spec.name, 0.0)) for spec in model.fmu_specs)
         parts.append(f"static const double bw_defaults_{position}[] = {{{values}}};")
         suffix = "_rotational" if axis.rotational else ""
         plausible = (1.0, 50.0) if axis.rotational else (100.0, 1000.0)
         axis_lines.append(
             f"    {{{c_string(axis.name)}, {c_string(axis.label)}, {c_string(axis.displacement)}, {c_string(axis.velocity)}, "
-            f"{c_string(axis.output)}, {int(axis.rotational)}, {c_double(axis.to_kernel)}, {c_double(axis.from_kernel)}, "
-            f"{c_double(axis.plausible_travel)}, {c_double(plausible[0])}, {c_double(plausible[1])}, "
+            f"{c_string(axis.output)}, {int(axis.rotational)}, {exact_text(axis.to_kernel)}, {exact_text(axis.from_kernel)}, "
+            f"{exact_text(axis.plausible_travel)}, {exact_text(plausible[0])}, {exact_text(plausible[1])}, "
             f"&bw_model_{model.name}{suffix}, bw_defaults_{position}}}")
     parts.append("\nstatic const bw_axis_spec bw_axis_specs[BW_AXES] = {\n" + ",\n".join(axis_lines) + "\n};\n")
     group_of, component = [-1] * len(axis_models), [0] * len(axis_models)
@@ -411,9 +379,9 @@ def model_source(axis_models, identifier: str, groups=()) -> GeneratedModel:
     parts.append("static const int bw_axis_group[BW_AXES] = {" + ", ".join(map(str, group_of)) + "};")
     parts.append("static const int bw_axis_component[BW_AXES] = {" + ", ".join(map(str, component)) + "};\n")
     parts.append("static const bw_variable bw_variables[BW_VARIABLES] = {\n" + ",\n".join(
-        f"    {{{c_string(v.name)}, {KINDS[v.kind]}, {v.axis}, {v.index}, {c_double(v.scale)}}}" for v in variables)
+        f"    {{{c_string(v.name)}, {KINDS[v.kind]}, {v.axis}, {v.index}, {exact_text(v.scale)}}}" for v in variables)
         + "\n};\n")
-    parts.append("static const double bw_nominal[BW_VARIABLES] = {" + ", ".join(c_double(nominal(v)) for v in variables)
+    parts.append("static const double bw_nominal[BW_VARIABLES] = {" + ", ".join(exact_text(nominal(v)) for v in variables)
                  + "};\n")
     body = "\n".join(parts)
 

@@ -1,7 +1,13 @@
-"""modelDescription.xml of a native bushing FMU, FMI 2.0 or 3.0, from the same variable table as
-the pythonfmu FMU (``fmu_src/fmi/variables.py``): the same names, value references, causalities,
-units, descriptions and start values, plus the states' derivatives and the event indicators of
-model exchange.
+"""modelDescription.xml of every bushing FMU, written once: the native FMU's (FMI 2.0 or 3.0,
+co-simulation and model exchange) and the pythonfmu FMU's (FMI 2.0, co-simulation).
+
+Both read the one variable table (``variables``): the same names, value references, causalities,
+units, descriptions and start values; the native FMU adds the states' derivatives, the event
+indicators and the time of model exchange. Both declare each output's dependencies from the
+activity analysis of the model's kernels (``dependencies``): in co-simulation, the inputs an
+output reads at the step's end (x through the jump, v where a dashpot passes it on); with model
+exchange as well, the states. What differs between the two FMUs is their :class:`Face`: the
+interfaces, the capabilities and the tool that made them.
 """
 from __future__ import annotations
 
@@ -9,11 +15,12 @@ import datetime
 from xml.dom.minidom import parseString
 from xml.etree import ElementTree as ET
 
-from ... import __version__
-from ...model.parameter_specs import UNIT_DEFINITIONS
-from ..variables import FmuVariable, fmu_description
-from ..dependencies import V, X, axis_dependencies, group_dependencies
-from .generate import all_variables, c_double, nominal
+from dataclasses import dataclass, field
+
+from .. import __version__
+from ..model.parameter_specs import UNIT_DEFINITIONS
+from .dependencies import V, X, axis_dependencies, group_dependencies
+from .variables import FmuVariable, all_variables, exact_text, fmu_description, fmu_variables, nominal
 
 LOG_CATEGORIES = (("logStatusWarning", "Warnings: values accepted but doubtful (units, the paper's constraints)"),
                   ("logStatusDiscard", "Steps refused"),
@@ -21,6 +28,33 @@ LOG_CATEGORIES = (("logStatusWarning", "Warnings: values accepted but doubtful (
                   ("logStatusFatal", "Fatal errors"),
                   ("logAll", "Everything else"))
 INTERFACES = ("cs", "me")
+CAPABILITIES_FMI2 = {"needsExecutionTool": "false", "canBeInstantiatedOnlyOncePerProcess": "false",
+                     "canNotUseMemoryManagementFunctions": "false", "canGetAndSetFMUstate": "true",
+                     "canSerializeFMUstate": "true", "providesDirectionalDerivative": "true"}
+
+
+@dataclass(frozen=True)
+class Face:
+    """How an FMU implements its description: the interfaces it offers (``cs``, ``me``), its FMI 2
+    capability flags, how the tool that made it is named (after the project's name and version) and
+    the C file it ships (if any)."""
+    interfaces: tuple[str, ...]
+    tool: str
+    capabilities: dict = field(default_factory=lambda: dict(CAPABILITIES_FMI2))
+    source_file: str | None = None
+
+
+def native_face(identifier: str, interfaces=INTERFACES) -> Face:
+    """The native FMU's: C compiled for the host, its source shipped, directional derivatives."""
+    return Face(tuple(interfaces), "(build_fmu.py --native)", source_file=f"{identifier}.c")
+
+
+def pythonfmu_face(pythonfmu_version: str) -> Face:
+    """The pythonfmu FMU's: co-simulation in a Python interpreter (pythonfmu 0.7's capabilities:
+    no directional derivatives, its own memory management)."""
+    capabilities = dict(CAPABILITIES_FMI2, needsExecutionTool="true", canNotUseMemoryManagementFunctions="true")
+    del capabilities["providesDirectionalDerivative"]
+    return Face(("cs",), f"(build_fmu.py) with PythonFMU {pythonfmu_version}", capabilities)
 
 
 def _units(root: ET.Element, variables: list[FmuVariable], position: int) -> None:
@@ -45,10 +79,10 @@ def _pretty(root: ET.Element) -> bytes:
     return b"\n".join(line for line in text.splitlines() if line.strip()) + b"\n"
 
 
-def _common_attributes(identifier: str, token_name: str, token: str, axis_models, version: str) -> dict:
+def _common_attributes(identifier: str, token_name: str, token: str, axis_models, version: str, tool: str) -> dict:
     return {"fmiVersion": version, "modelName": identifier, token_name: token,
             "description": fmu_description(axis_models), "author": "Bouc-Wen bushing project", "version": __version__,
-            "license": "MIT", "generationTool": f"boucwen-bushing {__version__} (build_fmu.py --native)",
+            "license": "MIT", "generationTool": f"boucwen-bushing {__version__} {tool}",
             "generationDateAndTime": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
             "variableNamingConvention": "structured"}
 
@@ -107,19 +141,16 @@ def _unknown(parent: ET.Element, tag: str, key: str, value: str, knowns: list[Fm
                                 "dependenciesKind": " ".join("dependent" for _ in knowns)})
 
 
-def fmi2(axis_models, identifier: str, token: str, interfaces=INTERFACES, event_indicators: int = 0,
-         source_file: str | None = None, groups=()) -> bytes:
-    """FMI 2.0 modelDescription.xml (``interfaces``: "cs" and/or "me"; ``groups``: the coupled groups)."""
+def fmi2(axis_models, identifier: str, token: str, face: Face, event_indicators: int = 0, groups=()) -> bytes:
+    """FMI 2.0 modelDescription.xml of an FMU with ``face`` (``groups``: the coupled groups)."""
+    interfaces = face.interfaces
     groups = _coupled(axis_models, groups)
-    variables = all_variables(axis_models, groups)
-    attributes = _common_attributes(identifier, "guid", token, axis_models, "2.0")
+    variables = all_variables(axis_models, groups) if "me" in interfaces else fmu_variables(axis_models, groups)
+    attributes = _common_attributes(identifier, "guid", token, axis_models, "2.0", face.tool)
     if "me" in interfaces:
         attributes["numberOfEventIndicators"] = str(event_indicators)
     root = ET.Element("fmiModelDescription", attributes)
-    capabilities = {"modelIdentifier": identifier, "needsExecutionTool": "false",
-                    "canBeInstantiatedOnlyOncePerProcess": "false", "canNotUseMemoryManagementFunctions": "false",
-                    "canGetAndSetFMUstate": "true", "canSerializeFMUstate": "true",
-                    "providesDirectionalDerivative": "true"}
+    capabilities = {"modelIdentifier": identifier, **face.capabilities}
     for interface in interfaces:
         if interface == "me":
             element = ET.SubElement(root, "ModelExchange", dict(capabilities, completedIntegratorStepNotNeeded="true"))
@@ -127,8 +158,8 @@ def fmi2(axis_models, identifier: str, token: str, interfaces=INTERFACES, event_
             element = ET.SubElement(root, "CoSimulation", dict(
                 capabilities, canHandleVariableCommunicationStepSize="true", canInterpolateInputs="false",
                 maxOutputDerivativeOrder="0", canRunAsynchronuously="false"))
-        if source_file:
-            ET.SubElement(ET.SubElement(element, "SourceFiles"), "File", name=source_file)
+        if face.source_file:
+            ET.SubElement(ET.SubElement(element, "SourceFiles"), "File", name=face.source_file)
     _units(root, variables, len(root))
     _categories_and_experiment(root)
     model_variables = ET.SubElement(root, "ModelVariables")
@@ -138,11 +169,11 @@ def fmi2(axis_models, identifier: str, token: str, interfaces=INTERFACES, event_
                                 description=v.description, causality=v.causality, variability=v.variability)
         real = {"unit": v.unit}
         if v.start is not None:
-            real["start"] = c_double(v.start)
+            real["start"] = exact_text(v.start)
         if v.kind == "derivative":
             real["derivative"] = str(index[v.state])
         if v.kind == "state":
-            real["nominal"] = c_double(nominal(v))
+            real["nominal"] = exact_text(nominal(v))
         ET.SubElement(element, "Real", real)
     structure = ET.SubElement(root, "ModelStructure")
     outputs = ET.SubElement(structure, "Outputs")
@@ -171,11 +202,12 @@ def _coupled(axis_models, groups) -> tuple:
 
 
 def fmi3(axis_models, identifier: str, token: str, groups=()) -> bytes:
-    """FMI 3.0 modelDescription.xml, co-simulation and model exchange (``groups``: the coupled groups)."""
+    """FMI 3.0 modelDescription.xml of the native FMU, co-simulation and model exchange (``groups``:
+    the coupled groups)."""
     groups = _coupled(axis_models, groups)
     variables = all_variables(axis_models, groups)
     root = ET.Element("fmiModelDescription", _common_attributes(identifier, "instantiationToken", token, axis_models,
-                                                                "3.0"))
+                                                                "3.0", native_face(identifier).tool))
     capabilities = {"modelIdentifier": identifier, "needsExecutionTool": "false",
                     "canBeInstantiatedOnlyOncePerProcess": "false", "canGetAndSetFMUState": "true",
                     "canSerializeFMUState": "true", "providesDirectionalDerivatives": "true",
@@ -190,11 +222,11 @@ def fmi3(axis_models, identifier: str, token: str, groups=()) -> bytes:
         attributes = {"name": v.name, "valueReference": str(v.value_reference), "description": v.description,
                       "causality": v.causality, "variability": v.variability, "unit": v.unit}
         if v.start is not None:
-            attributes["start"] = c_double(v.start)
+            attributes["start"] = exact_text(v.start)
         if v.kind == "derivative":
             attributes["derivative"] = str(v.state)
         if v.kind == "state":
-            attributes["nominal"] = c_double(nominal(v))
+            attributes["nominal"] = exact_text(nominal(v))
         ET.SubElement(model_variables, "Float64", attributes)
     structure = ET.SubElement(root, "ModelStructure")
     dependencies = _dependencies(variables, axis_models, INTERFACES, groups)
