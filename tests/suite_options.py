@@ -76,7 +76,8 @@ def rounding_variant(config):
 
             def offset_seed(*args, **kwargs):
                 bound = inspect.signature(search).bind(*args, **kwargs)
-                bound.arguments["seed"] += offset
+                request = bound.arguments["request"]
+                bound.arguments["request"] = dataclasses.replace(request, seed=request.seed + offset)
                 return search(*bound.args, **bound.kwargs)
 
             patch.setattr(fitting, "_search", offset_seed)

@@ -257,3 +257,60 @@ def test_the_docs_layout_names_every_module_of_fmu_src():
                                                                           if p.is_dir() and p.name != "__pycache__"})
     missing = [name for name in modules if f"`{name}`" not in layout]
     assert not missing, f"docs/index.md's Layout does not name {missing}"
+
+
+def _module_of(name: str) -> str | None:
+    """The module or package of this repository that the dotted ``name`` is, or is a name of."""
+    while name:
+        path = REPO / name.replace(".", "/")
+        if path.with_suffix(".py").is_file() or (path / "__init__.py").is_file():
+            return name
+        name = name.rpartition(".")[0]
+    return None
+
+
+def _module_imports() -> dict[str, set[str]]:
+    """{module: the modules of fmu_src and identification it imports, at its top or inside a
+    function} (a package stands for its __init__)."""
+    graph = {}
+    for name in SUBPACKAGES:
+        for path in sorted((REPO / name).rglob("*.py")):
+            parts = path.relative_to(REPO).with_suffix("").parts
+            module = ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+            graph[module] = {target for _, imported in _imports(path, name) if imported.split(".")[0] in SUBPACKAGES
+                             for target in [_module_of(imported)] if target and target != module}
+    return graph
+
+
+def test_no_two_modules_import_each_other_even_through_others():
+    graph = _module_imports()
+    circles = []
+
+    def visit(module, path, on_path, done):
+        on_path.add(module)
+        for imported in sorted(graph.get(module, ())):
+            if imported in on_path:
+                circles.append(path[path.index(imported):] + [imported])
+            elif imported not in done:
+                visit(imported, path + [imported], on_path, done)
+        on_path.discard(module)
+        done.add(module)
+
+    done = set()
+    for module in sorted(graph):
+        if module not in done:
+            visit(module, [module], set(), done)
+    # a package's __init__ handing its modules' names on is not a circle of the code
+    circles = [c for c in circles if not any(m in SUBPACKAGES or m.count(".") == 1 and m.split(".")[1] in
+                                             SUBPACKAGES[m.split(".")[0]] for m in c)]
+    assert not circles, circles
+
+
+def test_no_function_is_longer_than_a_reader_can_hold():
+    import ast
+    long = []
+    for path in [*(REPO / "fmu_src").rglob("*.py"), *(REPO / "identification").rglob("*.py"), REPO / "build_fmu.py"]:
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)) and node.end_lineno - node.lineno >= 100:
+                long.append(f"{path.relative_to(REPO)}:{node.lineno} {node.name}, {node.end_lineno - node.lineno + 1} lines")
+    assert not long, long

@@ -284,3 +284,29 @@ def test_the_jump_test_is_one_kernel_in_python_numba_and_c(tmp_path):
         assert bool(compiled(*arguments)) is python
         lines, _ = c[("displacement_jumped", index)]
         assert lines == python_lines(int(python), "int"), arguments
+
+
+def test_every_differentiable_call_has_its_rule_in_the_table_and_no_other_does():
+    for call in kernel_language.CALLS:
+        assert (call.derivative is not None) == (call.tangent == "chain"), call.name
+
+
+def test_the_tangent_generator_decides_no_call_by_its_name():
+    # the table holds each call's rule (kernel_language.KernelCall.derivative, .active): the
+    # generator compares no name of the table, alone or in a tuple
+    import ast
+    import inspect
+
+    from fmu_src.kernels import tangents
+    names = {call.name for call in kernel_language.CALLS}
+
+    def constants(node):
+        if isinstance(node, ast.Constant):
+            return [node.value]
+        if isinstance(node, (ast.Tuple, ast.List, ast.Set)):
+            return [element.value for element in node.elts if isinstance(element, ast.Constant)]
+        return []
+    named = [f"line {node.lineno}: {ast.unparse(node)}" for node in ast.walk(ast.parse(inspect.getsource(tangents)))
+             if isinstance(node, ast.Compare)
+             and names & {value for side in (node.left, *node.comparators) for value in constants(side)}]
+    assert not named, named

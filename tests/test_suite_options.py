@@ -30,11 +30,14 @@ def test_forces_are_perturbed_at_the_level_asked_and_only_inside_the_variant():
 
 def test_every_fit_seed_is_offset_inside_the_variant_only(monkeypatch):
     seeds = []
-    monkeypatch.setattr(fitting, "_search", lambda tests, noise, model, preset, settings, seed, *rest: seeds.append(seed))
+    monkeypatch.setattr(fitting, "_search", lambda request, engine, progress, started: seeds.append(request.seed))
+
+    def request(seed):
+        return fitting.SearchRequest([], [], None, "default", None, seed)
     with rounding_variant(Options(seed_offset=2)):
-        fitting._search(None, None, "proposed", "default", None, 5, None)
-        fitting._search(None, None, "proposed", "default", None, seed=0)
-    fitting._search(None, None, "proposed", "default", None, 5)
+        fitting._search(request(5), None, True, 0.0)
+        fitting._search(request=request(0), engine=None, progress=True, started=0.0)
+    fitting._search(request(5), None, True, 0.0)
     assert seeds == [7, 2, 5]
 
 

@@ -10,8 +10,11 @@ the same ones, each naming the function and the line. This table is what they ta
 - ``arguments``: how many;
 - ``result``: ``float``, ``int`` (a count: ceil, floor, trunc, int, len), ``bool`` (a test), or
   ``same`` (the arguments' type: abs, min, max of ints is an int);
-- ``tangent``: ``chain`` (a function of its arguments with a derivative: the tangent generator holds
-  its rule, ``tangents.CHAIN_RULES``) or ``zero`` (a count or a test: no derivative);
+- ``tangent``: ``chain`` (a function of its arguments with a derivative) or ``zero`` (a count or a
+  test: no derivative);
+- ``derivative``: a ``chain`` call's tangent rule, the syntax of its tangent from its arguments
+  and theirs (the tangent generator applies it and decides no call by its name), and ``active``:
+  the arguments whose dependence the result carries (copysign's sign argument is a branch);
 - ``c``: the C of the call, its arguments as doubles in ``{0}``, ``{1}`` (``bw_int`` is the
   translator's helper for Python's int of a float); None where the C depends on the arguments'
   types (abs, min, max, int, float, len), which the translator writes itself.
@@ -19,7 +22,8 @@ the same ones, each naming the function and the line. This table is what they ta
 :class:`KernelFunction` is the analysis both tools share: a kernel's tree, its arguments, its errors
 with lines, the fixpoint over its locals, what its names and calls mean, its tuple indices. Each
 tool adds what it infers (C types, activities) and what it writes (C, tangents), and keeps its own
-naming of the versions it makes per argument pattern.
+naming of the versions it makes per argument pattern. :func:`with_bodies` is how both the tangent
+generator and its lanes (``vector_tangents``) keep a kernel's control flow.
 
 ``tests/test_kernel_language.py`` runs every entry in Python, numba and C (bit for bit) and its
 tangent against complex step (or, for the zero-tangent entries, checks the tangent is 0).
@@ -31,19 +35,27 @@ import builtins
 import math
 import types
 from dataclasses import dataclass
+from typing import Callable
 
 from .unrolling import UnrollError, kernel_definition, kernel_global, kernel_statements
 
 
 @dataclass(frozen=True)
 class KernelCall:
-    """A call a kernel may make (see the module docstring)."""
+    """A call a kernel may make (see the module docstring). ``derivative(b, x, t)``: its tangent
+    as a syntax tree, from its arguments' trees ``x`` and their tangents' ``t`` (None for an
+    inactive one), built with ``b`` (the tangent generator's builder: ``mul``, ``neg``, ``div``,
+    ``times``, ``where``, ``compare``, ``math``, ``helper``, ``copy``, ``zero``, ``power``); None for
+    a call whose tangent class is ``zero``. ``active``: the arguments whose activity the result
+    carries (default: all)."""
     name: str
     module: str
     arguments: int
     result: str
     tangent: str
     c: str | None = None
+    derivative: Callable | None = None
+    active: tuple[int, ...] | None = None
 
     @property
     def written(self) -> str:
@@ -51,25 +63,42 @@ class KernelCall:
         return f"math.{self.name}" if self.module == "math" else self.name
 
 
+def _sign_of(b, x, t):
+    """|x|'s derivative: the branch the value takes (+ at 0, as Python's abs and C's fabs)."""
+    return b.where(b.compare(x[0], ">=", 0.0), t[0], b.neg(t[0]))
+
+
+def _first_of_equal(op: str):
+    """min's or max's derivative: Python returns the first of equal arguments, so at a tie the
+    first's."""
+    return lambda b, x, t: b.where(b.compare(x[1], op, x[0]), t[1] or b.zero(), t[0] or b.zero())
+
+
 CALLS = (
-    KernelCall("exp", "math", 1, "float", "chain", "exp({0})"),
-    KernelCall("log", "math", 1, "float", "chain", "log({0})"),
-    KernelCall("sqrt", "math", 1, "float", "chain", "sqrt({0})"),
-    KernelCall("sin", "math", 1, "float", "chain", "sin({0})"),
-    KernelCall("cos", "math", 1, "float", "chain", "cos({0})"),
-    KernelCall("fabs", "math", 1, "float", "chain", "fabs({0})"),
-    KernelCall("copysign", "math", 2, "float", "chain", "copysign({0}, {1})"),
-    KernelCall("pow", "math", 2, "float", "chain", "pow({0}, {1})"),
+    KernelCall("exp", "math", 1, "float", "chain", "exp({0})", lambda b, x, t: b.mul(b.math("exp", x[0]), t[0])),
+    KernelCall("log", "math", 1, "float", "chain", "log({0})", lambda b, x, t: b.div(t[0], x[0])),
+    KernelCall("sqrt", "math", 1, "float", "chain", "sqrt({0})",
+               lambda b, x, t: b.mul(b.helper("tangent_sqrt_slope", x[0]), t[0])),
+    KernelCall("sin", "math", 1, "float", "chain", "sin({0})", lambda b, x, t: b.mul(b.math("cos", x[0]), t[0])),
+    KernelCall("cos", "math", 1, "float", "chain", "cos({0})",
+               lambda b, x, t: b.neg(b.mul(b.math("sin", x[0]), t[0]))),
+    KernelCall("fabs", "math", 1, "float", "chain", "fabs({0})", _sign_of),
+    # copysign(a, s) = |a|*sgn(s): the sign of a times the sign of s carries a's tangent; s's sign
+    # is a branch (its derivative 0 away from s = 0), so only a is active
+    KernelCall("copysign", "math", 2, "float", "chain", "copysign({0}, {1})",
+               lambda b, x, t: b.mul(b.times(b.math("copysign", 1.0, b.copy(x[0])), b.math("copysign", 1.0, x[1])),
+                                     t[0]), active=(0,)),
+    KernelCall("pow", "math", 2, "float", "chain", "pow({0}, {1})", lambda b, x, t: b.power(x[0], x[1], t[0], t[1])),
     KernelCall("ceil", "math", 1, "int", "zero", "bw_int(ceil({0}))"),
     KernelCall("floor", "math", 1, "int", "zero", "bw_int(floor({0}))"),
     KernelCall("trunc", "math", 1, "int", "zero", "bw_int({0})"),
     KernelCall("isfinite", "math", 1, "bool", "zero", "(isfinite({0}) != 0)"),
     KernelCall("isnan", "math", 1, "bool", "zero", "(isnan({0}) != 0)"),
     KernelCall("isinf", "math", 1, "bool", "zero", "(isinf({0}) != 0)"),
-    KernelCall("abs", "builtins", 1, "same", "chain"),
-    KernelCall("min", "builtins", 2, "same", "chain"),
-    KernelCall("max", "builtins", 2, "same", "chain"),
-    KernelCall("float", "builtins", 1, "float", "chain"),
+    KernelCall("abs", "builtins", 1, "same", "chain", derivative=_sign_of),
+    KernelCall("min", "builtins", 2, "same", "chain", derivative=_first_of_equal("<")),
+    KernelCall("max", "builtins", 2, "same", "chain", derivative=_first_of_equal(">")),
+    KernelCall("float", "builtins", 1, "float", "chain", derivative=lambda b, x, t: t[0]),
     KernelCall("int", "builtins", 1, "int", "zero"),
     KernelCall("len", "builtins", 1, "int", "zero"),
     KernelCall("bool", "builtins", 1, "bool", "zero"),
@@ -191,3 +220,15 @@ class KernelFunction:
         if not isinstance(value, int) or isinstance(value, bool):
             raise self.error(e, f"index {value!r}: only int tuple indices")
         return value
+
+
+def with_bodies(s, block):
+    """The ``if``, ``while`` or ``for`` statement ``s`` with its test or loop kept and its bodies
+    rewritten by ``block`` (an empty body a ``pass``): how the tangent generator and its lanes
+    rewrite (``vector_tangents``) keep the kernel's control flow."""
+    body, orelse = block(s.body) or [ast.Pass()], block(s.orelse)
+    if isinstance(s, ast.If):
+        return ast.If(s.test, body, orelse)
+    if isinstance(s, ast.While):
+        return ast.While(s.test, body, orelse)
+    return ast.For(s.target, s.iter, body, orelse, None)

@@ -79,6 +79,8 @@ import types
 from typing import Callable
 
 from . import kernel_language
+from .kernel_language import with_bodies
+from .vector_tangents import vectorize
 
 SLOPE_CAP = 1e100
 """Largest magnitude of the slope factor a^(b-1) of ``a ** b`` (and of d sqrt) near a = 0 (module docstring)."""
@@ -293,9 +295,8 @@ class _Spec(kernel_language.KernelFunction):
                 raise self.error(e, f"{call.written} takes {call.arguments} argument{'s' if call.arguments > 1 else ''}")
             if call.tangent == "zero":
                 return False
-            if what == "copysign":
-                return self.scalar(arguments[0], e)
-            return self.scalar(join(*arguments) if len(arguments) == 2 else arguments[0], e)
+            carried = arguments if call.active is None else [arguments[i] for i in call.active]
+            return self.scalar(join(*carried) if len(carried) == 2 else carried[0], e)
         raise self.error(e, f"expression {type(e).__name__} is not differentiated")
 
     def scalar(self, a, e):
@@ -489,40 +490,9 @@ class _Spec(kernel_language.KernelFunction):
             kind, what = self.callee(e)
             if kind == "kernel":
                 raise self.error(e, f"a call of {what.__name__} that was not hoisted")
-            args = [P(x) for x in e.args]
-            ts = [T(x) for x in e.args]
-            if kind == "builtin":
-                if what == "float":
-                    return ts[0]
-                if what == "abs":
-                    return ast.IfExp(_compare(args[0], ast.GtE(), ast.Constant(0.0)), ts[0], _neg(ts[0]))
-                if what in ("min", "max"):
-                    # Python returns the first of equal arguments: its derivative at a tie
-                    op = ast.Lt() if what == "min" else ast.Gt()
-                    return ast.IfExp(_compare(args[1], op, args[0]), ts[1] or ast.Constant(0.0),
-                                     ts[0] or ast.Constant(0.0))
-            if kind == "math":
-                call = lambda name, *xs: ast.Call(ast.Attribute(ast.Name("math", ast.Load()), name, ast.Load()),  # noqa
-                                                  list(xs), [])
-                x, t = args[0], ts[0]
-                if what == "exp":
-                    return _mul(call("exp", x), t)
-                if what == "log":
-                    return ast.BinOp(t, ast.Div(), x)
-                if what == "sqrt":
-                    return _mul(ast.Call(ast.Name("tangent_sqrt_slope", ast.Load()), [x], []), t)
-                if what == "sin":
-                    return _mul(call("cos", x), t)
-                if what == "cos":
-                    return _neg(_mul(call("sin", x), t))
-                if what == "fabs":
-                    return ast.IfExp(_compare(x, ast.GtE(), ast.Constant(0.0)), t, _neg(t))
-                if what == "copysign":
-                    sign = ast.BinOp(call("copysign", ast.Constant(1.0), _copy(x)), ast.Mult(),
-                                     call("copysign", ast.Constant(1.0), args[1]))
-                    return _mul(sign, t)
-                if what == "pow":
-                    return self.pow_tangent(args[0], args[1], ts[0], ts[1])
+            call = (kernel_language.MATH if kind == "math" else kernel_language.BUILTINS)[what]
+            if call.derivative is not None:     # the kernel language's table says how
+                return call.derivative(_Builder(self), [P(x) for x in e.args], [T(x) for x in e.args])
         raise self.error(e, f"{ast.unparse(e)} is not differentiated")
 
     def pow_tangent(self, base, exponent, ta, tb):
@@ -534,18 +504,6 @@ class _Spec(kernel_language.KernelFunction):
             out = _add(out, _mul(ast.Call(ast.Name("tangent_pow_log", ast.Load()), [_copy(base), _copy(exponent)], []),
                                  tb))
         return out
-
-
-def with_bodies(s, block):
-    """The ``if``, ``while`` or ``for`` statement ``s`` with its test or loop kept and its bodies
-    rewritten by ``block`` (an empty body a ``pass``): how the tangent generator and its lanes
-    rewrite (``vector_tangents``) keep the kernel's control flow."""
-    body, orelse = block(s.body) or [ast.Pass()], block(s.orelse)
-    if isinstance(s, ast.If):
-        return ast.If(s.test, body, orelse)
-    if isinstance(s, ast.While):
-        return ast.While(s.test, body, orelse)
-    return ast.For(s.target, s.iter, body, orelse, None)
 
 
 def _compare(a, op, b):
@@ -576,6 +534,48 @@ def _mul(a, b):
 
 def _neg(a):
     return None if a is None else ast.UnaryOp(ast.USub(), a)
+
+
+class _Builder:
+    """The syntax a call's tangent rule (``kernel_language.KernelCall.derivative``) is built with:
+    products and negations that keep an inactive tangent (None) None, and the calls, tests and
+    constants the rules name."""
+    COMPARISONS = {"<": ast.Lt, ">": ast.Gt, ">=": ast.GtE}
+
+    def __init__(self, spec):
+        self.power = spec.pow_tangent
+
+    mul, neg, copy = staticmethod(_mul), staticmethod(_neg), staticmethod(_copy)
+
+    @staticmethod
+    def _tree(x):
+        return ast.Constant(x) if isinstance(x, float) else x
+
+    @staticmethod
+    def div(a, b):
+        return ast.BinOp(a, ast.Div(), b)
+
+    @staticmethod
+    def times(a, b):
+        return ast.BinOp(a, ast.Mult(), b)
+
+    @staticmethod
+    def where(test, body, orelse):
+        return ast.IfExp(test, body, orelse)
+
+    def compare(self, a, op: str, b):
+        return _compare(self._tree(a), self.COMPARISONS[op](), self._tree(b))
+
+    def math(self, name: str, *arguments):
+        return ast.Call(ast.Attribute(ast.Name("math", ast.Load()), name, ast.Load()),
+                        [self._tree(x) for x in arguments], [])
+
+    def helper(self, name: str, *arguments):
+        return ast.Call(ast.Name(name, ast.Load()), [self._tree(x) for x in arguments], [])
+
+    @staticmethod
+    def zero():
+        return ast.Constant(0.0)
 
 
 # ---------------------------------------------------------------------------- the generator
@@ -636,7 +636,6 @@ class Generator:
         (a float's tangent a ``lanes``-tuple; ``vector_tangents``): the value computed once for all
         directions, which is what makes the fit's exact Jacobian cheaper than ``lanes`` + 1
         simulations."""
-        from .vector_tangents import vectorize
         return vectorize("\n\n".join(self.sources.values()), self.lanes)
 
     def namespace(self, function) -> dict:

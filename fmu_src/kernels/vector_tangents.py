@@ -45,7 +45,7 @@ import ast
 import copy
 import itertools
 
-from .tangents import with_bodies
+from .kernel_language import with_bodies
 
 TANGENT_PREFIXES = ("d_", "_td")
 """The names the generated tangents hold their tangents in (``tangents`` reserves them)."""

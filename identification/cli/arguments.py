@@ -74,11 +74,23 @@ def main(argv: list[str] | None = None) -> int:
     or 143 for a command stopped by SIGINT (Ctrl-C) or SIGTERM (``identification.interrupt``: one
     line on stderr saying what was written, no worker process left behind)."""
     program = "bushing-identify" if Path(sys.argv[0]).name.startswith("bushing-identify") else "python -m identification"
+    return run(build_parser(program).parse_args(argv))
+
+
+def build_parser(program: str = "python -m identification") -> argparse.ArgumentParser:
+    """Every command and its arguments (``program``: the name the usage lines give)."""
     parser = argparse.ArgumentParser(prog=program,
                                      description="Identify the bushing model's parameters from measured tests.")
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     subcommands = parser.add_subparsers(dest="command", required=True)
+    for add in (_add_fit, _add_sensitivity, _add_report, _add_compare, _add_predict, _add_design, _add_fit_many,
+                _add_assemble, _add_characterise):
+        add(subcommands)
+    return parser
 
+
+def _add_fit(subcommands) -> None:
+    """The ``fit`` command's arguments."""
     fit_parser = subcommands.add_parser("fit", help="fit a model's parameters to rig tests, with convergence evidence")
     fit_parser.add_argument("--model", choices=MODEL_CHOICES, metavar="MODEL",
                             help=f"one of {', '.join(MODEL_NAMES)} ({_linear_models()} by linear least squares; "
@@ -95,6 +107,9 @@ def main(argv: list[str] | None = None) -> int:
                             help="also write the ensemble: every parameter set within the 95 %% confidence threshold")
     fit_parser.add_argument("--plots", type=Path, help="directory for the waterfall and the training tests' plots")
 
+
+def _add_sensitivity(subcommands) -> None:
+    """The ``sensitivity`` command's arguments."""
     sensitivity_parser = subcommands.add_parser(
         "sensitivity", help="rank the 16 parameters by local sensitivity (paper Tables 1 and 3)")
     sensitivity_parser.add_argument("--params", type=Path, required=True, help="parameter file (.json or .ssv)")
@@ -102,6 +117,9 @@ def main(argv: list[str] | None = None) -> int:
                                     help="relative change, 0 < delta < 1 (default 0.1)")
     sensitivity_parser.add_argument("--csv", type=Path, help="also write the table as CSV")
 
+
+def _add_report(subcommands) -> None:
+    """The ``report`` command's arguments."""
     report_parser = subcommands.add_parser("report", help="verification report: error tables and plots (paper §5)")
     report_parser.add_argument("--params", type=Path, required=True,
                                help="parameter file (.json or .ssv) or ensemble (then with its band)")
@@ -113,6 +131,9 @@ def main(argv: list[str] | None = None) -> int:
                                help="fit F = k*x + c*v on these files and show it beside the model")
     report_parser.add_argument("--plots", type=Path, help="directory for force-time/force-displacement PNGs")
 
+
+def _add_compare(subcommands) -> None:
+    """The ``compare`` command's arguments."""
     compare_parser = subcommands.add_parser(
         "compare", help="fit several models on training tests, weigh them on held-out files and a table, and "
                         "recommend one")
@@ -135,6 +156,9 @@ def main(argv: list[str] | None = None) -> int:
     compare_parser.add_argument("--out", type=Path, required=True,
                                 help="directory for the fitted parameter files, the table (CSV) and the plots")
 
+
+def _add_predict(subcommands) -> None:
+    """The ``predict`` command's arguments."""
     predict_parser = subcommands.add_parser(
         "predict", help="simulate a parameter file or an ensemble on a test's displacement")
     predict_parser.add_argument("--params", type=Path, required=True,
@@ -150,6 +174,9 @@ def main(argv: list[str] | None = None) -> int:
                                      "multi-axis path time_s,dx_mm,dy_mm,Fx_N,Fy_N[,Fx_min_N,Fx_max_N,...]")
     predict_parser.add_argument("--plot", type=Path, help="also plot the prediction (PNG)")
 
+
+def _add_design(subcommands) -> None:
+    """The ``design`` command's arguments."""
     design_parser = subcommands.add_parser("design", help="rank candidate next tests by how much the ensemble disagrees")
     design_parser.add_argument("--ensemble", type=Path, required=True, help="ensemble file (fit --ensemble)")
     design_parser.add_argument("--noise", type=positive_float, metavar="N",
@@ -157,11 +184,17 @@ def main(argv: list[str] | None = None) -> int:
     design_parser.add_argument("--top", type=positive_int, default=3, help="how many to recommend (default 3)")
     design_parser.add_argument("--json", action="store_true", help="print the ranking as JSON")
 
+
+def _add_fit_many(subcommands) -> None:
+    """The ``fit-many`` command's arguments."""
     fleet_parser = subcommands.add_parser("fit-many", help="fit a fleet: every sub-folder of DIR with a tests.json")
     fleet_parser.add_argument("folder", type=Path, metavar="DIR")
     fleet_parser.add_argument("--out", type=Path, required=True, help="directory for <name>.json and summary.csv")
     _add_search_arguments(fleet_parser)
 
+
+def _add_assemble(subcommands) -> None:
+    """The ``assemble`` command's arguments."""
     assemble_parser = subcommands.add_parser(
         "assemble", help="build a six-axis parameter file (SixAxisBushing) from one fit per axis")
     assemble_parser.add_argument("--axis", action="append", default=[], metavar="NAME=FILE",
@@ -178,6 +211,9 @@ def main(argv: list[str] | None = None) -> int:
     missing.add_argument("--default", type=Path, metavar="SIX.json",
                          help="an axis without a file takes its set from this six-axis file")
 
+
+def _add_characterise(subcommands) -> None:
+    """The ``characterise`` command's arguments."""
     characterise_parser = subcommands.add_parser(
         "characterise", help="dynamic stiffness |K*| and loss angle over amplitudes and frequencies (data sheet)")
     characterise_parser.add_argument("--params", type=Path, required=True,
@@ -195,7 +231,9 @@ def main(argv: list[str] | None = None) -> int:
     characterise_parser.add_argument("--plots", type=Path, help="directory for the data-sheet plots (PNG)")
     characterise_parser.add_argument("--json", action="store_true", help="print a summary as JSON")
 
-    args = parser.parse_args(argv)
+
+def run(args: argparse.Namespace) -> int:
+    """Run the command ``args`` names (``build_parser``'s); the exit status as :func:`main`."""
     with warnings.catch_warnings(), signals_raise():
         # A user reads the warning, not where in our code it was raised.
         warnings.showwarning = lambda message, category, *rest, **keywords: commands.print_warning(str(message))

@@ -177,6 +177,31 @@ def fit(measurements, model: str | BushingModel = DEFAULT_MODEL, preset: str = "
     require("fit", "identification.fit")
     from threadpoolctl import threadpool_limits
     started = time.perf_counter()
+    tests, noise, table, multi, bushing = _training(measurements, model, seed, jacobian, kdyn, multiaxis, coupling)
+    # One BLAS thread here as in every task: a multi-threaded BLAS may sum in another order,
+    # and the scales and the Jacobian's SVD computed here must not depend on the engine.
+    with threadpool_limits(limits=1):
+        if bushing.linear is not None:
+            result = _fit_linear(bushing, tests, noise, started, table, multi)
+        else:
+            if preset not in PRESETS:
+                raise IdentificationError(f"unknown preset {preset!r}; choose one of {', '.join(PRESETS)}")
+            request = SearchRequest(tests, noise, bushing, preset, _settings(PRESETS[preset], screening, starts), seed,
+                                    table, multi, jacobian, ensemble)
+            owned = engine is None
+            engine = engine or make_engine(workers, scheduler)
+            # an engine made here is closed here, and aborted if the search is left by an exception
+            # (Ctrl-C, SIGTERM): see identification.fitting.engine
+            with engine if owned else contextlib.nullcontext():
+                result = _search(request, engine, progress, started)
+    if not result.converged:
+        warnings.warn(result.warning, FitNotConvergedWarning, stacklevel=2)
+    return result
+
+
+def _training(measurements, model, seed: int, jacobian: str, kdyn, multiaxis, coupling: str | None):
+    """``fit``'s arguments read and checked: (one-axis tests, their noise levels, the table or
+    None, the multi-axis tests with their noise levels and coupling, the model)."""
     table = kdyn if kdyn is None or isinstance(kdyn, KdynTable) else load_kdyn_table(kdyn)
     multi = as_multiaxis(multiaxis)
     _check_coupling(multi, coupling)
@@ -189,25 +214,7 @@ def fit(measurements, model: str | BushingModel = DEFAULT_MODEL, preset: str = "
         raise IdentificationError(f"jacobian = {jacobian!r}: choose one of {', '.join(JACOBIANS)}")
     noise = [_noise_of(t) for t in tests]
     multi = MultiAxisTraining(multi, [_axis_noise_of(m) for m in multi], coupling or "none")
-    # One BLAS thread here as in every task: a multi-threaded BLAS may sum in another order,
-    # and the scales and the Jacobian's SVD computed here must not depend on the engine.
-    with threadpool_limits(limits=1):
-        if bushing.linear is not None:
-            result = _fit_linear(bushing, tests, noise, started, table, multi)
-        else:
-            if preset not in PRESETS:
-                raise IdentificationError(f"unknown preset {preset!r}; choose one of {', '.join(PRESETS)}")
-            settings = _settings(PRESETS[preset], screening, starts)
-            owned = engine is None
-            engine = engine or make_engine(workers, scheduler)
-            # an engine made here is closed here, and aborted if the search is left by an exception
-            # (Ctrl-C, SIGTERM): see identification.fitting.engine
-            with engine if owned else contextlib.nullcontext():
-                result = _search(tests, noise, bushing, preset, settings, seed, engine, progress, started, table,
-                                 ensemble, jacobian, multi)
-    if not result.converged:
-        warnings.warn(result.warning, FitNotConvergedWarning, stacklevel=2)
-    return result
+    return tests, noise, table, multi, bushing
 
 
 def _noise_of(test: RigTest) -> NoiseEstimate:
@@ -272,7 +279,7 @@ def _settings(base: SearchSettings, screening: int | None, starts: int | None) -
         base = replace(base, stages=stages)
     if screening is not None:
         base = replace(base, screening=screening)
-    return SearchSettings(base.screening, base.stages)   # validates
+    return SearchSettings(base.screening, base.stages, base.global_search)   # validates
 
 
 def _exact_jacobian_or_why_not(tests, space: SearchSpace, progress: bool) -> tuple[str, str | None]:
@@ -310,111 +317,189 @@ def _exact_jacobian_or_why_not(tests, space: SearchSpace, progress: bool) -> tup
     return "exact", None
 
 
-def _search(tests, noise, model, preset, settings, seed, engine, progress, started, table=None,
-            sample_ensemble=True, jacobian_kind="exact", multi: MultiAxisTraining | None = None) -> FitResult:
-    multi = multi or MultiAxisTraining([], [], "none")
-    measurements = [t.measurement for t in tests] + multi.components()
-    space = SearchSpace.from_measurements(measurements, model, steps=[t.kind == "step" for t in tests]
-                                          + [False] * (len(measurements) - len(tests)), table=table)
-    # with a table, the screening and the early stages run its coarser loop (kdyn_table)
-    notes = []
-    if jacobian_kind == "exact":
-        jacobian_kind, note = _exact_jacobian_or_why_not(tests, space, progress)
-        if note:
-            notes.append(note)
-    problem = Problem(Objective(tests, noise, model=space.bushing, table=table, search=table is not None,
-                                **multi.objective_arguments()), space, jacobian_kind)
-    ga_evaluations = PAPER_GA["population"] * PAPER_GA["generations"]
-    loop = slow_loop_start(tests, space) if preset != "paper" else None
-    if loop is None and preset != "paper":
-        loop = table_start(table, space)
-        if isinstance(loop, str):           # the table gives no start, and why
-            notes.append(loop)
-            loop = None
-    if loop is not None:
-        notes.append(f"note: {LOOP_STARTS} of the screened starts take the {loop.describe()}")
-    bars = SearchProgress(progress, settings, ga_evaluations if preset == "paper" else
-                          settings.screening + (LOOP_STARTS if loop else 0))
-    if preset == "paper":
-        from identification.fitting.multistart import genetic_algorithm
-        theta, misfits = genetic_algorithm(problem, engine, seed, bars.screening, **PAPER_GA)
-    else:
-        theta, misfits = screen(problem, engine, settings.screening, seed, bars.screening,
-                                anchored=loop and anchored_coordinates(loop, space), anchored_count=LOOP_STARTS)
-    evaluations = ga_evaluations if preset == "paper" else len(misfits)
-    n, d = problem.objective.size, len(space.names)
-    *early, last = settings.stages
-    records = run_stages(problem, engine, first_records(theta, misfits, settings.stages[0][0]), early, bars.stage)
-    # The forward model's steps per sample, checked where the result is decided: at the best
-    # start before the last stage, and at the best fit; if that changes them, the last stage
-    # runs once more, and a third check only reports (identification.fitting.refinement). A lone best
-    # start gets company before the check at the best fit (_extend_if_alone).
-    refinement = _check_steps(problem, tests, records, n, d)
-    problem = Problem(refinement.objective.with_fit_loop(tests), space, jacobian_kind)
-    records = run_stages(problem, engine, records, [last], bars.stage, first_stage=len(early))
-    records, added, agreeing = _extend_if_alone(problem, engine, records, last, len(early), n, d, bars)
-    final_count = last[0] + added
-    if added:
-        notes.append(f"note: only {agreeing} of the {last[0]} final starts reached the best misfit, so {added} more "
-                     f"start{'s' if added > 1 else ''} of the earlier stages also ran the last stage")
-    refinement_at_best = _check_steps(problem, tests, records, n, d)
-    evaluations += refinement.evaluations + refinement_at_best.evaluations
-    if refinement_at_best.changed:
-        problem = Problem(refinement_at_best.objective, space, jacobian_kind)
-        records = run_stages(problem, engine, records, [(final_count, last[1])],
-                             lambda s, k: bars.stage(s, k, again=True, total=final_count), first_stage=len(early))
-        final_check = _check_steps(problem, tests, records, n, d)
-        evaluations += final_check.evaluations
-        if final_check.changed:
-            notes.append(f"note: at the best fit the forward model would need "
-                         f"{'/'.join(map(str, final_check.objective.steps_per_sample))} steps per sample (it ran "
-                         f"{'/'.join(map(str, problem.objective.steps_per_sample))}); its own error may take more "
-                         "than a tenth of the confidence region")
-    bars.close()
-    evaluations += sum(r.evaluations - 1 for r in records)
+@dataclass(frozen=True)
+class SearchRequest:
+    """What one search fits: the training (one-axis tests with their noise, a table, multi-axis
+    tests), the model, the preset's settings and name, the seed, the Jacobian wanted, and whether
+    the ensemble is sampled."""
+    tests: list
+    noise: list
+    model: BushingModel
+    preset: str
+    settings: SearchSettings
+    seed: int
+    table: KdynTable | None = None
+    multi: MultiAxisTraining = MultiAxisTraining([], [], "none")
+    jacobian_kind: str = "exact"
+    sample_ensemble: bool = True
 
-    # scored by the objective used from here on; a failed start is skipped (failed_starts)
-    final = [r for r in records if r.stage == len(early) and not r.failed]
-    best = _best_record(final or records)
-    failed = failed_starts(records)
-    if not final:
-        notes.append(f"note: every start of the last stage failed (residuals or Jacobian not finite); the result is "
-                     f"the best finite point the search found (stage {best.stage + 1 if best.stage >= 0 else 0})")
-    threshold = misfit_threshold(best.misfit, n, d)
-    scaled_jacobian = _identifiability_jacobian(problem, best.theta, notes)
-    ident = identifiability(scaled_jacobian * np.sqrt(n), space.names, threshold * n)
-    evaluations += simulations_per_jacobian(problem, d, known=False)
-    limit = best.misfit + threshold
-    sampler = None
-    members = [best.theta]
-    if sample_ensemble:
+
+def _search(request: SearchRequest, engine, progress: bool, started: float) -> FitResult:
+    """The search of a nonlinear model's parameters (``fit``), on ``engine``, timed from ``started``."""
+    return _Search(request, engine, progress, started).run()
+
+
+class _Search:
+    """One search, step by step: the box and the objective, the global phase, the least-squares
+    stages with the forward model's steps checked, the ensemble, the result. Each step reads what
+    the ones before it left here; ``notes`` and ``evaluations`` (simulations run) add up."""
+
+    def __init__(self, request: SearchRequest, engine, progress: bool, started: float):
+        self.request, self.engine, self.progress, self.started = request, engine, progress, started
+        self.notes: list[str] = []
+        self.evaluations = 0
+
+    def run(self) -> FitResult:
+        self.problem = self._problem()
+        theta, misfits = self._global_phase()
+        records, added, agreeing = self._stages(theta, misfits)
+        # scored by the objective used from here on; a failed start is skipped (failed_starts)
+        final = [r for r in records if r.stage == len(self.request.settings.stages) - 1 and not r.failed]
+        best = _best_record(final or records)
+        if not final:
+            self.notes.append(f"note: every start of the last stage failed (residuals or Jacobian not finite); the "
+                              f"result is the best finite point the search found (stage "
+                              f"{best.stage + 1 if best.stage >= 0 else 0})")
+        return self._result(records, final, best, added, agreeing)
+
+    def _problem(self) -> Problem:
+        """The box scaled by the data and the objective; the exact Jacobian where it pays."""
+        request = self.request
+        multi = request.multi
+        measurements = [t.measurement for t in request.tests] + multi.components()
+        self.space = SearchSpace.from_measurements(measurements, request.model,
+                                                   steps=[t.kind == "step" for t in request.tests]
+                                                   + [False] * (len(measurements) - len(request.tests)),
+                                                   table=request.table)
+        # with a table, the screening and the early stages run its coarser loop (kdyn_table)
+        self.jacobian_kind = request.jacobian_kind
+        if self.jacobian_kind == "exact":
+            self.jacobian_kind, note = _exact_jacobian_or_why_not(request.tests, self.space, self.progress)
+            if note:
+                self.notes.append(note)
+        objective = Objective(request.tests, request.noise, model=self.space.bushing, table=request.table,
+                              search=request.table is not None, **multi.objective_arguments())
+        self.n, self.d = objective.size, len(self.space.names)     # residuals, coordinates
+        return Problem(objective, self.space, self.jacobian_kind)
+
+    def _data_start(self):
+        """A start read off the data (a slow loop, else a table), or None; a table that gives
+        none says why in a note. The paper's GA takes none."""
+        request = self.request
+        if request.settings.genetic:
+            return None
+        loop = slow_loop_start(request.tests, self.space)
+        if loop is None:
+            loop = table_start(request.table, self.space)
+            if isinstance(loop, str):           # the table gives no start, and why
+                self.notes.append(loop)
+                loop = None
+        if loop is not None:
+            self.notes.append(f"note: {LOOP_STARTS} of the screened starts take the {loop.describe()}")
+        return loop
+
+    def _global_phase(self):
+        """The preset's global phase: its points and their misfits, best first."""
+        settings, problem = self.request.settings, self.problem
+        loop = self._data_start()
+        self.bars = SearchProgress(self.progress, settings, settings.global_evaluations(
+            settings.screening + (LOOP_STARTS if loop else 0)))
+        if settings.genetic:
+            from identification.fitting.multistart import genetic_algorithm
+            theta, misfits = genetic_algorithm(problem, self.engine, self.request.seed, self.bars.screening,
+                                               **PAPER_GA)
+        else:
+            theta, misfits = screen(problem, self.engine, settings.screening, self.request.seed, self.bars.screening,
+                                    anchored=loop and anchored_coordinates(loop, self.space),
+                                    anchored_count=LOOP_STARTS)
+        self.evaluations += settings.global_evaluations(len(misfits))
+        return theta, misfits
+
+    def _stages(self, theta, misfits):
+        """The least-squares stages from the global phase's best points: (records, starts added to
+        the last stage, starts that agreed before). The forward model's steps per sample are
+        checked where the result is decided: at the best start before the last stage, and at the
+        best fit; if that changes them, the last stage runs once more, and a third check only
+        reports (identification.fitting.refinement). A lone best start gets company before the
+        check at the best fit (_extend_if_alone)."""
+        tests, space, engine, bars = self.request.tests, self.space, self.engine, self.bars
+        *early, last = self.request.settings.stages
+        n, d = self.n, self.d
+        records = run_stages(self.problem, engine, first_records(theta, misfits, self.request.settings.stages[0][0]),
+                             early, bars.stage)
+        refinement = _check_steps(self.problem, tests, records, n, d)
+        problem = Problem(refinement.objective.with_fit_loop(tests), space, self.jacobian_kind)
+        records = run_stages(problem, engine, records, [last], bars.stage, first_stage=len(early))
+        records, added, agreeing = _extend_if_alone(problem, engine, records, last, len(early), n, d, bars)
+        final_count = last[0] + added
+        if added:
+            self.notes.append(f"note: only {agreeing} of the {last[0]} final starts reached the best misfit, so {added} "
+                              f"more start{'s' if added > 1 else ''} of the earlier stages also ran the last stage")
+        refinement_at_best = _check_steps(problem, tests, records, n, d)
+        self.evaluations += refinement.evaluations + refinement_at_best.evaluations
+        if refinement_at_best.changed:
+            problem = Problem(refinement_at_best.objective, space, self.jacobian_kind)
+            records = run_stages(problem, engine, records, [(final_count, last[1])],
+                                 lambda s, k: bars.stage(s, k, again=True, total=final_count), first_stage=len(early))
+            final_check = _check_steps(problem, tests, records, n, d)
+            self.evaluations += final_check.evaluations
+            if final_check.changed:
+                self.notes.append(f"note: at the best fit the forward model would need "
+                                  f"{'/'.join(map(str, final_check.objective.steps_per_sample))} steps per sample (it "
+                                  f"ran {'/'.join(map(str, problem.objective.steps_per_sample))}); its own error may "
+                                  "take more than a tenth of the confidence region")
+        bars.close()
+        self.evaluations += sum(r.evaluations - 1 for r in records)
+        self.problem = problem
+        return records, added, agreeing
+
+    def _ensemble(self, best: StartRecord, final: list[StartRecord], ident, threshold: float):
+        """The ensemble's members (coordinates, the best first), the posterior's sampler (or None)
+        and the failed profile tasks: every set within the confidence threshold the profiles, the
+        posterior and the final starts found; the best alone where the ensemble is not sampled."""
+        problem, space = self.problem, self.space
+        n, d = self.n, self.d
+        if not self.request.sample_ensemble:
+            return [best.theta], None, 0
+        limit = best.misfit + threshold
         extremes, extreme_misfits, failed_profiles = profile_extremes(problem, best.theta, best.misfit, ident, limit,
-                                                                      engine)
-        failed += failed_profiles
+                                                                      self.engine)
         # here, not on a worker: the compiled kernel runs the walkers on every core of this process
-        draws, _, sampler = posterior_samples(problem, best.theta, seed, threshold_scale(best.misfit, n, d))
+        draws, _, sampler = posterior_samples(problem, best.theta, self.request.seed,
+                                              threshold_scale(best.misfit, n, d))
         pushed, pushed_misfits = push_to_boundary(problem, best.theta, draws, limit)
         per_jacobian = simulations_per_jacobian(problem, d, known=False)
-        evaluations += WALKERS * STEPS + len(draws) * len(PUSH) \
+        self.evaluations += WALKERS * STEPS + len(draws) * len(PUSH) \
             + len(PROBES) * 2 * per_jacobian * (1 + PROFILE_ROUNDS * PROFILE_EVALUATIONS)
         members = select_members(best.theta, [(r.theta, r.misfit) for r in final],
                                  np.vstack([extremes, pushed]), np.concatenate([extreme_misfits, pushed_misfits]),
                                  limit, space.bounds())
-    rows = space.to_model_parameters(np.array(members))
-    names = space.bushing.parameter_names
-    ensemble = [dict(zip(names, map(float, row))) for row in rows]
-    parameters = ParameterSet(space.bushing, ensemble[0])
-    steps = problem.objective.steps_per_sample
-    fits = _test_fits(tests, noise, parameters, steps) + multi.fits(parameters)
-    steps = steps + [m.driven.steps_per_sample for m in problem.objective.multiaxis]
-    result = FitResult(parameters, float(best.misfit), fits, records, threshold,
-                       ensemble, ident, preset, seed, evaluations, time.perf_counter() - started, engine.description,
-                       space, final_starts=len(final), sampler=sampler, notes=notes, steps_per_sample=steps,
-                       table=table_fit(table, parameters), added_starts=added, agreed_before_added=agreeing,
-                       ensemble_sampled=sample_ensemble, residuals=n, failed_starts=failed,
-                       coupling=multi.coupling if multi.measurements else None)
-    result.parameters.provenance = result.provenance()
-    return result
+        return members, sampler, failed_profiles
+
+    def _result(self, records, final, best: StartRecord, added: int, agreeing: int) -> FitResult:
+        request, problem, space = self.request, self.problem, self.space
+        n, d = self.n, self.d
+        threshold = misfit_threshold(best.misfit, n, d)
+        scaled_jacobian = _identifiability_jacobian(problem, best.theta, self.notes)
+        ident = identifiability(scaled_jacobian * np.sqrt(n), space.names, threshold * n)
+        self.evaluations += simulations_per_jacobian(problem, d, known=False)
+        members, sampler, failed_profiles = self._ensemble(best, final, ident, threshold)
+        rows = space.to_model_parameters(np.array(members))
+        ensemble = [dict(zip(space.bushing.parameter_names, map(float, row))) for row in rows]
+        parameters = ParameterSet(space.bushing, ensemble[0])
+        steps = problem.objective.steps_per_sample
+        fits = _test_fits(request.tests, request.noise, parameters, steps) + request.multi.fits(parameters)
+        steps = steps + [m.driven.steps_per_sample for m in problem.objective.multiaxis]
+        result = FitResult(parameters, float(best.misfit), fits, records, threshold,
+                           ensemble, ident, request.preset, request.seed, self.evaluations,
+                           time.perf_counter() - self.started, self.engine.description, space,
+                           final_starts=len(final), sampler=sampler, notes=self.notes, steps_per_sample=steps,
+                           table=table_fit(request.table, parameters), added_starts=added,
+                           agreed_before_added=agreeing, ensemble_sampled=request.sample_ensemble, residuals=n,
+                           failed_starts=failed_starts(records) + failed_profiles,
+                           coupling=request.multi.coupling if request.multi.measurements else None)
+        result.parameters.provenance = result.provenance()
+        return result
 
 
 def _best_record(records: list[StartRecord]) -> StartRecord:

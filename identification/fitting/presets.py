@@ -11,14 +11,34 @@ PAPER_GA = {"population": 300, "generations": 200, "crossover_probability": 0.8,
 """The paper's genetic algorithm (pymoo: uniform crossover, polynomial mutation per coordinate)."""
 
 
+SOBOL = "sobol"
+GENETIC = "genetic"
+GLOBAL_SEARCHES = (SOBOL, GENETIC)
+"""A fit's global phase: scrambled Sobol points screened (``multistart.screen``), or the paper's GA
+(``multistart.genetic_algorithm``, ``PAPER_GA``), whose final population ranks the starts."""
+
+
 @dataclass(frozen=True)
 class SearchSettings:
-    """How much search a fit runs: ``screening`` global points (Sobol, or the GA's population),
-    then ``stages`` of (starts, largest number of least-squares evaluations of each)."""
+    """How much search a fit runs, and how: ``screening`` global points (Sobol points, or the GA's
+    population) found by ``global_search`` (``GLOBAL_SEARCHES``), then ``stages`` of (starts,
+    largest number of least-squares evaluations of each)."""
     screening: int
     stages: tuple[tuple[int, int], ...]
+    global_search: str = SOBOL
+
+    @property
+    def genetic(self) -> bool:
+        """Whether the global phase is the paper's GA (no starts read off the data then)."""
+        return self.global_search == GENETIC
+
+    def global_evaluations(self, screened: int) -> int:
+        """The simulations the global phase ran, ``screened`` points kept."""
+        return PAPER_GA["population"] * PAPER_GA["generations"] if self.genetic else screened
 
     def __post_init__(self):
+        if self.global_search not in GLOBAL_SEARCHES:
+            raise ValueError(f"global search {self.global_search!r}: choose one of {', '.join(GLOBAL_SEARCHES)}")
         if self.screening < 1:
             raise ValueError(f"screening = {self.screening} points: give 1 or more")
         if not self.stages:
@@ -35,13 +55,13 @@ _STAGES = ((128, 10), (24, 30), (6, 300))
 PRESETS = {
     "default": SearchSettings(screening=8192, stages=_STAGES),
     # the paper's GA as the global stage (its final population ranks the starts)
-    "paper": SearchSettings(screening=PAPER_GA["population"], stages=_STAGES),
+    "paper": SearchSettings(screening=PAPER_GA["population"], stages=_STAGES, global_search=GENETIC),
 }
 
 
 def global_phase(preset: str) -> str:
     """What the preset's global phase is, in words."""
-    if preset == "paper":
+    if PRESETS[preset].genetic:
         return (f"the paper's GA (pymoo, population {PAPER_GA['population']}, "
                 f"{PAPER_GA['generations']} generations)")
     return f"{PRESETS[preset].screening} scrambled Sobol points"

@@ -220,13 +220,6 @@ class SearchSpace:
             p = _rescale_block(p, weight[len("alpha"):], p[weight])
         return np.array([c.kind.to_coordinate(c, p[c.parameter], p, self) for c in self.coordinates])
 
-    def coordinate_of(self, c: SearchCoordinate, value: float) -> float:
-        """The coordinate ``c`` of a parameter value, for a kind that reads no other parameter;
-        a scale of 0 is -inf."""
-        if c.kind.reads(c):
-            raise ValueError(f"the {c.kind.name} coordinate of {c.parameter} depends on other parameters")
-        return c.kind.to_coordinate(c, value, {}, self)
-
     def inside(self, coordinates: np.ndarray) -> np.ndarray:
         """Whether each row of coordinates lies in the box."""
         theta = np.atleast_2d(coordinates)
