@@ -30,7 +30,8 @@ from xml.etree import ElementTree as ET
 
 from .fmi.axes import ONE_AXIS, SIX_AXES, SIX_AXIS_IDENTIFIER, SIX_AXIS_NAMES, Coupling, model_on_axis
 from .model.registry import BushingModel, DEFAULT_MODEL, MODELS, get_model
-from .model.parameter_specs import UNIT_DEFINITIONS, UNIT_SYSTEM, ParameterError
+from .model.parameter_specs import UNIT_SYSTEM, ParameterError
+from .model.units import si_form
 
 SSV_NAMESPACES = {"ssv": "http://ssp-standard.org/SSP1/SystemStructureParameterValues",
                   "ssc": "http://ssp-standard.org/SSP1/SystemStructureCommon"}
@@ -290,7 +291,7 @@ def _write_ssv(path: Path, params: Mapping[str, float], model: BushingModel) -> 
 
 def write_ssv_values(path: Path, set_name: str, values: Mapping[str, float], units: Mapping[str, str]) -> None:
     """One ssv:ParameterSet of ``values`` (names in order) with their ``units`` (a unit that
-    ``UNIT_DEFINITIONS`` cannot express in SI base units is left out, never written wrong)."""
+    ``units.si_form`` cannot express in SI base units is left out, never written wrong)."""
     ssv, ssc = SSV_NAMESPACES["ssv"], SSV_NAMESPACES["ssc"]
     ET.register_namespace("ssv", ssv)
     ET.register_namespace("ssc", ssc)
@@ -298,7 +299,7 @@ def write_ssv_values(path: Path, set_name: str, values: Mapping[str, float], uni
     parameters = ET.SubElement(root, f"{{{ssv}}}Parameters")
     # SSP requires a BaseUnit for every unit, which N^(1-n)/mm (beta, gamma) cannot have:
     # those values go without a unit attribute rather than with a false one.
-    expressible = {name: unit for name, unit in units.items() if UNIT_DEFINITIONS.get(unit) is not None}
+    expressible = {name: unit for name, unit in units.items() if si_form(unit) is not None}
     for name, value in values.items():
         element = ET.SubElement(parameters, f"{{{ssv}}}Parameter", name=name)
         real = ET.SubElement(element, f"{{{ssv}}}Real", value=repr(value))
@@ -307,7 +308,7 @@ def write_ssv_values(path: Path, set_name: str, values: Mapping[str, float], uni
     units = ET.SubElement(root, f"{{{ssv}}}Units")
     for unit in sorted(set(expressible.values())):
         element = ET.SubElement(units, f"{{{ssc}}}Unit", name=unit)
-        ET.SubElement(element, f"{{{ssc}}}BaseUnit", UNIT_DEFINITIONS[unit])
+        ET.SubElement(element, f"{{{ssc}}}BaseUnit", si_form(unit))
     ET.indent(root)
     ET.ElementTree(root).write(path, encoding="UTF-8", xml_declaration=True)
 

@@ -25,6 +25,7 @@ from dataclasses import dataclass, replace
 
 from ..model.parameter_specs import ParameterError
 from ..model.definition import BushingModel
+from ..model.units import rotational
 
 SMALL_ANGLE_RAD = 0.35
 """Above this rotation the small-angle bushing is an approximation worth a warning."""
@@ -33,15 +34,6 @@ PLAUSIBLE_TRAVEL_M = 0.1
 where metres are expected. Warned about, not refused."""
 PLAUSIBLE_ANGULAR_VELOCITY_RAD_S = 50.0
 """The rotational counterpart of definition.PLAUSIBLE_VELOCITY_MM_S (for the force bound)."""
-
-ROTATIONAL_UNITS = {
-    "N/mm": "N.mm/rad", "N.s/mm": "N.mm.s/rad", "mm": "rad", "N": "N.mm", "1": "1",
-    "N^(1-n)/mm": "(N.mm)^(1-n)/rad", "N^(1-n1)/mm": "(N.mm)^(1-n1)/rad", "N^(1-n2)/mm": "(N.mm)^(1-n2)/rad",
-    "N/mm^3": "N.mm/rad^3", "N.s^alpha/mm": "N.mm.s^alpha/rad",
-    "N.s^2/mm": "N.mm.s^2/rad", "N.s^2/mm^2": "N.mm.s^2/rad^2",
-}
-"""A translational parameter's unit -> the same parameter's unit on a rotational axis."""
-
 
 @dataclass(frozen=True)
 class Axis:
@@ -192,7 +184,7 @@ def model_on_axis(model: BushingModel, axis: Axis) -> BushingModel:
     """``model`` with the parameter units of ``axis`` (the same kernels and checks)."""
     if not axis.rotational:
         return model
-    specs = tuple(replace(spec, unit=ROTATIONAL_UNITS[spec.unit]) for spec in model.specs)
+    specs = tuple(replace(spec, unit=rotational(spec.unit)) for spec in model.specs)
     return replace(model, specs=specs, title=f"{model.title}, rotational", rotational=True)
 
 

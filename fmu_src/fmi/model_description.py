@@ -18,7 +18,7 @@ from xml.etree import ElementTree as ET
 from dataclasses import dataclass, field
 
 from .. import __version__
-from ..model.parameter_specs import UNIT_DEFINITIONS
+from ..model.units import si_form
 from .dependencies import V, X, axis_dependencies, group_dependencies
 from .variables import FmuVariable, all_variables, exact_text, fmu_description, fmu_variables, nominal
 
@@ -61,7 +61,7 @@ def _units(root: ET.Element, variables: list[FmuVariable], position: int) -> Non
     definitions = ET.Element("UnitDefinitions")
     for unit in sorted({v.unit for v in variables if v.unit}):
         element = ET.SubElement(definitions, "Unit", name=unit)
-        base = UNIT_DEFINITIONS[unit]
+        base = si_form(unit)
         if base is not None:
             ET.SubElement(element, "BaseUnit", base)
     root.insert(position, definitions)

@@ -2,8 +2,9 @@
 
 - ``definition``: ``BushingModel`` and its parts (states, search box, coupled kernels, slow loop,
   track start), checked when a model is defined;
-- ``parameter_specs``: a parameter's spec (name, unit, meaning, range), constraints, unit
-  definitions and validation;
+- ``parameter_specs``: a parameter's spec (name, unit, meaning, range), constraints and
+  validation;
+- ``units``: a unit's SI form and its form on a rotational axis, read from its name;
 - ``search_coordinates``: the fit's coordinate kinds (map, inverse, bounds);
 - ``integration``: the shared integration machinery (the Bouc-Wen block, friction, Maxwell
   elements, vector algebra) and the step protocol, written in the kernel language;

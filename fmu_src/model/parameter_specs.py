@@ -16,6 +16,8 @@ import math
 from dataclasses import dataclass
 from typing import Mapping
 
+from .units import UnitError, si_form
+
 UNIT_SYSTEM = "N-mm-s"
 
 
@@ -35,6 +37,12 @@ class ParameterSpec:
     why: str = ""
     maximum: float | None = None
     bound_powers: tuple[int, int] | None = None
+
+    def __post_init__(self):
+        try:
+            si_form(self.unit)
+        except UnitError as exc:
+            raise UnitError(f"parameter {self.name}: {exc}") from None
 
     @property
     def allowed(self) -> str:
@@ -104,57 +112,6 @@ DAMPING = dict(minimum=0.0, why="a negative dashpot adds energy")
 WEIGHT = dict(minimum=0.0, why="a negative weight turns the hysteresis loop inside out")
 GAIN = dict(minimum=0.0, why="a negative initial stiffness of the hysteresis is unstable")
 EXPONENT = dict(minimum=0.0, exclusive=True, why="exponent of |z|")
-
-
-UNIT_DEFINITIONS: dict[str, dict[str, str] | None] = {
-    # name -> SI base-unit exponents and factor (value_SI = factor * value), as FMI and SSP
-    # write them; None: no SI form.
-    "m": {"m": "1"},
-    "s": {"s": "1"},
-    "m/s": {"m": "1", "s": "-1"},
-    "N": {"kg": "1", "m": "1", "s": "-2"},
-    "N/mm": {"kg": "1", "s": "-2", "factor": "1000"},
-    "N.s/mm": {"kg": "1", "s": "-1", "factor": "1000"},
-    "1": {},
-    # beta*|z|^n must be in N/mm, so beta and gamma carry N^(1-n)/mm: a non-integer power
-    # that a BaseUnit cannot express. Declared by name only.
-    "N^(1-n1)/mm": None,
-    "N^(1-n2)/mm": None,
-    # the baseline models (registry)
-    "mm": {"m": "1", "factor": "0.001"},
-    "N^(1-n)/mm": None,
-    # the filled-rubber models (berg_model, fractional_model): a cubic spring, and the
-    # fractional element's coefficient, whose unit has the non-integer power s^alpha
-    "N/mm^3": {"kg": "1", "m": "-2", "s": "-2", "factor": "1000000000"},
-    "N.s^alpha/mm": None,
-    # ports and parameters of the rotational axes (fmu_src/fmi/axes.py)
-    "rad": {"rad": "1"},
-    "rad/s": {"rad": "1", "s": "-1"},
-    "N.m": {"kg": "1", "m": "2", "s": "-2"},
-    "N.mm": {"kg": "1", "m": "2", "s": "-2", "factor": "0.001"},
-    "N.mm/rad": {"kg": "1", "m": "2", "s": "-2", "rad": "-1", "factor": "0.001"},
-    "N.mm.s/rad": {"kg": "1", "m": "2", "s": "-1", "rad": "-1", "factor": "0.001"},
-    # rates of the states (the native FMU's model exchange)
-    "N/s": {"kg": "1", "m": "1", "s": "-3"},
-    "1/s": {"s": "-1"},
-    "N.m/s": {"kg": "1", "m": "2", "s": "-3"},
-    # event indicators of coupled groups: d.v of a friction's travel and velocity
-    "m2/s": {"m": "2", "s": "-1"},
-    "rad2/s": {"rad": "2", "s": "-1"},
-    "N.mm/rad^3": {"kg": "1", "m": "2", "s": "-2", "rad": "-3", "factor": "0.001"},
-    "N.mm.s^alpha/rad": None,
-    "(N.mm)^(1-n)/rad": None,
-    "(N.mm)^(1-n1)/rad": None,
-    "(N.mm)^(1-n2)/rad": None,
-    # the hydraulic mount (hydraulic_model): the fluid column's effective mass and turbulent
-    # damping, and the rate of its velocity state
-    "N.s^2/mm": {"kg": "1", "factor": "1000"},
-    "N.s^2/mm^2": {"kg": "1", "m": "-1", "factor": "1000000"},
-    "m/s/s": {"m": "1", "s": "-2"},
-    "N.mm.s^2/rad": {"kg": "1", "m": "2", "rad": "-1", "factor": "0.001"},
-    "N.mm.s^2/rad^2": {"kg": "1", "m": "2", "rad": "-2", "factor": "0.001"},
-    "rad/s/s": {"rad": "1", "s": "-2"},
-}
 
 
 class ParameterError(ValueError):
