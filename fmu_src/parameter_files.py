@@ -31,7 +31,7 @@ from xml.etree import ElementTree as ET
 from .fmi.axes import ONE_AXIS, SIX_AXES, SIX_AXIS_IDENTIFIER, SIX_AXIS_NAMES, Coupling, model_on_axis
 from .model.registry import BushingModel, DEFAULT_MODEL, MODELS, get_model
 from .model.parameter_specs import UNIT_SYSTEM, ParameterError
-from .model.units import si_form
+from .model.units import UnitError, si_form
 
 SSV_NAMESPACES = {"ssv": "http://ssp-standard.org/SSP1/SystemStructureParameterValues",
                   "ssc": "http://ssp-standard.org/SSP1/SystemStructureCommon"}
@@ -289,9 +289,17 @@ def _write_ssv(path: Path, params: Mapping[str, float], model: BushingModel) -> 
     write_ssv_values(path, model.identifier, model.check(params), model.fmu_units)
 
 
+def _si_form_if_any(unit: str) -> dict[str, str] | None:
+    try:
+        return si_form(unit)
+    except UnitError:
+        return None
+
+
 def write_ssv_values(path: Path, set_name: str, values: Mapping[str, float], units: Mapping[str, str]) -> None:
     """One ssv:ParameterSet of ``values`` (names in order) with their ``units`` (a unit that
-    ``units.si_form`` cannot express in SI base units is left out, never written wrong)."""
+    ``units.si_form`` cannot express in SI base units, or cannot read, such as another FMU's
+    ``degC``, is left out, never written wrong)."""
     ssv, ssc = SSV_NAMESPACES["ssv"], SSV_NAMESPACES["ssc"]
     ET.register_namespace("ssv", ssv)
     ET.register_namespace("ssc", ssc)
@@ -299,7 +307,7 @@ def write_ssv_values(path: Path, set_name: str, values: Mapping[str, float], uni
     parameters = ET.SubElement(root, f"{{{ssv}}}Parameters")
     # SSP requires a BaseUnit for every unit, which N^(1-n)/mm (beta, gamma) cannot have:
     # those values go without a unit attribute rather than with a false one.
-    expressible = {name: unit for name, unit in units.items() if si_form(unit) is not None}
+    expressible = {name: unit for name, unit in units.items() if _si_form_if_any(unit) is not None}
     for name, value in values.items():
         element = ET.SubElement(parameters, f"{{{ssv}}}Parameter", name=name)
         real = ET.SubElement(element, f"{{{ssv}}}Real", value=repr(value))

@@ -57,6 +57,11 @@ def test_every_models_units_are_read_on_both_kinds_of_axis():
             si_form(spec.unit), si_form(rotational(spec.unit))
 
 
+def test_a_frequency_and_the_example_bodys_units_are_read():
+    assert si_form("Hz") == {"s": "-1"} and si_form("kg.m2") == {"kg": "1", "m": "2"}
+    assert si_form("N.m.s") == {"kg": "1", "m": "2", "s": "-1"}
+
+
 @pytest.mark.parametrize("unit", ["N/inch", "N/mm.s", "N^2.5", "kN", ""])
 def test_a_unit_it_cannot_read_is_refused_with_the_parameter_named(unit):
     with pytest.raises(UnitError, match=r"^parameter k: unit .* is not one of|^parameter k: unit .*write a product"):
