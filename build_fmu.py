@@ -5,7 +5,7 @@ win64, with its default set; the sets as ``.ssv``, README.txt, SHA256SUMS), whic
 compiler applies a parameter set to as start values.
 
 Writes ``DIR/<identifier>.fmu`` (FMI 2.0 co-simulation, pythonfmu; with ``--native``: compiled C,
-FMI 2.0 or 3.0, co-simulation and model exchange, see ``fmu_src/native``) of the model NAME
+FMI 2.0 or 3.0, co-simulation and model exchange, see ``fmu_src/fmi/native``) of the model NAME
 (``proposed``, the default: ``BoucWenBushing.fmu``; ``spencer``: ``SpencerBushing``;
 ``single_bouc_wen``: ``SingleBoucWenBushing``; ``berg``: ``BergBushing``; ``fractional``:
 ``FractionalBushing``; ``kelvin_voigt``: ``KelvinVoigtBushing``; every model of
@@ -77,8 +77,9 @@ SIX_AXIS_DEFAULT_FILE = "params_six_axis_illustrative.json"
 
 
 SOURCE_DIR = Path(fmu_src.__file__).resolve().parent
-NOT_PACKED = ("fmi/native/",)
-"""What the pythonfmu FMU leaves out of fmu_src: the native FMU's generator (C, compilers)."""
+NOT_PACKED = ("fmi/native/", "fmi/model_description.py", "fmi/dependencies.py", "kernels/python_to_c.py")
+"""What the pythonfmu FMU leaves out of fmu_src: what builds an FMU and never runs inside one (the
+native FMU's generator, the C translator, the model description and its dependencies)."""
 LIBRARY_MODULES = tuple(sorted(path.relative_to(SOURCE_DIR).as_posix() for path in SOURCE_DIR.rglob("*.py")
                                if path.relative_to(SOURCE_DIR).as_posix() not in ("__init__.py", SLAVE_MODULE)
                                and not path.relative_to(SOURCE_DIR).as_posix().startswith(NOT_PACKED)))

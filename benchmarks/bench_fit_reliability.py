@@ -166,11 +166,11 @@ def _problem(tests):
 
 
 def _finish(problem, theta, tests):
-    from identification.fitting.fit import _test_fits
+    from identification.fitting.search import test_fits
     from fmu_src.parameter_files import ParameterSet
     from identification.measured.noise import estimate_noise
     params = dict(zip(PARAMETER_NAMES, map(float, problem.space.to_parameters(theta)[0])))
-    fits = _test_fits(tests, [estimate_noise(t.measurement.force_N) for t in tests],
+    fits = test_fits(tests, [estimate_noise(t.measurement.force_N) for t in tests],
                       ParameterSet(problem.space.bushing, params))
     return [params], all(f.at_floor for f in fits), [f.nrmse for f in fits], ""
 

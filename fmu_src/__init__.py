@@ -1,6 +1,7 @@
 """The bushing models and their FMI face (see README.md).
 
-The subpackages, each only importing those listed before it:
+The subpackages, each only importing those listed before it (but ``model.registry``, which finds
+the modules of ``models`` by name):
 
 - ``model``: the model contract (``definition``: what a model module gives; ``parameter_specs``:
   parameter specs, constraints and units; ``search_coordinates``: the fit's coordinate kinds;

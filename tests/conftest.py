@@ -59,7 +59,7 @@ def paper_force(p, time_s, displacement, velocity, rtol=1e-8, atol=1e-8):
 def _paper_test_force(parameters: tuple, kind: str, duration_s: float, amplitude_mm: float, frequency_hz: float,
                       rise_time_s: float) -> np.ndarray:
     p = dict(parameters)
-    time_s = np.arange(round(duration_s * 1000.0) + 1) / 1000.0   # both ends, as protocols.sample_times
+    time_s = np.arange(round(duration_s * 1000.0) + 1) / 1000.0   # both ends, as signals.sample_times
     if kind == "sine":
         omega = 2.0 * np.pi * frequency_hz
         return paper_force(p, time_s, lambda t: amplitude_mm * np.sin(omega * t),

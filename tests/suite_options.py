@@ -71,16 +71,16 @@ def rounding_variant(config):
 
             patch.setattr(RigTest, "__post_init__", perturbed)
         if offset:
-            from identification.fitting import fit as fitting
-            search = fitting._search
+            from identification.fitting import search
+            run = search.run
 
             def offset_seed(*args, **kwargs):
-                bound = inspect.signature(search).bind(*args, **kwargs)
+                bound = inspect.signature(run).bind(*args, **kwargs)
                 request = bound.arguments["request"]
                 bound.arguments["request"] = dataclasses.replace(request, seed=request.seed + offset)
-                return search(*bound.args, **bound.kwargs)
+                return run(*bound.args, **bound.kwargs)
 
-            patch.setattr(fitting, "_search", offset_seed)
+            patch.setattr(search, "run", offset_seed)
         yield
 
 

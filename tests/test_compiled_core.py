@@ -144,7 +144,7 @@ def test_a_changed_model_source_compiles_afresh_instead_of_loading_stale_machine
     original, _, misses = probe()
     assert misses == 1
     assert probe() == (original, 1, 0)                   # unchanged: the machine code is loaded
-    model = tmp_path / "code" / "fmu_src" / "spencer_model.py"
+    model = tmp_path / "code" / "fmu_src" / "models" / "spencer_model.py"
     text = model.read_text()
     law = "return c1 * ((alpha * z + c0 * v + k0 * (x - y)) / C) + k1 * (x - x0)"
     assert text.count(law) == 1

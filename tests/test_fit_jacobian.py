@@ -287,7 +287,7 @@ def test_the_fit_takes_differences_where_the_exact_jacobian_would_not_pay(table2
     """A fit to a dynamic-stiffness table alone (its rows are differences either way), and a cache
     folder that cannot be written (every process would compile the module again): forward
     differences, the second with a note that names the folder and the way out."""
-    from identification.fitting import fit as fitting
+    from identification.fitting import search as fitting
     space = table2_problem.space
     assert fitting._exact_jacobian_or_why_not([], space, False) == ("difference", None)
     blocked = tmp_path / "file_not_folder"

@@ -298,8 +298,10 @@ def test_paper_ga_preset_runs_the_ga_then_the_least_squares_stages(monkeypatch):
     # agreed (the lone-start extension); which happens depends on the processor's rounding.
     import identification.fitting.fit as fitting
     import identification.fitting.multistart as multistart
-    monkeypatch.setitem(fitting.PAPER_GA, "population", 24)
-    monkeypatch.setitem(fitting.PAPER_GA, "generations", 3)
+    import identification.fitting.presets as presets
+    import identification.fitting.search as search
+    monkeypatch.setitem(presets.PAPER_GA, "population", 24)
+    monkeypatch.setitem(presets.PAPER_GA, "generations", 3)
     ga_runs = []
 
     def counted_ga(*args, **kwargs):
@@ -312,7 +314,7 @@ def test_paper_ga_preset_runs_the_ga_then_the_least_squares_stages(monkeypatch):
 
     genetic_algorithm = multistart.genetic_algorithm
     monkeypatch.setattr(multistart, "genetic_algorithm", counted_ga)
-    monkeypatch.setattr(fitting, "screen", no_screening)
+    monkeypatch.setattr(search, "screen", no_screening)
     sine = load_measurement(DATA / "synthetic_table5_sine_2mm_10Hz.csv")
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")

@@ -1,4 +1,4 @@
-"""The search's last resort before a warning: a lone best start gets company (fitting._extend_if_alone).
+"""The search's last resort before a warning: a lone best start gets company (fitting.search._extend_if_alone).
 
 The problem is a one-coordinate double well, solved by the search's own least-squares task:
 residuals (theta^2 - 1, sqrt(1 + (1 + theta)/8)) have local minima near theta = -1 (misfit 1)
@@ -9,7 +9,8 @@ import numpy as np
 
 from identification.fitting.engine import SerialEngine
 from identification.fitting.ensemble import misfit_threshold
-from identification.fitting.fit import MIN_AGREEING, _extend_if_alone
+from identification.fitting.result import MIN_AGREEING
+from identification.fitting.search import _extend_if_alone
 from identification.fitting.multistart import StartRecord
 
 RESIDUALS, COORDINATES = 100, 1      # the n and d the threshold is computed for

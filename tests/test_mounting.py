@@ -1,5 +1,5 @@
 """Every axis mounts its model with an offset and a preload, as MSC Adams' BUSHING does:
-F = model(x - offset) + preload (model_definition.MOUNTING_SPECS), in the pythonfmu and the native
+F = model(x - offset) + preload (definition.MOUNTING_SPECS), in the pythonfmu and the native
 FMUs, one axis and six, and in the identification's simulate and predict. 0 and 0 give the model's forces as
 its kernels compute them, bit for bit."""
 import math

@@ -44,7 +44,7 @@ def run_outside_the_checkout(site: Path, cwd: Path, code: str) -> subprocess.Com
 def test_the_wheel_declares_both_console_scripts(installed_wheel):
     entry_points, = installed_wheel.glob("*.dist-info/entry_points.txt")
     text = entry_points.read_text()
-    assert "bushing-identify = identification.cli.arguments:main" in text
+    assert "bushing-identify = identification.cli:main" in text
     assert "bushing-build-fmu = build_fmu:main" in text
 
 

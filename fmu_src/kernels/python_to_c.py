@@ -3,7 +3,7 @@
 The kernels (``definition``: ``prepare``, ``initial_state``, ``step``, ``force`` ... and
 the shared machinery of ``integration``) are plain float arithmetic on scalars and tuples, which
 numba compiles. This module translates the same source into C, function by function, for the
-native FMU (``fmu_src/native``):
+native FMU (``fmu_src/fmi/native``):
 
 - types are inferred from the arguments a function is called with (as numba does): ``double``,
   ``int`` (counts and status codes; Python's bools too) and tuples of them, which become C structs

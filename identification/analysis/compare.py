@@ -43,7 +43,8 @@ from fmu_src.model.registry import BushingModel, resolve_model
 from identification.fitting.engine import make_engine
 from identification.errors import FitNotConvergedWarning
 from identification.fitting.result import FLOOR_FACTOR, FitResult, TableFit, information_criterion
-from identification.fitting.fit import fit, table_fit
+from identification.fitting.fit import fit
+from identification.fitting.search import table_fit
 from identification.interrupt import writing
 from identification.measured.kdyn_table import KDYN_UNCERTAINTY, LOSS_ANGLE_UNCERTAINTY_DEG, KdynTable
 from identification.measured.measurements import load_measurement, measurement_name

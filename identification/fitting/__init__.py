@@ -1,6 +1,8 @@
 """Fitting: a model's parameters from training tests, and how sure the fit is.
 
-- ``fit``: ``fit``, the whole procedure (the box, the starts, the search, the ensemble);
+- ``fit``: ``fit``, the front door: the training read and checked, a linear model fitted by least
+  squares, any other searched;
+- ``search``: the search, step by step (the box, the starts, the stages, the ensemble, the result);
 - ``result``: ``FitResult``, what a fit returns (its summary, its parameter and ensemble files);
 - ``presets``: how much of each search phase a fit runs, defined once;
 - ``search_space``: the box of dimensionless coordinates the fit searches, scaled by the data;

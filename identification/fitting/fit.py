@@ -17,7 +17,7 @@
    the ensemble: distinct start end points and posterior draws (emcee) pushed to the edge of
    the 95 % confidence region.
 
-The ``paper`` preset replaces the Sobol screening by the paper's genetic algorithm (pymoo:
+The search itself is ``identification.fitting.search``. The ``paper`` preset replaces the Sobol screening by the paper's genetic algorithm (pymoo:
 population 300, 200 generations, uniform crossover 0.8, mutation probability 0.05 per
 coordinate) and keeps the rest. Kelvin-Voigt is fitted by linear least squares (the
 optimum is exact, so only the floor is checked).
@@ -25,45 +25,31 @@ optimum is exact, so only the floor is checked).
 from __future__ import annotations
 
 import contextlib
-import math
-import os
-import sys
-import threading
 import time
 import warnings
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from fmu_src.model.registry import BushingModel, DEFAULT_MODEL, resolve_model
-from fmu_src.kernels.numba_binding import cache_directory
 from fmu_src.parameter_files import ParameterSet
 from identification.forward.population import parameter_matrix
 from identification.fitting.engine import make_engine
-from identification.fitting.ensemble import (PROBES, PROFILE_EVALUATIONS, PROFILE_ROUNDS, PUSH, STEPS, WALKERS,
-                                             identifiability, misfit_threshold, posterior_samples, profile_extremes,
-                                             push_to_boundary, select_members, threshold_scale)
-from identification.errors import CharacterisationWarning, IdentificationError
+from identification.errors import IdentificationError
 from identification.extras import require
-from identification.fitting.result import (FLOOR_FACTOR, MIN_AGREEING, FitNotConvergedWarning, FitResult,  # noqa: F401
-                                           RigTestFit, TableFit, agreeing_starts)
+from identification.fitting.result import FLOOR_FACTOR, MIN_AGREEING, FitNotConvergedWarning, FitResult  # noqa: F401
 from identification.measured.kdyn_table import KdynTable, load_kdyn_table
-from identification.fitting.loop_start import LOOP_STARTS, anchored_coordinates, slow_loop_start
 from identification.measured.measurements import Measurement
-from identification.measured.multiaxis import (COUPLED_AXES, MultiAxisMeasurement, coupled_axes, load_multiaxis,
-                                               vector_nrmse)
-from identification.fitting.multistart import (JACOBIANS, Problem, StartRecord, failed_starts, first_records, jacobian,
-                                               run_stages, screen, simulations_per_jacobian)
+from identification.measured.multiaxis import COUPLED_AXES, MultiAxisMeasurement, coupled_axes, load_multiaxis
+from identification.fitting.multistart import JACOBIANS, jacobian
 from identification.measured.noise import NoiseEstimate, estimate_noise
-from identification.fitting.objectives import Objective, nrmse
-from identification.fitting.presets import PAPER_GA, PRESETS, SearchSettings
-from identification.fitting.progress import SearchProgress
-from identification.fitting.refinement import refine_steps
+from identification.fitting.objectives import Objective
+from identification.fitting.presets import PRESETS, SearchSettings
 from identification.measured.rig_tests import Manifest, RigTest
 from identification.fitting.search_space import SearchSpace
-from identification.forward.simulate import simulate_multiaxis, simulate
-from identification.fitting.table_start import table_start
+from identification.fitting import search
+from identification.fitting.search import MultiAxisTraining, SearchRequest, table_fit, test_fits
 
 MIN_FINAL_STARTS = 3
 """A reduced budget (``starts``) keeps at least this many starts to the end: with two, one
@@ -193,7 +179,7 @@ def fit(measurements, model: str | BushingModel = DEFAULT_MODEL, preset: str = "
             # an engine made here is closed here, and aborted if the search is left by an exception
             # (Ctrl-C, SIGTERM): see identification.fitting.engine
             with engine if owned else contextlib.nullcontext():
-                result = _search(request, engine, progress, started)
+                result = search.run(request, engine, progress, started)
     if not result.converged:
         warnings.warn(result.warning, FitNotConvergedWarning, stacklevel=2)
     return result
@@ -243,32 +229,6 @@ def _check_coupling(multi: list[MultiAxisMeasurement], coupling: str | None) -> 
         coupled_axes(coupling, m)
 
 
-@dataclass(frozen=True)
-class MultiAxisTraining:
-    """The multi-axis training tests, each axis's noise level and the coupling they are run with."""
-    measurements: list[MultiAxisMeasurement]
-    noise: list[list[NoiseEstimate]]
-    coupling: str
-
-    def objective_arguments(self) -> dict:
-        return {"multiaxis": self.measurements, "multiaxis_noise": self.noise, "coupling": self.coupling}
-
-    def components(self) -> list[Measurement]:
-        return [c for m in self.measurements for c in m.components()]
-
-    def fits(self, parameters: ParameterSet) -> list[RigTestFit]:
-        """Each test's vector NRMSE at ``parameters`` against its noise: the rms of the axes'
-        noise levels over the rms force vector (``multiaxis.vector_nrmse``'s units)."""
-        fits = []
-        for m, levels in zip(self.measurements, self.noise):
-            predicted = simulate_multiaxis(parameters, m.time_s, m.displacement_mm, coupling=self.coupling,
-                                           velocity_mm_s=m.velocity_mm_s)
-            noise = NoiseEstimate(math.sqrt(sum(level.sigma_N ** 2 for level in levels)),
-                                  math.sqrt(float(np.mean(np.sum(m.force_N ** 2, axis=1)))))
-            fits.append(RigTestFit(m.name, f"{len(m.axes)}-axis", noise, vector_nrmse(predicted, m.force_N)))
-        return fits
-
-
 def _settings(base: SearchSettings, screening: int | None, starts: int | None) -> SearchSettings:
     if starts is not None:
         if starts < 1:
@@ -280,245 +240,6 @@ def _settings(base: SearchSettings, screening: int | None, starts: int | None) -
     if screening is not None:
         base = replace(base, screening=screening)
     return SearchSettings(base.screening, base.stages, base.global_search)   # validates
-
-
-def _exact_jacobian_or_why_not(tests, space: SearchSpace, progress: bool) -> tuple[str, str | None]:
-    """("exact", None) with the sensitivity module compiled (or loaded) here first, so that the
-    workers load it from the disk cache instead of each compiling it at once; or ("difference",
-    a note saying why) where the exact Jacobian would not pay: a fit to a dynamic-stiffness table
-    alone (its rows are differences either way), or a cache folder that cannot be written (every
-    process, every worker would compile the module again, a minute or more each)."""
-    from identification.forward.parameter_jacobian import sensitivity_module
-    if not tests:
-        return "difference", None
-    folder = cache_directory()
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-        writable = os.access(folder, os.W_OK)
-    except OSError:
-        writable = False
-    if not writable:
-        return "difference", (f"note: the compiled models' cache {folder} cannot be written, so the fit takes "
-                              "forward differences for its Jacobian (the exact one would be compiled again in every "
-                              "process); set BUSHING_CACHE_DIR to a writable folder")
-    # The first fit of a model on a machine compiles the module for a minute or more: say so
-    # if it takes longer than a moment (a load from the cache takes under a second).
-    message = threading.Timer(3.0, lambda: print(
-        f"compiling the fit's exact Jacobian for the {space.bushing.name} model (once per machine: a minute or two; "
-        f"cached in {folder})", file=sys.stderr, flush=True)) if progress else None
-    if message:
-        message.daemon = True
-        message.start()
-    try:
-        sensitivity_module(space.bushing, len(space.names))
-    finally:
-        if message:
-            message.cancel()
-    return "exact", None
-
-
-@dataclass(frozen=True)
-class SearchRequest:
-    """What one search fits: the training (one-axis tests with their noise, a table, multi-axis
-    tests), the model, the preset's settings and name, the seed, the Jacobian wanted, and whether
-    the ensemble is sampled."""
-    tests: list
-    noise: list
-    model: BushingModel
-    preset: str
-    settings: SearchSettings
-    seed: int
-    table: KdynTable | None = None
-    multi: MultiAxisTraining = MultiAxisTraining([], [], "none")
-    jacobian_kind: str = "exact"
-    sample_ensemble: bool = True
-
-
-def _search(request: SearchRequest, engine, progress: bool, started: float) -> FitResult:
-    """The search of a nonlinear model's parameters (``fit``), on ``engine``, timed from ``started``."""
-    return _Search(request, engine, progress, started).run()
-
-
-class _Search:
-    """One search, step by step: the box and the objective, the global phase, the least-squares
-    stages with the forward model's steps checked, the ensemble, the result. Each step reads what
-    the ones before it left here; ``notes`` and ``evaluations`` (simulations run) add up."""
-
-    def __init__(self, request: SearchRequest, engine, progress: bool, started: float):
-        self.request, self.engine, self.progress, self.started = request, engine, progress, started
-        self.notes: list[str] = []
-        self.evaluations = 0
-
-    def run(self) -> FitResult:
-        self.problem = self._problem()
-        theta, misfits = self._global_phase()
-        records, added, agreeing = self._stages(theta, misfits)
-        # scored by the objective used from here on; a failed start is skipped (failed_starts)
-        final = [r for r in records if r.stage == len(self.request.settings.stages) - 1 and not r.failed]
-        best = _best_record(final or records)
-        if not final:
-            self.notes.append(f"note: every start of the last stage failed (residuals or Jacobian not finite); the "
-                              f"result is the best finite point the search found (stage "
-                              f"{best.stage + 1 if best.stage >= 0 else 0})")
-        return self._result(records, final, best, added, agreeing)
-
-    def _problem(self) -> Problem:
-        """The box scaled by the data and the objective; the exact Jacobian where it pays."""
-        request = self.request
-        multi = request.multi
-        measurements = [t.measurement for t in request.tests] + multi.components()
-        self.space = SearchSpace.from_measurements(measurements, request.model,
-                                                   steps=[t.kind == "step" for t in request.tests]
-                                                   + [False] * (len(measurements) - len(request.tests)),
-                                                   table=request.table)
-        # with a table, the screening and the early stages run its coarser loop (kdyn_table)
-        self.jacobian_kind = request.jacobian_kind
-        if self.jacobian_kind == "exact":
-            self.jacobian_kind, note = _exact_jacobian_or_why_not(request.tests, self.space, self.progress)
-            if note:
-                self.notes.append(note)
-        objective = Objective(request.tests, request.noise, model=self.space.bushing, table=request.table,
-                              search=request.table is not None, **multi.objective_arguments())
-        self.n, self.d = objective.size, len(self.space.names)     # residuals, coordinates
-        return Problem(objective, self.space, self.jacobian_kind)
-
-    def _data_start(self):
-        """A start read off the data (a slow loop, else a table), or None; a table that gives
-        none says why in a note. The paper's GA takes none."""
-        request = self.request
-        if request.settings.genetic:
-            return None
-        loop = slow_loop_start(request.tests, self.space)
-        if loop is None:
-            loop = table_start(request.table, self.space)
-            if isinstance(loop, str):           # the table gives no start, and why
-                self.notes.append(loop)
-                loop = None
-        if loop is not None:
-            self.notes.append(f"note: {LOOP_STARTS} of the screened starts take the {loop.describe()}")
-        return loop
-
-    def _global_phase(self):
-        """The preset's global phase: its points and their misfits, best first."""
-        settings, problem = self.request.settings, self.problem
-        loop = self._data_start()
-        self.bars = SearchProgress(self.progress, settings, settings.global_evaluations(
-            settings.screening + (LOOP_STARTS if loop else 0)))
-        if settings.genetic:
-            from identification.fitting.multistart import genetic_algorithm
-            theta, misfits = genetic_algorithm(problem, self.engine, self.request.seed, self.bars.screening,
-                                               **PAPER_GA)
-        else:
-            theta, misfits = screen(problem, self.engine, settings.screening, self.request.seed, self.bars.screening,
-                                    anchored=loop and anchored_coordinates(loop, self.space),
-                                    anchored_count=LOOP_STARTS)
-        self.evaluations += settings.global_evaluations(len(misfits))
-        return theta, misfits
-
-    def _stages(self, theta, misfits):
-        """The least-squares stages from the global phase's best points: (records, starts added to
-        the last stage, starts that agreed before). The forward model's steps per sample are
-        checked where the result is decided: at the best start before the last stage, and at the
-        best fit; if that changes them, the last stage runs once more, and a third check only
-        reports (identification.fitting.refinement). A lone best start gets company before the
-        check at the best fit (_extend_if_alone)."""
-        tests, space, engine, bars = self.request.tests, self.space, self.engine, self.bars
-        *early, last = self.request.settings.stages
-        n, d = self.n, self.d
-        records = run_stages(self.problem, engine, first_records(theta, misfits, self.request.settings.stages[0][0]),
-                             early, bars.stage)
-        refinement = _check_steps(self.problem, tests, records, n, d)
-        problem = Problem(refinement.objective.with_fit_loop(tests), space, self.jacobian_kind)
-        records = run_stages(problem, engine, records, [last], bars.stage, first_stage=len(early))
-        records, added, agreeing = _extend_if_alone(problem, engine, records, last, len(early), n, d, bars)
-        final_count = last[0] + added
-        if added:
-            self.notes.append(f"note: only {agreeing} of the {last[0]} final starts reached the best misfit, so {added} "
-                              f"more start{'s' if added > 1 else ''} of the earlier stages also ran the last stage")
-        refinement_at_best = _check_steps(problem, tests, records, n, d)
-        self.evaluations += refinement.evaluations + refinement_at_best.evaluations
-        if refinement_at_best.changed:
-            problem = Problem(refinement_at_best.objective, space, self.jacobian_kind)
-            records = run_stages(problem, engine, records, [(final_count, last[1])],
-                                 lambda s, k: bars.stage(s, k, again=True, total=final_count), first_stage=len(early))
-            final_check = _check_steps(problem, tests, records, n, d)
-            self.evaluations += final_check.evaluations
-            if final_check.changed:
-                self.notes.append(f"note: at the best fit the forward model would need "
-                                  f"{'/'.join(map(str, final_check.objective.steps_per_sample))} steps per sample (it "
-                                  f"ran {'/'.join(map(str, problem.objective.steps_per_sample))}); its own error may "
-                                  "take more than a tenth of the confidence region")
-        bars.close()
-        self.evaluations += sum(r.evaluations - 1 for r in records)
-        self.problem = problem
-        return records, added, agreeing
-
-    def _ensemble(self, best: StartRecord, final: list[StartRecord], ident, threshold: float):
-        """The ensemble's members (coordinates, the best first), the posterior's sampler (or None)
-        and the failed profile tasks: every set within the confidence threshold the profiles, the
-        posterior and the final starts found; the best alone where the ensemble is not sampled."""
-        problem, space = self.problem, self.space
-        n, d = self.n, self.d
-        if not self.request.sample_ensemble:
-            return [best.theta], None, 0
-        limit = best.misfit + threshold
-        extremes, extreme_misfits, failed_profiles = profile_extremes(problem, best.theta, best.misfit, ident, limit,
-                                                                      self.engine)
-        # here, not on a worker: the compiled kernel runs the walkers on every core of this process
-        draws, _, sampler = posterior_samples(problem, best.theta, self.request.seed,
-                                              threshold_scale(best.misfit, n, d))
-        pushed, pushed_misfits = push_to_boundary(problem, best.theta, draws, limit)
-        per_jacobian = simulations_per_jacobian(problem, d, known=False)
-        self.evaluations += WALKERS * STEPS + len(draws) * len(PUSH) \
-            + len(PROBES) * 2 * per_jacobian * (1 + PROFILE_ROUNDS * PROFILE_EVALUATIONS)
-        members = select_members(best.theta, [(r.theta, r.misfit) for r in final],
-                                 np.vstack([extremes, pushed]), np.concatenate([extreme_misfits, pushed_misfits]),
-                                 limit, space.bounds())
-        return members, sampler, failed_profiles
-
-    def _result(self, records, final, best: StartRecord, added: int, agreeing: int) -> FitResult:
-        request, problem, space = self.request, self.problem, self.space
-        n, d = self.n, self.d
-        threshold = misfit_threshold(best.misfit, n, d)
-        scaled_jacobian = _identifiability_jacobian(problem, best.theta, self.notes)
-        ident = identifiability(scaled_jacobian * np.sqrt(n), space.names, threshold * n)
-        self.evaluations += simulations_per_jacobian(problem, d, known=False)
-        members, sampler, failed_profiles = self._ensemble(best, final, ident, threshold)
-        rows = space.to_model_parameters(np.array(members))
-        ensemble = [dict(zip(space.bushing.parameter_names, map(float, row))) for row in rows]
-        parameters = ParameterSet(space.bushing, ensemble[0])
-        steps = problem.objective.steps_per_sample
-        fits = _test_fits(request.tests, request.noise, parameters, steps) + request.multi.fits(parameters)
-        steps = steps + [m.driven.steps_per_sample for m in problem.objective.multiaxis]
-        result = FitResult(parameters, float(best.misfit), fits, records, threshold,
-                           ensemble, ident, request.preset, request.seed, self.evaluations,
-                           time.perf_counter() - self.started, self.engine.description, space,
-                           final_starts=len(final), sampler=sampler, notes=self.notes, steps_per_sample=steps,
-                           table=table_fit(request.table, parameters), added_starts=added,
-                           agreed_before_added=agreeing, ensemble_sampled=request.sample_ensemble, residuals=n,
-                           failed_starts=failed_starts(records) + failed_profiles,
-                           coupling=request.multi.coupling if request.multi.measurements else None)
-        result.parameters.provenance = result.provenance()
-        return result
-
-
-def _best_record(records: list[StartRecord]) -> StartRecord:
-    """The record of the lowest misfit (then the best-screened start) among ``records``; a failed
-    start counts with the last point where it was finite (screened points always are)."""
-    finite = [r for r in records if np.isfinite(r.misfit)] or records
-    return min(finite, key=lambda r: (r.misfit, r.start))
-
-
-def _identifiability_jacobian(problem: Problem, theta: np.ndarray, notes: list[str]) -> np.ndarray:
-    """The residuals' Jacobian at the best fit for the identifiability; entries that are not finite
-    (a difference across a blow-up) are taken as 0, with a note."""
-    scaled_jacobian, _ = jacobian(problem, theta)
-    finite = np.isfinite(scaled_jacobian)
-    if not finite.all():
-        notes.append(f"note: {int(np.count_nonzero(~finite))} entries of the Jacobian at the best fit are not finite "
-                     "and were taken as 0 for the identifiability")
-        scaled_jacobian = np.where(finite, scaled_jacobian, 0.0)
-    return scaled_jacobian
 
 
 def linear_solution(bushing: BushingModel, measurements) -> dict[str, float]:
@@ -570,80 +291,8 @@ def _fit_linear(bushing: BushingModel, tests, noise, started, table=None,
         values = {**{name: float(value) for name, value in zip(free, solution.x)}, **held}
     parameters = ParameterSet(bushing, values)
     misfit = float(objective(parameter_matrix([values], bushing))[0])
-    result = FitResult(parameters, misfit, _test_fits(tests, noise, parameters) + multi.fits(parameters), [], 0.0,
+    result = FitResult(parameters, misfit, test_fits(tests, noise, parameters) + multi.fits(parameters), [], 0.0,
                        [values], None, "linear", 0, 1, time.perf_counter() - started, table=table_fit(table, parameters),
                        residuals=objective.size, coupling=multi.coupling if multi.measurements else None)
     result.parameters.provenance = result.provenance()
     return result
-
-
-def _extend_if_alone(problem: Problem, engine, records: list[StartRecord], last: tuple[int, int], stage: int,
-                     n: int, d: int, bars) -> tuple[list[StartRecord], int, int]:
-    """If fewer than MIN_AGREEING of the last stage's starts reach the best misfit within the
-    ensemble threshold, up to ``last[0]`` more starts run the last stage too (once): those that
-    stopped in the latest earlier stage first, each group by misfit. A lone best start thus
-    gets its chance to be confirmed, or a better optimum is found, before the fit says it is
-    not converged. Returns the records (sorted as ``run_stages`` sorts them), how many starts
-    were added and how many agreed before."""
-    best = min((r.misfit for r in records if r.stage == stage and not r.failed), default=np.inf)
-    agreeing = agreeing_starts(records, stage, best, misfit_threshold(best, n, d)) if np.isfinite(best) else 0
-    waiting = sorted((r for r in records if r.stage < stage and not r.failed),
-                     key=lambda r: (-r.stage, r.misfit, r.start))[:last[0]]
-    if agreeing >= MIN_AGREEING or not waiting:
-        return records, 0, agreeing
-    run_stages(problem, engine, waiting, [(len(waiting), last[1])],
-               lambda s, k: bars.stage(s, k, more=True, total=len(waiting)), first_stage=stage)
-    records.sort(key=lambda r: (-r.stage, r.misfit, r.start))
-    return records, len(waiting), agreeing
-
-
-def _check_steps(problem: Problem, tests, records, n: int, d: int):
-    """``refinement.refine_steps`` at the best start of the latest stage (its misfit sets the
-    region's delta chi^2)."""
-    best = _best_record([r for r in records if r.stage == records[0].stage and not r.failed] or records)
-    return refine_steps(problem.objective, tests, problem.space.to_parameters(best.theta[None, :]),
-                        misfit_threshold(best.misfit, n, d) * n)
-
-
-def _test_fits(tests, noise, parameters: ParameterSet, steps=None) -> list[RigTestFit]:
-    """Each test's noise and NRMSE at ``parameters``, simulated with ``steps`` per sample (per
-    test; default: chosen from the signal)."""
-    fits = []
-    for test, level, m_steps in zip(tests, noise, steps or [None] * len(tests)):
-        m = test.measurement
-        predicted = simulate(parameters, m.time_s, m.displacement_mm, m.measured_velocity_mm_s,
-                             steps_per_sample=m_steps)
-        fits.append(RigTestFit(test.name, test.kind, level, nrmse(predicted, m.force_N)))
-    return fits
-
-
-def table_fit(table: KdynTable | None, parameters: ParameterSet) -> TableFit | None:
-    """The table's rows (weight > 0) against the converged characterisation of ``parameters``,
-    and how far the fit's fixed-cycle loop is from it (its largest relative |K*| difference):
-    a fitted table, or one held out (``compare``)."""
-    if table is None:
-        return None
-    from identification.forward.dynamic_stiffness import MAX_CYCLES, STEPS_PER_CYCLE, TOLERANCE, run_sines, stiffness_from_sums
-    from identification.fitting.objectives import PreparedTable
-    model = parameters.model
-    prepared = PreparedTable.of(table, model)
-    rows = prepared.rows
-    matrix = parameter_matrix([parameters.parameters], model)
-
-    def steady(steps):
-        result, _ = run_sines(matrix, model, rows.amplitude_mm, rows.frequency_hz, rows.preload_mm, steps, MAX_CYCLES,
-                              TOLERANCE)
-        if np.any(result[:, 3] == 1):
-            warnings.warn(f"{table.name}: some cases of the fitted set reach no steady state within {MAX_CYCLES} "
-                          "cycles", CharacterisationWarning, stacklevel=4)
-        if np.any(result[:, 3] == 2):
-            warnings.warn(f"{table.name}: the fitted set fails on some cases (overflow or too many substeps); their "
-                          "errors are NaN", CharacterisationWarning, stacklevel=4)
-        return stiffness_from_sums(result, rows.amplitude_mm)[2:]
-
-    kdyn, angle = steady(STEPS_PER_CYCLE)
-    # the fit loop against the steady state at the fit loop's own steps: what its few cycles leave
-    fixed, _ = prepared.stiffness(matrix, model)
-    converged_fit_steps, _ = steady(prepared.steps_per_cycle)
-    return TableFit(table.name, kdyn / rows.kdyn_N_per_mm - 1.0, angle - rows.loss_angle_deg, rows.weight,
-                    float(np.max(np.abs(fixed[0] / converged_fit_steps - 1.0))))

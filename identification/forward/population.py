@@ -1,6 +1,6 @@
 """The bushing models compiled with numba, for simulating whole populations of parameter sets.
 
-One definition. Each model's own source (``fmu_src/<name>_model.py``) is compiled by
+One definition. Each model's own source (``fmu_src/models/<name>_model.py``) is compiled by
 ``fmu_src/kernels/numba_binding.py`` (a generated module named after its content, in the cache
 folder, its kernels and the shared machinery compiled), with the population loop below
 appended. The FMU runs the same functions, as plain Python or compiled the same way;

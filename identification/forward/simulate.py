@@ -107,7 +107,7 @@ def simulate_multiaxis(parameters, time_s, displacement_mm, model: str | Bushing
                        ) -> np.ndarray:
     """The force vectors [N], (samples, d), of a parameter set on a multi-axis path ``displacement_mm``
     (samples, d = 2 or 3) [mm] at the times ``time_s`` [s] (and its measured ``velocity_mm_s``, if
-    any), driven as the fit drives a test (module docstring), with ``coupling`` (COUPLED_AXES;
+    any), driven as the fit drives a test (``identification.measured.multiaxis``), with ``coupling`` (COUPLED_AXES;
     default: every axis of the path coupled, radial on a plane, spherical in 3-space). The bushing
     starts relaxed at the first sample. ``parameters``: any form ``parameter_sets`` takes (a
     mounting's offset [mm] and preload [N] apply to every axis alike)."""
