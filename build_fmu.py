@@ -201,7 +201,13 @@ def build_fmu(params_file: str | Path | None = None, out_dir: str | Path = "dist
     BuildError
         The FMU fails fmpy's validation; ``ParameterError`` for an invalid parameter file.
     """
+    from pythonfmu import builder
     from pythonfmu.builder import FmuBuilder
+    binaries = Path(builder.__file__).parent / "resources" / "binaries"
+    if not any(binaries.rglob("*.so")) and not any(binaries.rglob("*.dll")):
+        raise BuildError(f"pythonfmu here ({Path(builder.__file__).parent}) has no FMU binaries: it is the copy a "
+                         "pythonfmu FMU loaded into this process carries, not an installed one; build before "
+                         "loading a pythonfmu FMU, or in another process")
 
     identifier, title, axes, defaults_json = fmu_axes(params_file, model)
     defaults_text = json.dumps(defaults_json, indent=2) + "\n"

@@ -8,6 +8,10 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import build_fmu
+# The installed pythonfmu, before any test loads a pythonfmu FMU into this process: such an FMU puts
+# its own copy of pythonfmu (resources/pythonfmu, without the builder's binaries) on sys.path, and
+# an xdist worker whose first FMU arrives built by another worker would otherwise build from it.
+import pythonfmu.builder  # noqa: E402,F401
 from fmu_src.parameter_files import load_parameters
 from suite_options import (_optimizer_rounding_variant, pytest_addoption, pytest_collection_modifyitems,  # noqa: F401
                            pytest_configure)
@@ -191,6 +195,21 @@ def pythonfmu_model_fmus(tmp_path_factory) -> dict:
     from fmu_src.model.registry import MODELS
     return built_once(tmp_path_factory, "pythonfmu", lambda folder: {
         name: build_fmu.build_fmu(out_dir=folder, model=name) for name in (*MODELS, "six_axis")})
+
+
+@pytest.fixture(scope="session")
+def coupled_six_axis_fmus(tmp_path_factory) -> dict:
+    """The illustrative six axes with a spherical group (the proposed model on x, y, z) and a conical
+    one (Berg on rx, ry) (``test_coupled_six_axis.six_axis_file``): its parameter file ("file"), its
+    pythonfmu FMU and its native FMUs ("fmi2", "fmi3")."""
+    from test_coupled_six_axis import six_axis_file
+
+    def build(folder):
+        path = six_axis_file(folder, {"translation": "spherical", "rotation": "conical"})
+        return {"file": path, "pythonfmu": build_fmu.build_fmu(path, folder / "pythonfmu", model="six_axis"),
+                "fmi2": build_fmu.build_native_fmu(path, folder / "fmi2", model="six_axis").path,
+                "fmi3": build_fmu.build_native_fmu(path, folder / "fmi3", model="six_axis", fmi_version=3).path}
+    return built_once(tmp_path_factory, "coupled_six_axis", build)
 
 
 def is_native(fmu_path) -> bool:

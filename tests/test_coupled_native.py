@@ -12,21 +12,15 @@ import test_fmu_directional_derivatives as derivatives
 from fmu_harness import BushingFmu
 from fmu_src.fmi.axes import SIX_AXES
 from fmu_src.parameter_files import read_six_axis
-from test_coupled_six_axis import (PORTS, STEP_S, assert_state_round_trip, plane_path, run_fmu, run_group,
-                                   six_axis_file)
-
-COUPLING = {"translation": "spherical", "rotation": "conical"}
+from test_coupled_six_axis import PORTS, STEP_S, assert_state_round_trip, plane_path, run_fmu, run_group
 
 
 @pytest.fixture(scope="module")
-def coupled(tmp_path_factory):
+def coupled(coupled_six_axis_fmus):
     """The six-axis set with a spherical (the proposed model on x, y, z) and a conical group (Berg on
     rx, ry), and its native FMUs, FMI 2 and 3, and pythonfmu FMU."""
-    folder = tmp_path_factory.mktemp("coupled_native")
-    path = six_axis_file(folder, COUPLING)
-    return {"file": path, 2: build_fmu.build_native_fmu(path, folder / "fmi2", model="six_axis").path,
-            3: build_fmu.build_native_fmu(path, folder / "fmi3", model="six_axis", fmi_version=3).path,
-            "pythonfmu": build_fmu.build_fmu(path, folder / "pythonfmu", model="six_axis")}
+    fmus = coupled_six_axis_fmus
+    return {"file": fmus["file"], 2: fmus["fmi2"], 3: fmus["fmi3"], "pythonfmu": fmus["pythonfmu"]}
 
 
 t = np.arange(0.0, 0.3 + STEP_S / 2, STEP_S)

@@ -41,12 +41,10 @@ def six_axis_file(tmp_path, coupling, **changes):
 
 
 @pytest.fixture(scope="module")
-def coupled_fmu(tmp_path_factory):
+def coupled_fmu(coupled_six_axis_fmus):
     """The pythonfmu six-axis FMU with spherical (x, y, z: the proposed model) and conical (rx, ry:
-    Berg) groups, and its parameter file."""
-    folder = tmp_path_factory.mktemp("coupled")
-    path = six_axis_file(folder, {"translation": "spherical", "rotation": "conical"})
-    return build_fmu.build_fmu(path, folder, model="six_axis"), path
+    Berg) groups (conftest's, built once a run), and its parameter file."""
+    return coupled_six_axis_fmus["pythonfmu"], coupled_six_axis_fmus["file"]
 
 
 def plane_path(t, radius=2.0):

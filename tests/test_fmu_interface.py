@@ -65,3 +65,22 @@ def test_packed_modules_have_build_specific_names(fmu_path, fmu_path_table2):
     first, second = slave_module(fmu_path), slave_module(fmu_path_table2)
     assert first.startswith("boucwen_bushing_") and second.startswith("boucwen_bushing_")
     assert first != second
+
+
+def test_a_build_from_the_pythonfmu_copy_an_fmu_carries_is_refused_with_why(fmu_path, tmp_path):
+    # A pythonfmu FMU carries pythonfmu without the builder's binaries; a process that loaded one
+    # first would build FMUs without binaries: build_fmu says so instead.
+    import subprocess
+    import sys
+    import zipfile
+    from conftest import REPO
+    with zipfile.ZipFile(fmu_path) as archive:
+        archive.extractall(tmp_path / "unzipped")
+    code = (f"import sys\nsys.path.insert(0, {str(tmp_path / 'unzipped' / 'resources')!r})\n"
+            "import pythonfmu.builder\nimport build_fmu\n"
+            "try:\n    build_fmu.build_fmu(out_dir=sys.argv[1])\n"
+            "except build_fmu.BuildError as exc:\n    print(exc)\n")
+    done = subprocess.run([sys.executable, "-c", code, str(tmp_path / "out")], cwd=REPO, capture_output=True,
+                          text=True, timeout=300)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert "has no FMU binaries" in done.stdout and not (tmp_path / "out").exists()

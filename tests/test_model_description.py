@@ -9,7 +9,6 @@ import math
 import pytest
 from fmpy import read_model_description
 
-import build_fmu
 from fmu_harness import BushingFmu
 from fmu_src.model.registry import MODELS
 
@@ -43,18 +42,11 @@ def test_both_fmus_declare_the_same_variables_and_output_dependencies(name, pyth
     assert_described_alike(pythonfmu_model_fmus[name], native_model_fmus[name])
 
 
-def _coupled_fmus(folder):
-    from test_coupled_six_axis import six_axis_file
-    path = six_axis_file(folder, {"translation": "spherical", "rotation": "conical"})
-    return (build_fmu.build_fmu(path, folder / "pythonfmu", model="six_axis"),
-            build_fmu.build_native_fmu(path, folder / "native", model="six_axis").path)
-
-
 @pytest.fixture(scope="module")
-def coupled_fmus(tmp_path_factory):
+def coupled_fmus(coupled_six_axis_fmus):
     """The pythonfmu and the native six-axis FMU with spherical (x, y, z: the proposed model) and
     conical (rx, ry: Berg) groups."""
-    return _coupled_fmus(tmp_path_factory.mktemp("coupled"))
+    return coupled_six_axis_fmus["pythonfmu"], coupled_six_axis_fmus["fmi2"]
 
 
 def test_both_coupled_six_axis_fmus_declare_the_same_variables_and_output_dependencies(coupled_fmus):
