@@ -176,14 +176,7 @@ def characterise(parameters, amplitudes_mm: Sequence[float] = DEFAULT_AMPLITUDES
     bushing, sets = parameter_sets(parameters, model)
     amplitudes = _grid_values(amplitudes_mm, "amplitude", "mm", PLAUSIBLE_AMPLITUDE_MM)
     frequencies = _grid_values(frequencies_hz, "frequency", "Hz", PLAUSIBLE_FREQUENCY_HZ)
-    if not math.isfinite(preload_mm):
-        raise IdentificationError(f"preload = {preload_mm} mm: give a finite displacement")
-    if int(steps_per_cycle) != steps_per_cycle or steps_per_cycle < 16:
-        raise IdentificationError(f"steps_per_cycle = {steps_per_cycle}: give an integer >= 16")
-    if not (0.0 < tolerance < 1.0):
-        raise IdentificationError(f"tolerance = {tolerance}: give a relative change between 0 and 1")
-    if int(max_cycles) != max_cycles or max_cycles < MIN_CYCLES:
-        raise IdentificationError(f"max_cycles = {max_cycles}: give an integer >= {MIN_CYCLES}")
+    _check_loop(preload_mm, steps_per_cycle, tolerance, max_cycles)
     case_amplitude = np.repeat(amplitudes, frequencies.size)
     case_frequency = np.tile(frequencies, amplitudes.size)
     cases = case_amplitude.size
@@ -203,16 +196,7 @@ def characterise(parameters, amplitudes_mm: Sequence[float] = DEFAULT_AMPLITUDES
         warnings.warn(f"{members - len(runs)} of the {members} ensemble members fail on some case (overflow or too many "
                       "substeps) and are left out of the min/max columns", CharacterisationWarning, stacklevel=2)
     best = tables[0]
-    not_steady = ~best["converged"]
-    if not_steady.any():
-        listed = ", ".join(f"{case_amplitude[i]:g} mm/{case_frequency[i]:g} Hz" for i in np.flatnonzero(not_steady))
-        warnings.warn(f"no steady state within {max_cycles} cycles for {listed}: the first harmonic still changes by "
-                      f"more than {tolerance:g} per cycle; these rows are the last cycle's (raise max_cycles)",
-                      CharacterisationWarning, stacklevel=2)
-    unsteady_members = sum(not t["converged"].all() for t in tables[1:])
-    if unsteady_members:
-        warnings.warn(f"{unsteady_members} ensemble member(s) reach no steady state within {max_cycles} cycles on some "
-                      "case; their last cycle is in the min/max columns", CharacterisationWarning, stacklevel=2)
+    _warn_unsteady(tables, case_amplitude, case_frequency, max_cycles, tolerance)
     table = DynamicStiffness(case_amplitude, case_frequency, np.full(cases, float(preload_mm)),
                              **{name: best[name] for name in RESULT_COLUMNS}, cycles=best["cycles"],
                              converged=best["converged"], loop_force_N=best["loop"], model=bushing.name,
@@ -221,6 +205,33 @@ def characterise(parameters, amplitudes_mm: Sequence[float] = DEFAULT_AMPLITUDES
         table.minimum = {name: np.min([t[name] for t in tables], axis=0) for name in RESULT_COLUMNS}
         table.maximum = {name: np.max([t[name] for t in tables], axis=0) for name in RESULT_COLUMNS}
     return table
+
+
+def _check_loop(preload_mm: float, steps_per_cycle: int, tolerance: float, max_cycles: int) -> None:
+    """``characterise``'s loop settings, each refused with its value and what is allowed."""
+    if not math.isfinite(preload_mm):
+        raise IdentificationError(f"preload = {preload_mm} mm: give a finite displacement")
+    if int(steps_per_cycle) != steps_per_cycle or steps_per_cycle < 16:
+        raise IdentificationError(f"steps_per_cycle = {steps_per_cycle}: give an integer >= 16")
+    if not (0.0 < tolerance < 1.0):
+        raise IdentificationError(f"tolerance = {tolerance}: give a relative change between 0 and 1")
+    if int(max_cycles) != max_cycles or max_cycles < MIN_CYCLES:
+        raise IdentificationError(f"max_cycles = {max_cycles}: give an integer >= {MIN_CYCLES}")
+
+
+def _warn_unsteady(tables, case_amplitude, case_frequency, max_cycles: int, tolerance: float) -> None:
+    """A CharacterisationWarning, at ``characterise``'s caller, for the best set's cases and the
+    ensemble members that reached no steady state within ``max_cycles``."""
+    not_steady = ~tables[0]["converged"]
+    if not_steady.any():
+        listed = ", ".join(f"{case_amplitude[i]:g} mm/{case_frequency[i]:g} Hz" for i in np.flatnonzero(not_steady))
+        warnings.warn(f"no steady state within {max_cycles} cycles for {listed}: the first harmonic still changes by "
+                      f"more than {tolerance:g} per cycle; these rows are the last cycle's (raise max_cycles)",
+                      CharacterisationWarning, stacklevel=3)
+    unsteady_members = sum(not t["converged"].all() for t in tables[1:])
+    if unsteady_members:
+        warnings.warn(f"{unsteady_members} ensemble member(s) reach no steady state within {max_cycles} cycles on some "
+                      "case; their last cycle is in the min/max columns", CharacterisationWarning, stacklevel=3)
 
 
 def run_sines(matrix: np.ndarray, model: str | BushingModel, amplitude_mm: np.ndarray, frequency_hz: np.ndarray,
