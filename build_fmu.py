@@ -80,9 +80,9 @@ SOURCE_DIR = Path(fmu_src.__file__).resolve().parent
 NOT_PACKED = ("fmi/native/", "fmi/model_description.py", "fmi/dependencies.py", "kernels/python_to_c.py")
 """What the pythonfmu FMU leaves out of fmu_src: what builds an FMU and never runs inside one (the
 native FMU's generator, the C translator, the model description and its dependencies)."""
-LIBRARY_MODULES = tuple(sorted(path.relative_to(SOURCE_DIR).as_posix() for path in SOURCE_DIR.rglob("*.py")
-                               if path.relative_to(SOURCE_DIR).as_posix() not in ("__init__.py", SLAVE_MODULE)
-                               and not path.relative_to(SOURCE_DIR).as_posix().startswith(NOT_PACKED)))
+LIBRARY_MODULES = tuple(sorted(name for name in (path.relative_to(SOURCE_DIR).as_posix()
+                                                 for path in SOURCE_DIR.rglob("*.py"))
+                               if name not in ("__init__.py", SLAVE_MODULE) and not name.startswith(NOT_PACKED)))
 """What the pythonfmu FMU packs beside its slave module, as paths under fmu_src: every module of
 it but the native FMU's generator (the models, the contract, the kernels' machinery, the FMI
 layer, the parameter files; its __init__ is PACKED_LIBRARY_INIT), so a model module added to
@@ -203,9 +203,10 @@ def build_fmu(params_file: str | Path | None = None, out_dir: str | Path = "dist
     """
     from pythonfmu import builder
     from pythonfmu.builder import FmuBuilder
-    binaries = Path(builder.__file__).parent / "resources" / "binaries"
+    pythonfmu_folder = Path(builder.__file__).parent
+    binaries = pythonfmu_folder / "resources" / "binaries"
     if not any(binaries.rglob("*.so")) and not any(binaries.rglob("*.dll")):
-        raise BuildError(f"pythonfmu here ({Path(builder.__file__).parent}) has no FMU binaries: it is the copy a "
+        raise BuildError(f"pythonfmu here ({pythonfmu_folder}) has no FMU binaries: it is the copy a "
                          "pythonfmu FMU loaded into this process carries, not an installed one; build before "
                          "loading a pythonfmu FMU, or in another process")
 

@@ -212,9 +212,9 @@ def test_the_package_docstrings_name_every_subpackage_and_module(name):
         assert "May import" in package.__doc__
 
 
-def _imports(path, package: str):
-    """(line, absolute module name) of every import of ``path`` (a module of ``package``), at its top
-    or inside a function, relative ones resolved."""
+def _imports(path):
+    """(line, absolute module name) of every import of the module at ``path``, at its top or inside a
+    function, relative ones resolved."""
     import ast
     parts = path.relative_to(REPO).with_suffix("").parts
     here = list(parts[:-1])
@@ -241,7 +241,7 @@ def test_subpackages_import_only_those_before_them(name):
         if len(parts) == 2 and (parts[-1] in ("__init__", "__main__") or name == "fmu_src"):
             continue                                   # the front doors hand names on; parameter_files is on top
         here = parts[1] if len(parts) > 2 else None
-        for line, imported in _imports(path, name):
+        for line, imported in _imports(path):
             target = imported.split(".")
             if target[0] != name or len(target) < 2 or target[1] not in order:
                 continue
@@ -277,7 +277,7 @@ def _module_imports() -> dict[str, set[str]]:
         for path in sorted((REPO / name).rglob("*.py")):
             parts = path.relative_to(REPO).with_suffix("").parts
             module = ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
-            graph[module] = {target for _, imported in _imports(path, name) if imported.split(".")[0] in SUBPACKAGES
+            graph[module] = {target for _, imported in _imports(path) if imported.split(".")[0] in SUBPACKAGES
                              for target in [_module_of(imported)] if target and target != module}
     return graph
 

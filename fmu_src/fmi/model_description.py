@@ -28,6 +28,8 @@ LOG_CATEGORIES = (("logStatusWarning", "Warnings: values accepted but doubtful (
                   ("logStatusFatal", "Fatal errors"),
                   ("logAll", "Everything else"))
 INTERFACES = ("cs", "me")
+NATIVE_TOOL = "(build_fmu.py --native)"
+"""How the native FMU's description names the tool that made it (after the project's name and version)."""
 CAPABILITIES_FMI2 = {"needsExecutionTool": "false", "canBeInstantiatedOnlyOncePerProcess": "false",
                      "canNotUseMemoryManagementFunctions": "false", "canGetAndSetFMUstate": "true",
                      "canSerializeFMUstate": "true", "providesDirectionalDerivative": "true"}
@@ -46,7 +48,7 @@ class Face:
 
 def native_face(identifier: str, interfaces=INTERFACES) -> Face:
     """The native FMU's: C compiled for the host, its source shipped, directional derivatives."""
-    return Face(tuple(interfaces), "(build_fmu.py --native)", source_file=f"{identifier}.c")
+    return Face(tuple(interfaces), NATIVE_TOOL, source_file=f"{identifier}.c")
 
 
 def pythonfmu_face(pythonfmu_version: str) -> Face:
@@ -207,7 +209,7 @@ def fmi3(axis_models, identifier: str, token: str, groups=()) -> bytes:
     groups = _coupled(axis_models, groups)
     variables = all_variables(axis_models, groups)
     root = ET.Element("fmiModelDescription", _common_attributes(identifier, "instantiationToken", token, axis_models,
-                                                                "3.0", native_face(identifier).tool))
+                                                                "3.0", NATIVE_TOOL))
     capabilities = {"modelIdentifier": identifier, "needsExecutionTool": "false",
                     "canBeInstantiatedOnlyOncePerProcess": "false", "canGetAndSetFMUState": "true",
                     "canSerializeFMUState": "true", "providesDirectionalDerivatives": "true",

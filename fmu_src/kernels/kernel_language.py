@@ -45,7 +45,7 @@ class KernelCall:
     """A call a kernel may make (see the module docstring). ``derivative(b, x, t)``: its tangent
     as a syntax tree, from its arguments' trees ``x`` and their tangents' ``t`` (None for an
     inactive one), built with ``b`` (the tangent generator's builder: ``mul``, ``neg``, ``div``,
-    ``times``, ``where``, ``compare``, ``math``, ``helper``, ``copy``, ``zero``, ``power``); None for
+    ``where``, ``compare``, ``math``, ``helper``, ``copy``, ``zero``, ``power``); None for
     a call whose tangent class is ``zero``. ``active``: the arguments whose activity the result
     carries (default: all)."""
     name: str
@@ -86,7 +86,7 @@ CALLS = (
     # copysign(a, s) = |a|*sgn(s): the sign of a times the sign of s carries a's tangent; s's sign
     # is a branch (its derivative 0 away from s = 0), so only a is active
     KernelCall("copysign", "math", 2, "float", "chain", "copysign({0}, {1})",
-               lambda b, x, t: b.mul(b.times(b.math("copysign", 1.0, b.copy(x[0])), b.math("copysign", 1.0, x[1])),
+               lambda b, x, t: b.mul(b.mul(b.math("copysign", 1.0, b.copy(x[0])), b.math("copysign", 1.0, x[1])),
                                      t[0]), active=(0,)),
     KernelCall("pow", "math", 2, "float", "chain", "pow({0}, {1})", lambda b, x, t: b.power(x[0], x[1], t[0], t[1])),
     KernelCall("ceil", "math", 1, "int", "zero", "bw_int(ceil({0}))"),

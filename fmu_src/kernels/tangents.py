@@ -556,10 +556,6 @@ class _Builder:
         return ast.BinOp(a, ast.Div(), b)
 
     @staticmethod
-    def times(a, b):
-        return ast.BinOp(a, ast.Mult(), b)
-
-    @staticmethod
     def where(test, body, orelse):
         return ast.IfExp(test, body, orelse)
 
