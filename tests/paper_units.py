@@ -33,6 +33,12 @@ PARAMETER_UNITS = {
     # travel, so gap is mm; kd*u is the membrane's force against P, so kd is N/mm
     "hydraulic": {"k0": "N/mm", "c0": "N.s/mm", "k1": "N/mm", "c1": "N.s/mm", "kb": "N/mm", "kc": "N/mm",
                   "mf": "N.s^2/mm", "cf": "N.s/mm", "ct": "N.s^2/mm^2", "gap": "mm", "kd": "N/mm"},
+    # the free plate's: as the hydraulic mount's, with k3*x^3 a force (N/mm^3); the plate's balance
+    # P - (kb + kc)*u = kd*u + kcage*(|u| - gap) makes kd and kcage N/mm, gap a travel [mm]; the cage
+    # engages over a travel of the plate, so the width is mm
+    "hydraulic_free_decoupler": {"k0": "N/mm", "k3": "N/mm^3", "c0": "N.s/mm", "k1": "N/mm", "c1": "N.s/mm",
+                                 "kb": "N/mm", "kc": "N/mm", "mf": "N.s^2/mm", "cf": "N.s/mm", "ct": "N.s^2/mm^2",
+                                 "gap": "mm", "width": "mm", "kcage": "N/mm", "kd": "N/mm"},
 }
 
 MOUNTING_UNITS = {"offset": "mm", "preload": "N"}

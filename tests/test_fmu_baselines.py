@@ -32,6 +32,11 @@ BAD_VALUES = [  # model, parameter, value, what the message says after "<name> =
     ("hydraulic", "kb", -5.0, "[N/mm] must be > 0"),
     ("hydraulic", "gap", -0.1, "[mm] must be >= 0"),
     ("hydraulic", "ct", float("inf"), "[N.s^2/mm^2]"),
+    # the free plate: a negative travel, engagement width or cage, a plate without centring
+    ("hydraulic_free_decoupler", "gap", -0.12, "[mm] must be >= 0"),
+    ("hydraulic_free_decoupler", "width", -0.005, "[mm] must be >= 0"),
+    ("hydraulic_free_decoupler", "kcage", -100.0, "[N/mm] must be >= 0"),
+    ("hydraulic_free_decoupler", "kd", 0.0, "[N/mm] must be > 0"),
 ]
 
 

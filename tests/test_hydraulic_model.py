@@ -26,6 +26,9 @@ DEFAULTS = {name: float(value) for name, value in json.loads(
 """data/params_hydraulic_mount.json as plain JSON: the track tuned to sqrt((kb + kc)/mf)/(2*pi) = 9.98 Hz,
 a 0.1 mm decoupler."""
 LINEAR = dict(DEFAULTS, gap=0.0, ct=0.0)
+DEFAULTS_OF_FREE_PLATE = {name: float(value) for name, value in json.loads(
+    (Path(__file__).resolve().parents[1] / "data" / "params_hydraulic_free_decoupler.json").read_text())
+    ["parameters"].items()}
 
 MAX_SUBSTEPS = 20000
 GAUSS_NODES, GAUSS_WEIGHTS = np.polynomial.legendre.leggauss(4)
@@ -163,25 +166,27 @@ def test_the_default_mount_has_a_hydromount_data_sheet():
     assert 2.0 <= sheet.kdyn_N_per_mm.max() / sheet.kdyn_N_per_mm[notch] <= 4.0
 
 
-def test_model_exchange_with_cvode_follows_the_radau_reference(native_model_fmus):
-    # the host integrates y, w, f1 itself (fmpy's CVode, BDF, rtol 1e-8; the model has no event
-    # indicators); the reference is scipy's Radau on the equations typed in
-    # tests/references/generate_references.py, the paper's 2 mm / 10 Hz sine (its first 0.3 s)
+@pytest.mark.parametrize("model", ["hydraulic", "hydraulic_free_decoupler"])
+def test_model_exchange_with_cvode_follows_the_radau_reference(native_model_fmus, model):
+    # the host integrates y, w, f1 itself (fmpy's CVode, BDF, rtol 1e-8; the free plate's event
+    # indicators are where it meets its cage); the reference is scipy's Radau on the equations
+    # typed in tests/references/, the paper's 2 mm / 10 Hz sine (its first 0.3 s)
     import sys
     sys.path.insert(0, str(REFERENCES))
     import generate_references
     from model_exchange import simulate_model_exchange
-    t_ref, _, force_ref = generate_references.read_csv(REFERENCES / "hydraulic_sine_2mm_10Hz.csv")
+    t_ref, _, force_ref = generate_references.read_csv(REFERENCES / f"{model}_sine_2mm_10Hz.csv")
     t = t_ref[t_ref <= 0.3 + 1e-12]
     omega = 2 * np.pi * 10.0
-    run = simulate_model_exchange(native_model_fmus["hydraulic"], t, lambda s: 2e-3 * np.sin(omega * s),
+    run = simulate_model_exchange(native_model_fmus[model], t, lambda s: 2e-3 * np.sin(omega * s),
                                   lambda s: 2e-3 * omega * np.cos(omega * s))
     error = np.max(np.abs(run.force_N - force_ref[:t.size])) / np.max(np.abs(force_ref))
     assert error <= 1e-5, error
 
 
-@pytest.mark.parametrize("kind", ["pythonfmu", "native"])
-def test_a_hydraulic_axis_of_the_six_axis_fmu_is_the_one_axis_model(tmp_path, kind):
+@pytest.mark.parametrize("kind, model", [("pythonfmu", "hydraulic"), ("native", "hydraulic"),
+                                         ("native", "hydraulic_free_decoupler")])
+def test_a_hydraulic_axis_of_the_six_axis_fmu_is_the_one_axis_model(tmp_path, kind, model):
     # the mount on the z axis of a six-axis FMU (the others Kelvin-Voigt), driven on every axis:
     # its force is the one-axis model's fed with z alone (the compiled path, the kernels' bits)
     import build_fmu
@@ -190,7 +195,7 @@ def test_a_hydraulic_axis_of_the_six_axis_fmu_is_the_one_axis_model(tmp_path, ki
     from identification.forward.population import simulate_model_held
     stiff = {"k": 500.0, "c": 1.0, "preload": 0.0}
     axes = {name: ("kelvin_voigt", stiff) for name in ("x", "y", "rx", "ry", "rz")}
-    axes["z"] = ("hydraulic", DEFAULTS)
+    axes["z"] = (model, DEFAULTS if model == "hydraulic" else DEFAULTS_OF_FREE_PLATE)
     document = save_six_axis(tmp_path / "six.json", axes)
     build = build_fmu.build_native_fmu if kind == "native" else build_fmu.build_fmu
     built = build(document, tmp_path / "out", "six_axis")
@@ -202,5 +207,5 @@ def test_a_hydraulic_axis_of_the_six_axis_fmu_is_the_one_axis_model(tmp_path, ki
     inputs = np.array(list(zip(t, *ports.values())), dtype=[("time", float)] + [(k, float) for k in ports])
     result = simulate_fmu(str(fmu), start_time=0.0, stop_time=t[-1], step_size=1e-3, output_interval=1e-3,
                           input=inputs, output=["Fz"])
-    expected = simulate_model_held("hydraulic", DEFAULTS, t, ports["dz"] * 1e3, ports["vz"] * 1e3)
+    expected = simulate_model_held(model, dict(axes["z"][1]), t, ports["dz"] * 1e3, ports["vz"] * 1e3)
     np.testing.assert_allclose(result["Fz"][:t.size], expected, rtol=1e-12, atol=1e-12 * np.max(np.abs(expected)))

@@ -1,11 +1,16 @@
 """The models' derivative and switching kernels (what a host's integrator calls in model
 exchange) against each model's equations typed independently in the tests."""
+import importlib.util
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 from conftest import paper_equations, paper_parameters
 from fmu_src.model.registry import MODELS
 from test_baseline_models import BOUC_WEN, SPENCER, bouc_wen_rhs, spencer_rhs
+
+REFERENCES = Path(__file__).resolve().parent / "references"
 
 def berg_rhs(p, s, x, v):
     """Berg's model: d/dt of the travel is v, the reversal force and direction hold between
@@ -42,6 +47,12 @@ HYDRAULIC = {"k0": 200.0, "c0": 0.05, "k1": 40.0, "c1": 0.4, "kb": 250.0, "kc": 
              "ct": 0.005, "gap": 0.1, "kd": 50.0}
 """data/params_hydraulic_mount.json's values: (kb + kc + kd)*gap = 32.5 N, so the states drawn below put
 the chambers' pressure difference P both inside the decoupler's free travel and on its cage."""
+FREE_PLATE = {"k0": 200.0, "k3": 20.0, "c0": 0.05, "k1": 40.0, "c1": 0.4, "kb": 250.0, "kc": 25.0, "mf": 0.07,
+              "cf": 1.3, "ct": 0.005, "gap": 0.12, "width": 0.005, "kcage": 2000.0, "kd": 5.0}
+"""data/params_hydraulic_free_decoupler.json's values."""
+_spec = importlib.util.spec_from_file_location("free_decoupler_mount", REFERENCES / "free_decoupler_mount.py")
+free_decoupler_mount = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(free_decoupler_mount)   # numpy and scipy only
 
 CASES = {
     # model: (parameters, independent right-hand side(p, state, x, v), state scale)
@@ -52,6 +63,11 @@ CASES = {
     "berg": (dict(FILLED_RUBBER, k1=150.0, c1=15.0, k2=250.0, c2=0.5), berg_rhs, (1.0, 50.0, 1.0, 100.0, 100.0)),
     "fractional": (dict(FILLED_RUBBER, b=70.0, alpha=0.22), fractional_rhs, (1.0, 50.0, 1.0) + (100.0,) * 20),
     "hydraulic": (HYDRAULIC, hydraulic_rhs, (1.0, 100.0, 50.0)),
+    # the free plate: tests/references/free_decoupler_mount.py's equations (its rounded cage typed
+    # with numpy's logaddexp); the states put P inside the free travel (33.6 N), on the cage and
+    # across its 0.005 mm engagement
+    "hydraulic_free_decoupler": (FREE_PLATE, lambda p, s, x, v: free_decoupler_mount.rhs(
+        0.0, s, p, lambda t: (x, v)), (0.3, 100.0, 50.0)),
 }
 
 

@@ -146,13 +146,18 @@ class TrackStart:
     """A fluid column (an inertia track of mass ``mass``, damping ``damping``) that resonates
     against a bulge stiffness ``stiffness`` and a chamber stiffness ``compliance``, in parallel with
     a static spring ``static``, behind a decoupler of free travel ``travel`` ("" if none): the fit
-    reads their starts off a dynamic-stiffness table's resonance (``identification.fitting.table_start``)."""
+    reads their starts off a dynamic-stiffness table's resonance (``identification.fitting.table_start``).
+    A free decoupler plate also names its cage's ``engagement`` width, the ``cage``'s stiffness and
+    the plate's ``centring`` stiffness ("" where the decoupler has none)."""
     static: str
     stiffness: str
     compliance: str
     mass: str
     damping: str
     travel: str = ""
+    engagement: str = ""
+    cage: str = ""
+    centring: str = ""
 
 
 @dataclass(frozen=True)

@@ -6,8 +6,8 @@ Writes, next to this file, ``<model>_sine_2mm_10Hz.csv`` and ``<model>_step_2mm_
 (columns time_s, displacement_mm, force_N; 1 ms samples) and ``<model>.png`` (hysteresis loop
 and step response) for the proposed model (the paper's Table 5), Spencer's, the single Bouc-Wen
 and Kelvin-Voigt (the project's fitted sets), the filled-rubber models Berg and fractional
-(illustrative sets typed in data/), and the hydraulic mount (rubber path, inertia track,
-decoupler; an illustrative set typed in data/). Running it again rewrites the same bytes on the
+(illustrative sets typed in data/), and the two hydraulic mounts (rubber path, inertia track,
+a membrane or a free-plate decoupler; illustrative sets typed in data/). Running it again rewrites the same bytes on the
 same numpy/scipy/matplotlib.
 
 Independent of the code under test: the equations are typed here from the paper (eqs. 1-5),
@@ -46,6 +46,7 @@ from scipy.integrate import solve_ivp
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import filled_rubber  # noqa: E402  (numpy and scipy only)
+import free_decoupler_mount  # noqa: E402  (numpy and scipy only)
 
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parents[1]
@@ -81,6 +82,11 @@ MODELS = {
     "hydraulic": ("params_hydraulic_mount.json",
                   "hydraulic mount: rubber k0, c0 and a Maxwell element in parallel with bulge kb, inertia track "
                   "mf, cf, ct, bellows kc and a tanh decoupler of travel gap; an illustrative engine mount"),
+    "hydraulic_free_decoupler": ("params_hydraulic_free_decoupler.json",
+                                 "hydraulic mount with a free decoupler plate: rubber k0, k3, c0 and a Maxwell "
+                                 "element in parallel with bulge kb, inertia track mf, cf, ct, bellows kc and a plate "
+                                 "free within +-gap, then caged (kcage, engagement width, centring kd); an "
+                                 "illustrative engine mount (free_decoupler_mount.py)"),
 }
 PATH_MODELS = ("berg", "fractional")
 """Solved on a fine straight-piece path (filled_rubber.py), not by an ODE solver."""
@@ -208,6 +214,8 @@ EQUATIONS = {
     "spencer": (spencer_rhs, spencer_force, spencer_start, [ATOL_MM, ATOL_N]),
     "single_bouc_wen": (single_bouc_wen_rhs, single_bouc_wen_force, single_bouc_wen_start, [ATOL_N]),
     "hydraulic": (hydraulic_rhs, hydraulic_force, hydraulic_start, [ATOL_MM, ATOL_MM_S, ATOL_N]),
+    "hydraulic_free_decoupler": (free_decoupler_mount.rhs, free_decoupler_mount.force, free_decoupler_mount.start,
+                                 [ATOL_MM, ATOL_MM_S, ATOL_N]),
 }
 
 

@@ -43,3 +43,26 @@ def complex_stiffness(p, frequency_hz):
     maxwell = k1 * 1j * omega * c1 / (k1 + 1j * omega * c1)
     track = kc - mf * omega ** 2 + 1j * omega * cf
     return k0 + 1j * omega * c0 + maxwell + kb * track / (kb + track)
+
+
+def free_decoupler_complex_stiffness(p, frequency_hz):
+    """K* [N/mm] of the free-plate mount (fmu_src/models/hydraulic_free_decoupler_model.py) in its
+    linear case: no free travel (gap = 0), no turbulent damping (ct = 0), no cubic spring (k3 = 0).
+
+    With gap = 0 the plate is a membrane held by its centring spring and its cage together:
+    P - (kb + kc)*u = (kd + kcage)*u, so u = P/Kt with Kt = kb + kc + kd + kcage, and the track is
+    driven by dp = a*P with a = (kd + kcage)/Kt. With P = kb*X - (kb + kc)*Y:
+
+    - the fluid column: (a*(kb + kc) - mf*omega^2 + i*omega*cf)*Y = a*kb*X;
+    - the fluid path: kb*(X - Y - U) = kb*((1 - kb/Kt)*X - a*Y) (as U = (kb*X - (kb + kc)*Y)/Kt);
+    - the rubber: k0 + i*omega*c0 and the Maxwell element, as in :func:`complex_stiffness`.
+
+    As kcage grows (a -> 1, kb/Kt -> 0) this is :func:`complex_stiffness`."""
+    omega = 2.0 * np.pi * np.asarray(frequency_hz, dtype=float)
+    k0, c0, k1, c1 = p["k0"], p["c0"], p["k1"], p["c1"]
+    kb, kc, mf, cf, kd, kcage = p["kb"], p["kc"], p["mf"], p["cf"], p["kd"], p["kcage"]
+    total = kb + kc + kd + kcage
+    a = (kd + kcage) / total
+    maxwell = k1 * 1j * omega * c1 / (k1 + 1j * omega * c1)
+    fluid = a * kb / (a * (kb + kc) - mf * omega ** 2 + 1j * omega * cf)
+    return k0 + 1j * omega * c0 + maxwell + kb * ((1.0 - kb / total) - a * fluid)

@@ -1,0 +1,238 @@
+"""A hydraulic mount whose decoupler is a free plate in a cage: inside its free travel the plate
+lets the fluid pass without pumping it through the inertia track, at the cage it engages
+(Flower 1985; Singh, Kim and Ravindra 1992; Geisberger, Khajepour and Golnaraghi 2002), with the
+rubber's progressive spring.
+
+    F   = k0*x + k3*x^3 + c0*dx/dt + f1 + kb*(x - y - u)                 the force [N]
+    df1/dt = k1*dx/dt - (k1/c1)*f1                                       the rubber's Maxwell element
+    P   = kb*(x - y) - kc*y                                              the chambers' pressure difference,
+                                                                         plate held at its centre [N]
+    u   = P/K - kcage/(K*(K + kcage)) * D(P),   K = kb + kc + kd         the plate's travel [mm]
+    D(P) = W*(softplus((P - K*gap)/W) - softplus((-P - K*gap)/W)),   W = K*width
+    dp  = P - (kb + kc)*u                                                what drives the track [N]
+    dy/dt = w,   mf*dw/dt = dp - cf*w - ct*|w|*w                         the fluid in the inertia track
+
+The plate is massless: it sits where the pressure across it, P - (kb + kc)*u, balances its weak
+centring spring kd*u and, beyond its free travel gap, the cage kcage*(|u| - gap). That balance
+is piecewise linear in P, and u above is its solution with the cage's corner rounded by a
+softplus over a width of about ``width`` [mm] of plate travel (D is the dead zone of the
+pressure: 0 inside +-K*gap, P -+ K*gap beyond). So, while |P| < K*gap, the plate follows the
+pressure (u = P/K), the track sees only dp = P*kd/K, a few percent of it, and the fluid path is
+the bulge in series with the bellows, almost without damping; beyond, the plate rests on its cage
+and the column is driven by nearly the whole pressure: the loss-angle peak near the track's
+resonance sqrt((kb + kc)/mf)/(2*pi) and the stiffness notch below it. The centring spring kd is
+what brings the column back to rest (without it, the column would have a line of equilibria
+inside the gap).
+
+With width > 0 every kernel is smooth (the softplus is analytic; |w|*w has the continuous
+derivative 2*|w|); width = 0 is the hard cage, whose corner at |P| = K*gap the model states as its
+two switches, P - K*gap and P + K*gap [N] (the event indicators of model exchange; with width > 0
+they mark where the cage engages). The saturating membrane of ``hydraulic_model`` is the other
+decoupler kind; with gap = 0 this one is a linear membrane of stiffness kd + kcage.
+
+Units N-mm-s; the state is ``(y, w, f1)`` as in ``hydraulic_model`` (fluid displacement [mm] and
+velocity [mm/s] in the mount's coordinates, the Maxwell force [N]), stepped the same way: the
+Maxwell element exactly, the fluid column by the classical Runge-Kutta method on substeps of at
+most ``hydraulic_model.THETA_TRACK`` over its fastest rate, which bounds the engaged column's too
+(the plate only softens what the column feels).
+
+With the default set a sine from rest settles within ``settling_s`` = 2 s: inside the gap the
+column returns to centre with the time constant cf*K/((kb + kc)*kd), 0.27 s.
+"""
+from __future__ import annotations
+
+import math
+
+from ..model.parameter_specs import DAMPING, SPRING, ParameterSpec
+from ..model.integration import NOT_FINITE, OK, TOO_MANY_SUBSTEPS, maxwell_decay, maxwell_step
+from ..model.definition import BushingModel, SearchBox, SearchCoordinate, StateSpec, TrackStart
+from ..model.search_coordinates import KIND
+from .berg_model import CUBIC
+from .hydraulic_model import POSITIVE, THETA_TRACK
+
+PARAMETER_SPECS = (
+    ParameterSpec("k0", "N/mm", "the rubber's static stiffness", **SPRING),
+    ParameterSpec("k3", "N/mm^3", "the rubber's cubic stiffness: the progressive spring k0*x + k3*x^3", **CUBIC),
+    ParameterSpec("c0", "N.s/mm", "the rubber's viscous damping", **DAMPING),
+    ParameterSpec("k1", "N/mm", "spring of the rubber's Maxwell element", **SPRING),
+    ParameterSpec("c1", "N.s/mm", "dashpot of the rubber's Maxwell element (relaxation time c1/k1)",
+                  **POSITIVE, why="it sets the Maxwell element's rate k1/c1"),
+    ParameterSpec("kb", "N/mm", "the upper chamber's bulge stiffness: the fluid path's stiffness when the "
+                  "fluid cannot move", **POSITIVE, why="the fluid path acts through it (a mount without "
+                  "one is the rubber path alone: another model)"),
+    ParameterSpec("kc", "N/mm", "the lower chamber's (bellows') stiffness against the volume pumped", **SPRING),
+    ParameterSpec("mf", "N.s^2/mm", "the inertia track's fluid as an effective mass at the mount",
+                  **POSITIVE, why="the fluid column's equation divides by it"),
+    ParameterSpec("cf", "N.s/mm", "the inertia track's linear (laminar) damping", **DAMPING),
+    ParameterSpec("ct", "N.s^2/mm^2", "the inertia track's turbulent damping, force ct*|w|*w",
+                  minimum=0.0, why="a negative turbulent damping adds energy", bound_powers=(0, 2)),
+    ParameterSpec("gap", "mm", "the decoupler plate's free travel each way before it meets its cage "
+                  "(0: a membrane of stiffness kd + kcage)", minimum=0.0, why="a travel is a magnitude"),
+    ParameterSpec("width", "mm", "the width of plate travel over which the cage engages (0: a hard cage, "
+                  "a corner at |u| = gap)", minimum=0.0, why="a width is a magnitude"),
+    ParameterSpec("kcage", "N/mm", "the cage's stiffness against the plate beyond its free travel", **SPRING),
+    ParameterSpec("kd", "N/mm", "the plate's weak centring stiffness within its travel", **POSITIVE,
+                  why="a plate without one leaves the fluid column no rest position"),
+)
+
+
+# ---------------------------------------------------------------------------- kernels
+def prepare(p):
+    """(k0, k3, c0, k1, rate1 = k1/c1, kb, kc, mf, cf, ct, K*gap, W = K*width,
+    kcage/(K*(K + kcage)), 1/K) with K = kb + kc + kd, from the 14 values in ``PARAMETER_SPECS`` order."""
+    k0, k3, c0, k1, c1, kb, kc, mf, cf, ct, gap, width, kcage, kd = p
+    stiffness = kb + kc + kd
+    return (k0, k3, c0, k1, k1 / c1, kb, kc, mf, cf, ct, stiffness * gap, stiffness * width,
+            kcage / (stiffness * (stiffness + kcage)), 1.0 / stiffness)
+
+
+def softplus(z):
+    """log(1 + exp(z)), written so that exp never overflows (both branches are the same analytic
+    function)."""
+    if z > 0.0:
+        return z + math.log(1.0 + math.exp(-z))
+    return math.log(1.0 + math.exp(z))
+
+
+def pressure_dead_zone(pressure, free, width):
+    """D(P) [N] (module docstring): 0 inside +-``free`` = K*gap, P -+ free beyond, the corners
+    rounded over ``width`` = K*width [N]; the hard corners where ``width`` = 0."""
+    if width <= 0.0:
+        if pressure > free:
+            return pressure - free
+        if pressure < -free:
+            return pressure + free
+        return 0.0
+    return width * (softplus((pressure - free) / width) - softplus((-pressure - free) / width))
+
+
+def track_force(kb, kc, free, width, cage, compliance, y, x):
+    """(the force kb*(x - y - u) the fluid path puts on the mount [N], the pressure difference dp
+    that drives the track [N]) at mount displacement x and fluid displacement y [mm]; ``free``,
+    ``width``, ``cage`` and ``compliance`` are ``prepare``'s K*gap, K*width, kcage/(K*(K + kcage)) and 1/K."""
+    pressure = kb * (x - y) - kc * y
+    u = pressure * compliance - cage * pressure_dead_zone(pressure, free, width)
+    return kb * (x - y - u), pressure - (kb + kc) * u
+
+
+def track_acceleration(kb, kc, mf, cf, ct, free, width, cage, compliance, y, w, x):
+    """dw/dt [mm/s^2] of the fluid column at mount displacement x."""
+    bulge, drive = track_force(kb, kc, free, width, cage, compliance, y, x)
+    return (drive - cf * w - ct * abs(w) * w) / mf
+
+
+def initial_state(m, x0):
+    """At rest at x0 [mm]: the chambers' pressures equal (P = 0: y = kb*x0/(kb + kc), the plate
+    centred), the fluid still, the Maxwell element relaxed."""
+    k0, k3, c0, k1, rate1, kb, kc, mf, cf, ct, free, width, cage, compliance = m
+    return (kb * x0 / (kb + kc), 0.0, 0.0)
+
+
+def force(m, state, x, v):
+    """F = k0*x + k3*x^3 + c0*v + f1 + kb*(x - y - u) [N], positive for positive x."""
+    k0, k3, c0, k1, rate1, kb, kc, mf, cf, ct, free, width, cage, compliance = m
+    y, w, f1 = state
+    bulge, drive = track_force(kb, kc, free, width, cage, compliance, y, x)
+    return k0 * x + k3 * x * x * x + c0 * v + f1 + bulge
+
+
+def jump(m, state, jump_mm):
+    """An instantaneous displacement jump: the fluid cannot move in no time (its mass) and the
+    plate follows the pressure (it is massless); the Maxwell spring takes the jump."""
+    k0, k3, c0, k1, rate1, kb, kc, mf, cf, ct, free, width, cage, compliance = m
+    y, w, f1 = state
+    return (y, w, f1 + k1 * jump_mm), OK
+
+
+def track_substeps(kb, kc, mf, cf, ct, w, h):
+    """The substeps over h [s] that keep each within THETA_TRACK of the column's fastest rate,
+    the rate of the column with the plate on its cage (``hydraulic_model.track_substeps``'s
+    bound: a kernel of another model's module is not compiled into this one's)."""
+    rate = math.sqrt((kb + kc) / mf) + (cf + 2.0 * ct * abs(w)) / mf
+    count = h * rate / THETA_TRACK
+    if not count < 1e9:         # inf or NaN (w not finite, mf vanishing): more than any budget
+        return 1_000_000_000
+    return max(1, int(math.ceil(count)))
+
+
+def integrate(m, state, x, v, h, max_substeps):
+    """Over the step x + v*t: the Maxwell force exactly, the fluid column by the classical
+    Runge-Kutta method on equal substeps (module docstring); returns (state, substeps, status)."""
+    k0, k3, c0, k1, rate1, kb, kc, mf, cf, ct, free, width, cage, compliance = m
+    y, w, f1 = state
+    n = track_substeps(kb, kc, mf, cf, ct, w, h)
+    if n > max_substeps:
+        return state, n, TOO_MANY_SUBSTEPS
+    s = h / n
+    for i in range(n):
+        x0 = x + v * (i * s)
+        a1 = track_acceleration(kb, kc, mf, cf, ct, free, width, cage, compliance, y, w, x0)
+        y2 = y + 0.5 * s * w
+        w2 = w + 0.5 * s * a1
+        a2 = track_acceleration(kb, kc, mf, cf, ct, free, width, cage, compliance, y2, w2, x0 + 0.5 * s * v)
+        y3 = y + 0.5 * s * w2
+        w3 = w + 0.5 * s * a2
+        a3 = track_acceleration(kb, kc, mf, cf, ct, free, width, cage, compliance, y3, w3, x0 + 0.5 * s * v)
+        y4 = y + s * w3
+        w4 = w + s * a3
+        a4 = track_acceleration(kb, kc, mf, cf, ct, free, width, cage, compliance, y4, w4, x0 + s * v)
+        y = y + s / 6.0 * (w + 2.0 * w2 + 2.0 * w3 + w4)
+        w = w + s / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
+    new = (y, w, maxwell_step(f1, k1, maxwell_decay(rate1, h), v, h))
+    if not (math.isfinite(new[0]) and math.isfinite(new[1]) and math.isfinite(new[2])):
+        return new, n, NOT_FINITE
+    return new, n, OK
+
+
+def derivatives(m, state, x, v):
+    """(dy/dt, dw/dt, df1/dt) [mm/s, mm/s^2, N/s] (model exchange)."""
+    k0, k3, c0, k1, rate1, kb, kc, mf, cf, ct, free, width, cage, compliance = m
+    y, w, f1 = state
+    return (w, track_acceleration(kb, kc, mf, cf, ct, free, width, cage, compliance, y, w, x), k1 * v - rate1 * f1)
+
+
+def switches(m, state, x, v):
+    """(P - K*gap, P + K*gap) [N]: where either changes sign the plate meets or leaves its cage."""
+    k0, k3, c0, k1, rate1, kb, kc, mf, cf, ct, free, width, cage, compliance = m
+    y, w, f1 = state
+    pressure = kb * (x - y) - kc * y
+    return (pressure - free, pressure + free)
+
+
+SEARCH = SearchBox(
+    (SearchCoordinate("k0", KIND.stiffness, -3.0, 1.0), SearchCoordinate("k3", KIND.cubic, 0.0, 2.0),
+     SearchCoordinate("c0", KIND.damping, -5.0, 1.0),
+     SearchCoordinate("k1", KIND.stiffness, -4.0, 1.0),
+     SearchCoordinate("c1", KIND.time_constant, -math.inf, 4.0, over=("k1",)),
+     SearchCoordinate("kb", KIND.stiffness, -3.0, 1.0), SearchCoordinate("kc", KIND.stiffness, -4.0, 0.5),
+     SearchCoordinate("mf", KIND.resonance, math.log10(0.3), math.log10(300.0), over=("kb", "kc")),
+     SearchCoordinate("cf", KIND.damping_ratio, -3.0, 0.5, over=("kb", "kc"), partner="mf"),
+     SearchCoordinate("ct", KIND.quadratic_damping, -6.0, 1.0),
+     SearchCoordinate("gap", KIND.travel, -4.0, 0.5), SearchCoordinate("width", KIND.travel, -5.0, -1.0),
+     SearchCoordinate("kcage", KIND.stiffness, -2.0, 2.0), SearchCoordinate("kd", KIND.stiffness, -5.0, 0.0)),
+    table_start=TrackStart(static="k0", stiffness="kb", compliance="kc", mass="mf", damping="cf", travel="gap",
+                           engagement="width", cage="kcage", centring="kd"))
+"""The fit's box, as ``hydraulic_model``'s for the rubber and the track; the cubic term as
+k3*X^2/k_ref (0 to 2), the plate's free travel and its engagement width against the largest
+amplitude X (1e-4 to 3 X and 1e-5 to 0.1 X), the cage and the centring spring against k_ref,
+log10 all. A data sheet gives starts for the track, the gap, the width and the cage
+(identification/fitting/table_start.py)."""
+
+
+MODEL = BushingModel(
+    "hydraulic_free_decoupler", "HydraulicFreeDecoupler",
+    "Hydraulic mount with a free decoupler plate: rubber, inertia track, plate in a cage",
+    PARAMETER_SPECS,
+    (StateSpec("y", 0, "m", "the fluid column's displacement, in the mount's coordinates"),
+     StateSpec("w", 1, "m/s", "the fluid column's velocity, in the mount's coordinates"),
+     StateSpec("f1", 2, "N", "force of the rubber's Maxwell element")),
+    "params_hydraulic_free_decoupler.json", prepare, initial_state, jump, integrate, force, derivatives, switches,
+    switch_specs=(StateSpec("P_minus_free", 0, "N", "pressure difference less the plate's free travel times K: "
+                            "where it changes sign the plate meets or leaves the cage (positive side)"),
+                  StateSpec("P_plus_free", 1, "N", "pressure difference plus the plate's free travel times K: "
+                            "where it changes sign the plate meets or leaves the cage (negative side)")),
+    search=SEARCH, plot_style=("C9", "-"), rank=55, settling_s=2.0,
+    description="Hydraulic engine mount with a free decoupler plate (one axis): a rubber path (progressive spring, "
+                "dashpot, Maxwell element) in parallel with a fluid path (bulge stiffness, inertia track with linear "
+                "and turbulent damping, lower chamber, a plate free within +-gap, then caged); FMI ports in SI units, "
+                "parameters in N-mm-s.")
