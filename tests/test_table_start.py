@@ -37,6 +37,23 @@ def test_the_synthetic_sheet_gives_the_track_near_its_truth():
     assert "fluid track from the data sheet" in start.describe()
 
 
+def test_a_free_plates_sheet_gives_its_gap_and_starts_for_its_cage():
+    # data/generate_hydraulic_free_decoupler.py's training sheet, made by scipy from a hard-caged
+    # plate free within +-0.12 mm (truth typed there: kb 280, kc 30, mf 0.09, a 9.34 Hz track);
+    # measured: resonance 8.4 Hz, kb 268, gap 0.20 mm, then the stated proportions of the cage
+    table = load_kdyn_table(REPO / "data" / "kdyn_synthetic_free_decoupler_train.csv")
+    start = table_start(table, SearchSpace.from_table(table, "hydraulic_free_decoupler"))
+    assert isinstance(start, TableStart) and not start.missing
+    p = start.parameters
+    assert resonance_hz(p) == pytest.approx(9.34, rel=0.15)
+    assert 0.5 * 0.12 <= p["gap"] <= 2.0 * 0.12
+    assert p["width"] == pytest.approx(0.05 * p["gap"], rel=1e-12)
+    assert p["kcage"] == pytest.approx(10.0 * (p["kb"] + p["kc"]), rel=1e-12)
+    assert p["kd"] == pytest.approx(0.02 * (p["kb"] + p["kc"]), rel=1e-12)
+    space = SearchSpace.from_table(table, "hydraulic_free_decoupler")
+    assert {space.names[i] for i in anchored_coordinates(start, space)} == set(p)
+
+
 def test_the_anchored_coordinates_are_the_starts_in_the_box():
     table = load_kdyn_table(TRAIN)
     space = SearchSpace.from_table(table, "hydraulic")

@@ -209,13 +209,15 @@ SEARCH = SearchBox(
      SearchCoordinate("cf", KIND.damping_ratio, -3.0, 0.5, over=("kb", "kc"), partner="mf"),
      SearchCoordinate("ct", KIND.quadratic_damping, -6.0, 1.0),
      SearchCoordinate("gap", KIND.travel, -4.0, 0.5), SearchCoordinate("width", KIND.travel, -5.0, -1.0),
-     SearchCoordinate("kcage", KIND.stiffness, -2.0, 2.0), SearchCoordinate("kd", KIND.stiffness, -5.0, 0.0)),
+     SearchCoordinate("kcage", KIND.stiffness, -2.0, 2.0), SearchCoordinate("kd", KIND.stiffness, -2.5, 0.0)),
     table_start=TrackStart(static="k0", stiffness="kb", compliance="kc", mass="mf", damping="cf", travel="gap",
                            engagement="width", cage="kcage", centring="kd"))
 """The fit's box, as ``hydraulic_model``'s for the rubber and the track; the cubic term as
 k3*X^2/k_ref (0 to 2), the plate's free travel and its engagement width against the largest
 amplitude X (1e-4 to 3 X and 1e-5 to 0.1 X), the cage and the centring spring against k_ref,
-log10 all. A data sheet gives starts for the track, the gap, the width and the cage
+log10 all. The centring spring stays above 10^-2.5 k_ref: a weaker one would leave the
+column unsettled after the fit loop's settling time, a steady state the fit must not be able to
+trade for a transient. A data sheet gives starts for the track, the gap, the width and the cage
 (identification/fitting/table_start.py)."""
 
 

@@ -23,10 +23,13 @@ reads back from it (at the table's largest amplitude, where the decoupler rests 
   column's kb^2/(omega_r*cf) dominates there;
 - the static spring k0 = K'(lowest frequency) - kb*kc/(kb + kc) (at least 1 % of it);
 - the decoupler's travel from the amplitudes: the peak appears once the pressure kb*X exceeds
-  what the membrane takes, (kb + kc + kd)*gap with kd its stiffness, taken as small against
-  kb + kc (a soft membrane), so gap is about kb/(kb + kc) times the smallest
-  amplitude whose peak loss angle reaches half the largest amplitude's (the geometric mean of it
-  and the largest amplitude below it, where the table has one).
+  what the membrane (or the free plate) takes, (kb + kc + kd)*gap with kd its stiffness, taken as
+  small against kb + kc (a soft membrane, a weakly centred plate), so gap is about kb/(kb + kc)
+  times the smallest amplitude whose peak loss angle reaches half the largest amplitude's (the
+  geometric mean of it and the largest amplitude below it, where the table has one);
+- a free plate's cage (``TrackStart.engagement``, ``cage``, ``centring``), which the sheet's
+  few amplitudes do not resolve: an engagement over 5 % of the travel, a cage ten times as stiff
+  as the chambers (kb + kc) and a centring spring 2 % of them.
 
 Read at one preload: the table's most common one among the largest amplitude's rows (the one
 nearest 0 of equally common ones). What the table cannot give (no peak of the loss stiffness
@@ -49,6 +52,11 @@ from identification.fitting.search_space import SearchSpace
 
 MIN_FREQUENCIES = 3
 """Frequencies at the largest amplitude below which no resonance is read."""
+ENGAGEMENT_SHARE = 0.05
+CAGE_TIMES = 10.0
+CENTRING_SHARE = 0.02
+"""A free plate's starts (:func:`_free_plate`): what the sheet does not resolve, so typical
+proportions of a hydromount's decoupler, left to the fit to move."""
 
 
 @dataclass(frozen=True)
@@ -118,7 +126,22 @@ def table_start(table: KdynTable | None, space: SearchSpace) -> TableStart | str
                        "the box")
         else:
             values[track.travel] = travel
+            values.update(_free_plate(track, travel, bulge + chamber))
     return TableStart(values, table.source, missing)
+
+
+def _free_plate(track, travel: float, chambers: float) -> dict[str, float]:
+    """Starts for a free decoupler plate's cage (those ``track`` names): the cage engaging over
+    ENGAGEMENT_SHARE of the free travel, CAGE_TIMES the chambers' stiffness kb + kc (a cage
+    much stiffer than the walls the fluid bulges), a centring spring CENTRING_SHARE of it."""
+    values = {}
+    if track.engagement:
+        values[track.engagement] = ENGAGEMENT_SHARE * travel
+    if track.cage:
+        values[track.cage] = CAGE_TIMES * chambers
+    if track.centring:
+        values[track.centring] = CENTRING_SHARE * chambers
+    return values
 
 
 def _travel(amplitude: np.ndarray, angle: np.ndarray, largest: float, share: float) -> float | None:
