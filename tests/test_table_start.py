@@ -107,3 +107,52 @@ def test_a_model_without_a_track_and_no_table_give_no_start():
     table = load_kdyn_table(TRAIN)
     assert table_start(table, SearchSpace.from_table(table, "berg")) is None
     assert table_start(None, SearchSpace.from_table(table, "hydraulic")) is None
+
+
+def _sine_tests(params, amplitude_mm, frequencies_hz, model="hydraulic"):
+    """2 s sines from rest at 1 kHz, the model's force (no noise), as rig tests."""
+    from identification.forward.simulate import simulate
+    from identification.measured.measurements import Measurement
+    from identification.measured.rig_tests import RigTest
+    t = np.arange(2001) / 1000.0
+    tests = []
+    for f in frequencies_hz:
+        x = amplitude_mm * np.sin(2.0 * np.pi * f * t)
+        v = amplitude_mm * 2.0 * np.pi * f * np.cos(2.0 * np.pi * f * t)
+        force = simulate(params, t, x, v, model=model)
+        tests.append(RigTest(Measurement(t, x, force, v, source=f"sine_{f:g}Hz.csv"), kind="sine"))
+    return tests
+
+
+def test_a_sines_first_harmonic_is_the_closed_forms_stiffness():
+    # the linear mount (no decoupler, no turbulence): each sine's reading against the closed form
+    # typed in tests/references/hydraulic_closed_form.py; its later half is settled (the column's
+    # transient decays as exp(-9.3/s*t)), the secant sine's harmonic is within (pi/(1000/f))^2/3
+    import importlib.util
+    from identification.fitting.table_start import sines_as_table
+    spec = importlib.util.spec_from_file_location("closed_form", REPO / "tests" / "references" / "hydraulic_closed_form.py")
+    closed_form = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(closed_form)
+    linear = dict(TRUTH, gap=0.0, ct=0.0)
+    frequencies = (3.0, 8.0, 12.0)
+    table = sines_as_table(_sine_tests(linear, 1.0, frequencies))
+    expected = closed_form.complex_stiffness(linear, np.array(frequencies))
+    np.testing.assert_allclose(table.frequency_hz, frequencies, rtol=1e-6)   # interpolated crossings: observed 4e-8
+    np.testing.assert_allclose(table.kdyn_N_per_mm, np.abs(expected), rtol=1e-3)       # observed <= 2.0e-4
+    np.testing.assert_allclose(table.loss_angle_deg, np.degrees(np.angle(expected)), atol=0.05)   # observed 0.019
+    assert table.amplitude_mm.tolist() == [1.0, 1.0, 1.0]
+
+
+def test_sines_alone_give_the_track_a_start_and_one_sine_says_why_not():
+    # time series alone: sines of 1 mm at five frequencies around the membrane mount's track
+    # (truth 9.98 Hz) give its resonance; one sine cannot, and the note says what would
+    from identification.fitting.table_start import sines_as_table
+    tests = _sine_tests(TRUTH, 1.0, (5.0, 7.0, 9.0, 11.0, 14.0))
+    table = sines_as_table(tests)
+    space = SearchSpace(300.0, 1.0, 600.0, 1.0, "hydraulic", 2.0)
+    start = table_start(table, space)
+    assert isinstance(start, TableStart)
+    assert resonance_hz(start.parameters) == pytest.approx(resonance_hz(TRUTH), rel=0.15)     # observed 9.08 Hz
+    assert "single amplitude" in start.missing and "sine_9Hz.csv" in start.describe()
+    note = table_start(sines_as_table(tests[2:3]), space)
+    assert isinstance(note, str) and "a single frequency" in note and "sines at 3 or more frequencies" in note

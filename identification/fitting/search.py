@@ -39,7 +39,7 @@ from identification.fitting.progress import SearchProgress
 from identification.fitting.refinement import refine_steps
 from identification.fitting.search_space import SearchSpace
 from identification.forward.simulate import simulate_multiaxis, simulate
-from identification.fitting.table_start import table_start
+from identification.fitting.table_start import sines_as_table, table_start
 
 
 @dataclass(frozen=True)
@@ -176,7 +176,10 @@ class _Search:
             return None
         loop = slow_loop_start(request.tests, self.space)
         if loop is None:
-            loop = table_start(request.table, self.space)
+            table = request.table
+            if table is None and self.space.bushing.search.table_start is not None:
+                table = sines_as_table(request.tests)       # time series alone: their sines' harmonics
+            loop = table_start(table, self.space)
             if isinstance(loop, str):           # the table gives no start, and why
                 self.notes.append(loop)
                 loop = None

@@ -31,6 +31,10 @@ reads back from it (at the table's largest amplitude, where the decoupler rests 
   few amplitudes do not resolve: an engagement over 5 % of the travel, a cage ten times as stiff
   as the chambers (kb + kc) and a centring spring 2 % of them.
 
+Time series alone (no table) give the same starts where their sines do: :func:`sines_as_table`
+reads each sine's first harmonic, and sines at three or more frequencies at their largest
+amplitude give the track, as a table's rows would.
+
 Read at one preload: the table's most common one among the largest amplitude's rows (the one
 nearest 0 of equally common ones). What the table cannot give (no peak of the loss stiffness
 inside its frequencies, fewer than three frequencies, a single amplitude for the travel) is left
@@ -44,10 +48,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
+from typing import Sequence
 
 import numpy as np
 
 from identification.measured.kdyn_table import KdynTable
+from identification.measured.rig_tests import RigTest
 from identification.fitting.search_space import SearchSpace
 
 MIN_FREQUENCIES = 3
@@ -70,6 +77,56 @@ class TableStart:
         values = ", ".join(f"{name} = {value:.4g}" for name, value in self.parameters.items())
         return (f"fluid track from the data sheet {self.source}: {values}"
                 + (f" ({self.missing})" if self.missing else ""))
+
+
+def sine_frequency_hz(time_s: np.ndarray, displacement_mm: np.ndarray) -> float:
+    """A sine's frequency [Hz]: whole cycles between its first and last upward mean-crossings over
+    the time between them, each crossing placed by linear interpolation between its samples; 0
+    with fewer than two crossings."""
+    x = displacement_mm - np.mean(displacement_mm)
+    up = np.flatnonzero((x[:-1] < 0.0) & (x[1:] >= 0.0))
+    if up.size < 2:
+        return 0.0
+    crossing = time_s[up] + (time_s[up + 1] - time_s[up]) * (-x[up]) / (x[up + 1] - x[up])
+    return (up.size - 1) / (crossing[-1] - crossing[0])
+
+
+def sines_as_table(tests: Sequence[RigTest]) -> KdynTable | None:
+    """The sine tests' first harmonics as a data sheet, for a fit given time series alone: each
+    sine's |K*| and loss angle from a least-squares fit of a sine, a cosine and a constant at its
+    frequency (``loop_start.dominant_frequency_hz``) to its displacement and its force over the
+    later half of its whole cycles (the earlier half holds the settling from rest), the amplitude
+    rounded to two significant digits so that sines at one nominal amplitude make one row set.
+    None where fewer than one sine has two whole cycles."""
+    rows, names = [], []
+    for test in tests:
+        m = test.measurement
+        frequency = sine_frequency_hz(m.time_s, m.displacement_mm) if test.kind == "sine" else 0.0
+        cycles = math.floor(frequency * (m.time_s[-1] - m.time_s[0])) if frequency > 0 else 0
+        if cycles < 2:
+            continue
+        window = m.time_s >= m.time_s[-1] - math.ceil(cycles / 2) / frequency
+        phase = 2.0 * math.pi * frequency * m.time_s[window]
+        basis = np.column_stack([np.sin(phase), np.cos(phase), np.ones(phase.size)])
+        (xs, xc, _), (fs, fc, _) = np.linalg.lstsq(basis, np.column_stack(
+            [m.displacement_mm[window], m.force_N[window]]), rcond=None)[0].T
+        stiffness = complex(fc, -fs) / complex(xc, -xs)    # phasors: a*sin + b*cos = Re((b - i*a)*exp(i*phase))
+        angle = math.degrees(math.atan2(stiffness.imag, stiffness.real))
+        if not (0.0 < angle < 90.0 and stiffness.real > 0.0):
+            continue                                        # no spring-and-damper reading (noise, a bad test)
+        amplitude = float(f"{abs(complex(xc, -xs)):.2g}")
+        rows.append((amplitude, frequency, abs(stiffness), angle))
+        names.append(m.source and Path(m.source).name or test.name)
+    if not rows:
+        return None
+    amplitude, frequency, kdyn, angle = (np.array(column) for column in zip(*rows))
+    return KdynTable(amplitude, frequency, np.zeros(amplitude.size), kdyn, angle, np.ones(amplitude.size),
+                     f"of the sines' first harmonics ({', '.join(names)})")
+
+
+def _named(table: KdynTable) -> str:
+    """How a note names the table: by its source (a file, or the sines it was read from)."""
+    return f"the table {table.source}"
 
 
 def _peak_frequency(frequency: np.ndarray, values: np.ndarray) -> float | None:
@@ -102,13 +159,14 @@ def table_start(table: KdynTable | None, space: SearchSpace) -> TableStart | str
     at = f"at its largest amplitude ({largest:g} mm" + (f", preload {preload:g} mm)" if preload else ")")
     if rows.size < MIN_FREQUENCIES:
         count = "a single frequency" if rows.size == 1 else f"{rows.size} frequencies"
-        return (f"note: the table has {count} {at}, fewer than {MIN_FREQUENCIES}: no resonance to read, the fit "
-                "starts from the default box")
+        return (f"note: {_named(table)} has {count} {at}, fewer than {MIN_FREQUENCIES}: no resonance to read, the "
+                f"fit starts from the default box (sines at {MIN_FREQUENCIES} or more frequencies around the track's "
+                "resonance give it a start)")
     f, k, d = frequency[rows], kdyn[rows], np.radians(angle[rows])
     storage, loss = k * np.cos(d), k * np.sin(d)
     resonance = _peak_frequency(f, loss)
     if resonance is None:
-        return (f"note: the table's loss stiffness {at} has no peak inside its frequencies "
+        return (f"note: the loss stiffness of {_named(table)} {at} has no peak inside its frequencies "
                 f"({f[0]:g}-{f[-1]:g} Hz): no resonance to read, the fit starts from the default box")
     bulge = max(storage[-1] - storage[0], 0.01 * storage[0])
     chamber = 0.1 * bulge
