@@ -86,11 +86,18 @@ def prepare(p):
             kcage / (stiffness * (stiffness + kcage)), 1.0 / stiffness)
 
 
+SOFTPLUS_FLOOR = -37.0
+"""Below it log(1 + exp(z)) < 8.6e-17, under half a unit of the last place of 1: :func:`softplus` is
+0 there, and the dead zone's far side (and the near one, away from the cage) costs no exp."""
+
+
 def softplus(z):
     """log(1 + exp(z)), written so that exp never overflows (both branches are the same analytic
-    function)."""
+    function); 0 below SOFTPLUS_FLOOR."""
     if z > 0.0:
         return z + math.log(1.0 + math.exp(-z))
+    if z < SOFTPLUS_FLOOR:
+        return 0.0
     return math.log(1.0 + math.exp(z))
 
 
