@@ -6,6 +6,7 @@ only), and the physics a free plate must show: inside its gap the fluid path let
 """
 import importlib.util
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -135,3 +136,19 @@ def test_switches_are_where_the_plate_meets_its_cage():
     pressure = HARD["kb"] * (x - 0.2) - HARD["kc"] * 0.2
     assert bushing.switches(constants, state, x, 1.0) == pytest.approx((pressure - free, pressure + free), rel=1e-14)
     assert bushing.update is None and len(bushing.switch_specs) == 2
+
+
+@pytest.mark.parametrize("name, value, says", [("gap", -0.12, "gap = -0.12 [mm] must be >= 0"),
+                                               ("width", -0.005, "width = -0.005 [mm] must be >= 0"),
+                                               ("kcage", -1.0, "kcage = -1.0 [N/mm] must be >= 0")])
+def test_a_parameter_file_with_a_negative_travel_width_or_cage_is_refused(tmp_path, name, value, says):
+    # the parameter files' reader (the FMUs' refusals are in tests/test_fmu_baselines.py)
+    from fmu_src.parameter_files import load_parameters
+    from fmu_src.model.parameter_specs import ParameterError
+    document = json.loads((Path(__file__).resolve().parents[1] / "data"
+                           / "params_hydraulic_free_decoupler.json").read_text())
+    document["parameters"][name] = value
+    path = tmp_path / "bad.json"
+    path.write_text(json.dumps(document))
+    with pytest.raises(ParameterError, match=re.escape(says)):
+        load_parameters(path, MODEL)
