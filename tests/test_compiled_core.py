@@ -152,3 +152,64 @@ def test_a_changed_model_source_compiles_afresh_instead_of_loading_stale_machine
     edited, hits, misses = probe()
     assert (hits, misses) == (0, 1)                      # compiled afresh ...
     assert edited - original == pytest.approx(100.0 * 0.02, rel=1e-9)   # ... with the edited force law (x = 0.02 mm)
+
+
+SPENCER_FORCES = """
+import numpy as np
+from identification.forward import population as compiled_core
+t = np.linspace(0.0, 0.05, 51)
+values = {"c0": 1.0, "k0": 1.0, "c1": 1.0, "k1": 100.0, "x0": 0.0, "alpha": 1.0, "A": 1.0, "beta": 0.5,
+          "gamma": 0.5, "n": 2.0}
+forces = compiled_core.simulate_population_held([values], t, np.sin(60.0 * t), 60.0 * np.cos(60.0 * t), model="spencer")
+print(" ".join(repr(float(f)) for f in forces[0]))
+"""
+
+
+def _spencer_process(cache_dir):
+    import os
+    import subprocess
+    import sys
+    from conftest import REPO
+    environment = dict(os.environ, BUSHING_CACHE_DIR=str(cache_dir), PYTHONPATH=str(REPO))
+    return subprocess.Popen([sys.executable, "-c", SPENCER_FORCES], env=environment, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, cwd=REPO)
+
+
+def _spencer_forces_here():
+    namespace = {}
+    exec(SPENCER_FORCES.replace("print(", "result = ("), namespace)
+    return namespace["result"]
+
+
+@pytest.mark.slow   # two processes compiling at once: CI's slow phase
+def test_two_processes_compiling_the_same_model_at_once_both_give_its_forces(tmp_path):
+    # issue 50, nothing lost: both start on an empty cache and compile the same generated module
+    # at the same moment; each gives the forces bit for bit, and a third process then loads them
+    first, second = _spencer_process(tmp_path), _spencer_process(tmp_path)
+    outputs = [process.communicate(timeout=600) for process in (first, second)]
+    assert [process.returncode for process in (first, second)] == [0, 0], [err[-2000:] for _, err in outputs]
+    expected = _spencer_forces_here()
+    for printed, _ in outputs:
+        assert printed.split() == expected.split()
+    third = _spencer_process(tmp_path)
+    printed, error = third.communicate(timeout=600)
+    assert third.returncode == 0 and printed.split() == expected.split(), error[-2000:]
+    assert not list(tmp_path.glob("*.tmp")), "a half-written generated module was left behind"
+
+
+@pytest.mark.slow
+def test_a_compile_stopped_by_a_signal_leaves_a_cache_the_next_process_uses(tmp_path):
+    # issue 50, nothing lost: SIGKILL (no handler can run) while the model compiles, at several
+    # moments; whatever the stop left in the cache, the next process gives the forces bit for bit
+    import signal
+    import time
+    expected = _spencer_forces_here()
+    for delay in (0.5, 1.5, 3.0):
+        cache = tmp_path / f"stopped_after_{delay}s"
+        stopped = _spencer_process(cache)
+        time.sleep(delay)
+        stopped.send_signal(signal.SIGKILL)
+        stopped.communicate(timeout=60)
+        after = _spencer_process(cache)
+        printed, error = after.communicate(timeout=600)
+        assert after.returncode == 0 and printed.split() == expected.split(), (delay, error[-2000:])
