@@ -289,15 +289,15 @@ def test_the_fit_takes_differences_where_the_exact_jacobian_would_not_pay(table2
     differences, the second with a note that names the folder and the way out."""
     from identification.fitting import search as fitting
     space = table2_problem.space
-    assert fitting._exact_jacobian_or_why_not([], space, False) == ("difference", None)
+    assert fitting._exact_jacobian_or_why_not([], space) == ("difference", None)
     blocked = tmp_path / "file_not_folder"
     blocked.write_text("")
     monkeypatch.setattr(fitting, "cache_directory", lambda: blocked / "cache")
-    kind, note = fitting._exact_jacobian_or_why_not(table2_problem.objective.tests, space, False)
+    kind, note = fitting._exact_jacobian_or_why_not(table2_problem.objective.tests, space)
     assert kind == "difference"
     assert str(blocked / "cache") in note and "BUSHING_CACHE_DIR" in note
     monkeypatch.undo()
-    assert fitting._exact_jacobian_or_why_not(table2_problem.objective.tests, space, False) == ("exact", None)
+    assert fitting._exact_jacobian_or_why_not(table2_problem.objective.tests, space) == ("exact", None)
 
 
 def test_the_sensitivities_check_their_output_points_as_the_forces_do():

@@ -68,13 +68,11 @@ class MultiAxisTraining:
         return fits
 
 
-def _exact_jacobian_or_why_not(tests, space: SearchSpace, progress: bool) -> tuple[str, str | None]:
-    """("exact", None) with the sensitivity module compiled (or loaded) here first, so that the
-    workers load it from the disk cache instead of each compiling it at once; or ("difference",
-    a note saying why) where the exact Jacobian would not pay: a fit to a dynamic-stiffness table
-    alone (its rows are differences either way), or a cache folder that cannot be written (every
-    process, every worker would compile the module again, a minute or more each)."""
-    from identification.forward.parameter_jacobian import sensitivity_module
+def _exact_jacobian_or_why_not(tests, space: SearchSpace) -> tuple[str, str | None]:
+    """("exact", None), or ("difference", a note saying why) where the exact Jacobian would not
+    pay: a fit to a dynamic-stiffness table alone (its rows are differences either way), or a
+    cache folder that cannot be written (every process, every worker would compile the module
+    again, a minute or more each)."""
     if not tests:
         return "difference", None
     folder = cache_directory()
@@ -87,20 +85,47 @@ def _exact_jacobian_or_why_not(tests, space: SearchSpace, progress: bool) -> tup
         return "difference", (f"note: the compiled models' cache {folder} cannot be written, so the fit takes "
                               "forward differences for its Jacobian (the exact one would be compiled again in every "
                               "process); set BUSHING_CACHE_DIR to a writable folder")
-    # The first fit of a model on a machine compiles the module for a minute or more: say so
-    # if it takes longer than a moment (a load from the cache takes under a second).
-    message = threading.Timer(3.0, lambda: print(
-        f"compiling the fit's exact Jacobian for the {space.bushing.name} model (once per machine: a minute or two; "
-        f"cached in {folder})", file=sys.stderr, flush=True)) if progress else None
-    if message:
-        message.daemon = True
-        message.start()
-    try:
-        sensitivity_module(space.bushing, len(space.names))
-    finally:
-        if message:
-            message.cancel()
     return "exact", None
+
+
+class JacobianCompile:
+    """The exact Jacobian's module of ``bushing`` in ``lanes`` directions, compiled (or loaded
+    from the disk cache) on a thread of this process while the global phase runs on the workers:
+    the compile takes one core for half a minute or more on a machine's first fit, and the
+    screening needs only the forward model. :meth:`wait` joins it before the least-squares
+    stages, whose workers then load it from the disk cache instead of each compiling it. A
+    first compile that takes longer than a moment says so, on stderr (``progress``)."""
+
+    def __init__(self, bushing: BushingModel, lanes: int, progress: bool):
+        self.bushing, self.lanes, self.error = bushing, lanes, None
+        self.message = threading.Timer(3.0, lambda: print(
+            f"compiling the fit's exact Jacobian for the {bushing.name} model beside the search (once per machine: "
+            f"a minute or less; cached in {cache_directory()})", file=sys.stderr, flush=True)) if progress else None
+        self.thread = threading.Thread(target=self._compile, name="exact Jacobian compile", daemon=True)
+
+    def _compile(self):
+        from identification.forward.parameter_jacobian import sensitivity_module
+        try:
+            sensitivity_module(self.bushing, self.lanes)
+        except BaseException as error:          # raised again by wait(), in the search's thread
+            self.error = error
+        finally:
+            if self.message:
+                self.message.cancel()
+
+    def start(self) -> "JacobianCompile":
+        if self.message:
+            self.message.daemon = True
+            self.message.start()
+        self.thread.start()
+        return self
+
+    def wait(self) -> None:
+        """Until the module is compiled or loaded; its error, if it failed."""
+        while self.thread.is_alive():
+            self.thread.join(0.1)       # in short waits: a Ctrl-C is not held up by the join
+        if self.error is not None:
+            raise self.error
 
 
 @dataclass(frozen=True)
@@ -159,10 +184,13 @@ class _Search:
                                                    table=request.table)
         # with a table, the screening and the early stages run its coarser loop (kdyn_table)
         self.jacobian_kind = request.jacobian_kind
+        self.jacobian_compile = None
         if self.jacobian_kind == "exact":
-            self.jacobian_kind, note = _exact_jacobian_or_why_not(request.tests, self.space, self.progress)
+            self.jacobian_kind, note = _exact_jacobian_or_why_not(request.tests, self.space)
             if note:
                 self.notes.append(note)
+            else:
+                self.jacobian_compile = JacobianCompile(self.space.bushing, len(self.space.names), self.progress).start()
         objective = Objective(request.tests, request.noise, model=self.space.bushing, table=request.table,
                               search=request.table is not None, **multi.objective_arguments())
         self.n, self.d = objective.size, len(self.space.names)     # residuals, coordinates
@@ -212,6 +240,8 @@ class _Search:
         reports (identification.fitting.refinement). A lone best start gets company before the
         check at the best fit (_extend_if_alone)."""
         tests, space, engine, bars = self.request.tests, self.space, self.engine, self.bars
+        if self.jacobian_compile is not None:
+            self.jacobian_compile.wait()
         *early, last = self.request.settings.stages
         n, d = self.n, self.d
         records = run_stages(self.problem, engine, first_records(theta, misfits, self.request.settings.stages[0][0]),
