@@ -43,29 +43,20 @@ from __future__ import annotations
 
 import math
 
-from ..model.parameter_specs import DAMPING, SPRING, ParameterSpec
+from ..model.parameter_specs import SPRING, ParameterSpec
 from ..model.integration import NOT_FINITE, OK, TOO_MANY_SUBSTEPS, maxwell_decay, maxwell_step
 from ..model.definition import BushingModel, SearchBox, SearchCoordinate, StateSpec, TrackStart
 from ..model.search_coordinates import KIND
 from .berg_model import CUBIC
-from .hydraulic_model import POSITIVE, THETA_TRACK
+from .hydraulic_model import PARAMETER_SPECS as MEMBRANE_SPECS, POSITIVE, THETA_TRACK
+
+SHARED = {spec.name: spec for spec in MEMBRANE_SPECS}
+"""The rubber's and the fluid column's specs, as the membrane mount declares them."""
 
 PARAMETER_SPECS = (
-    ParameterSpec("k0", "N/mm", "the rubber's static stiffness", **SPRING),
+    SHARED["k0"],
     ParameterSpec("k3", "N/mm^3", "the rubber's cubic stiffness: the progressive spring k0*x + k3*x^3", **CUBIC),
-    ParameterSpec("c0", "N.s/mm", "the rubber's viscous damping", **DAMPING),
-    ParameterSpec("k1", "N/mm", "spring of the rubber's Maxwell element", **SPRING),
-    ParameterSpec("c1", "N.s/mm", "dashpot of the rubber's Maxwell element (relaxation time c1/k1)",
-                  **POSITIVE, why="it sets the Maxwell element's rate k1/c1"),
-    ParameterSpec("kb", "N/mm", "the upper chamber's bulge stiffness: the fluid path's stiffness when the "
-                  "fluid cannot move", **POSITIVE, why="the fluid path acts through it (a mount without "
-                  "one is the rubber path alone: another model)"),
-    ParameterSpec("kc", "N/mm", "the lower chamber's (bellows') stiffness against the volume pumped", **SPRING),
-    ParameterSpec("mf", "N.s^2/mm", "the inertia track's fluid as an effective mass at the mount",
-                  **POSITIVE, why="the fluid column's equation divides by it"),
-    ParameterSpec("cf", "N.s/mm", "the inertia track's linear (laminar) damping", **DAMPING),
-    ParameterSpec("ct", "N.s^2/mm^2", "the inertia track's turbulent damping, force ct*|w|*w",
-                  minimum=0.0, why="a negative turbulent damping adds energy", bound_powers=(0, 2)),
+    *(SHARED[name] for name in ("c0", "k1", "c1", "kb", "kc", "mf", "cf", "ct")),
     ParameterSpec("gap", "mm", "the decoupler plate's free travel each way before it meets its cage "
                   "(0: a membrane of stiffness kd + kcage)", minimum=0.0, why="a travel is a magnitude"),
     ParameterSpec("width", "mm", "the width of plate travel over which the cage engages (0: a hard cage, "
