@@ -72,15 +72,15 @@ def rounding_variant(config):
             patch.setattr(RigTest, "__post_init__", perturbed)
         if offset:
             from identification.fitting import search
-            run = search.run
+            begin = search.begin     # every search starts there: fit's and compare's
 
             def offset_seed(*args, **kwargs):
-                bound = inspect.signature(run).bind(*args, **kwargs)
+                bound = inspect.signature(begin).bind(*args, **kwargs)
                 request = bound.arguments["request"]
                 bound.arguments["request"] = dataclasses.replace(request, seed=request.seed + offset)
-                return run(*bound.args, **bound.kwargs)
+                return begin(*bound.args, **bound.kwargs)
 
-            patch.setattr(search, "run", offset_seed)
+            patch.setattr(search, "begin", offset_seed)
         yield
 
 

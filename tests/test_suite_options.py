@@ -30,19 +30,19 @@ def test_forces_are_perturbed_at_the_level_asked_and_only_inside_the_variant():
 
 def test_every_fit_seed_is_offset_inside_the_variant_only(monkeypatch):
     seeds = []
-    monkeypatch.setattr(search, "run", lambda request, engine, progress, started: seeds.append(request.seed))
+    monkeypatch.setattr(search, "begin", lambda request, engine, progress, started: seeds.append(request.seed))
 
     def request(seed):
         return search.SearchRequest([], [], None, "default", None, seed)
     with rounding_variant(Options(seed_offset=2)):
-        search.run(request(5), None, True, 0.0)
-        search.run(request=request(0), engine=None, progress=True, started=0.0)
-    search.run(request(5), None, True, 0.0)
+        search.begin(request(5), None, True, 0.0)
+        search.begin(request=request(0), engine=None, progress=True, started=0.0)
+    search.begin(request(5), None, True, 0.0)
     assert seeds == [7, 2, 5]
 
 
 def test_without_options_nothing_changes():
     m = load_measurement(DATA / "synthetic_table5_sine_2mm_10Hz.csv")
-    run = search.run
+    begin = search.begin
     with rounding_variant(Options()):
-        assert search.run is run and np.array_equal(RigTest(m, "sine").measurement.force_N, m.force_N)
+        assert search.begin is begin and np.array_equal(RigTest(m, "sine").measurement.force_N, m.force_N)

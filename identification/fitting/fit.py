@@ -163,17 +163,14 @@ def fit(measurements, model: str | BushingModel = DEFAULT_MODEL, preset: str = "
     require("fit", "identification.fit")
     from threadpoolctl import threadpool_limits
     started = time.perf_counter()
-    tests, noise, table, multi, bushing = _training(measurements, model, seed, jacobian, kdyn, multiaxis, coupling)
+    request = training_request(measurements, model, preset, seed, screening, starts, kdyn, ensemble, jacobian,
+                               multiaxis, coupling)
     # One BLAS thread here as in every task: a multi-threaded BLAS may sum in another order,
     # and the scales and the Jacobian's SVD computed here must not depend on the engine.
     with threadpool_limits(limits=1):
-        if bushing.linear is not None:
-            result = _fit_linear(bushing, tests, noise, started, table, multi)
+        if request.model.linear is not None:
+            result = fit_linear(request, started)
         else:
-            if preset not in PRESETS:
-                raise IdentificationError(f"unknown preset {preset!r}; choose one of {', '.join(PRESETS)}")
-            request = SearchRequest(tests, noise, bushing, preset, _settings(PRESETS[preset], screening, starts), seed,
-                                    table, multi, jacobian, ensemble)
             owned = engine is None
             engine = engine or make_engine(workers, scheduler)
             # an engine made here is closed here, and aborted if the search is left by an exception
@@ -183,6 +180,20 @@ def fit(measurements, model: str | BushingModel = DEFAULT_MODEL, preset: str = "
     if not result.converged:
         warnings.warn(result.warning, FitNotConvergedWarning, stacklevel=2)
     return result
+
+
+def training_request(measurements, model: str | BushingModel = DEFAULT_MODEL, preset: str = "default", seed: int = 0,
+                     screening: int | None = None, starts: int | None = None, kdyn=None, ensemble: bool = True,
+                     jacobian: str = "exact", multiaxis=(), coupling: str | None = None) -> SearchRequest:
+    """``fit``'s arguments (the same names) read and checked: what one fit fits and how, for
+    :func:`fit_linear` (a model whose force is linear in its parameters) or
+    ``search.begin`` (every other; ``compare`` runs those step by step). Raises
+    IdentificationError as ``fit`` does."""
+    tests, noise, table, multi, bushing = _training(measurements, model, seed, jacobian, kdyn, multiaxis, coupling)
+    if preset not in PRESETS:
+        raise IdentificationError(f"unknown preset {preset!r}; choose one of {', '.join(PRESETS)}")
+    return SearchRequest(tests, noise, bushing, preset, _settings(PRESETS[preset], screening, starts), seed, table,
+                         multi, jacobian, ensemble)
 
 
 def _training(measurements, model, seed: int, jacobian: str, kdyn, multiaxis, coupling: str | None):
@@ -263,16 +274,16 @@ def _ranges(bushing: BushingModel, names) -> tuple[list[float], list[float]]:
             [np.inf if specs[name].maximum is None else specs[name].maximum for name in names])
 
 
-def _fit_linear(bushing: BushingModel, tests, noise, started, table=None,
-                multi: MultiAxisTraining | None = None) -> FitResult:
-    """A model whose force is linear in its parameters (``bushing.linear``) by linear least
-    squares (:func:`linear_solution`) on the tests other than steps (a linear spring cannot show
+def fit_linear(request: SearchRequest, started: float) -> FitResult:
+    """A model whose force is linear in its parameters (``request.model.linear``) by linear
+    least squares (:func:`linear_solution`) on the tests other than steps (a linear spring cannot show
     the step's relaxation; all tests if there are only steps) and on every axis of the
     multi-axis tests (such a bushing couples nothing). With a dynamic-stiffness table: scipy's
     bounded least squares on the whole objective (tests and table), from that solution or, with
-    a table alone, from the table's scales (k_ref for a stiffness, c_ref for a damping)."""
+    a table alone, from the table's scales (k_ref for a stiffness, c_ref for a damping). Timed
+    from ``started``."""
     from scipy.optimize import least_squares
-    multi = multi or MultiAxisTraining([], [], "none")
+    bushing, tests, noise, table, multi = request.model, request.tests, request.noise, request.table, request.multi
     free = [name for name, _ in bushing.linear.regressors]
     held = dict(bushing.linear.held)
     if tests or multi.measurements:

@@ -159,6 +159,8 @@ class FitResult:
     residuals: int = 0                     # n, the residuals chi^2/n is over (0: not recorded)
     failed_starts: int = 0                 # starts and profiles whose residuals or Jacobian were not finite
     coupling: str | None = None            # how the model ran on the multi-axis tests (None: there were none)
+    screened_misfit: float | None = None   # the global phase's best chi^2/n (None: no search, a linear model)
+    first_stage_misfit: float | None = None  # the best chi^2/n after the first least-squares stage
 
     @property
     def free_parameters(self) -> int:

@@ -147,23 +147,105 @@ class SearchRequest:
 
 def run(request: SearchRequest, engine, progress: bool, started: float) -> FitResult:
     """The search of a nonlinear model's parameters (``fit``), on ``engine``, timed from ``started``."""
-    return _Search(request, engine, progress, started).run()
+    return begin(request, engine, progress, started).run()
 
 
-class _Search:
-    """One search, step by step: the box and the objective, the global phase, the least-squares
-    stages with the forward model's steps checked, the ensemble, the result. Each step reads what
-    the ones before it left here; ``notes`` and ``evaluations`` (simulations run) add up."""
+def begin(request: SearchRequest, engine, progress: bool, started: float) -> "Search":
+    """A search that has not run yet: ``run()`` whole (``fit``), or step by step (``compare``
+    screens every model before it runs the stages of those still in the race)."""
+    return Search(request, engine, progress, started)
+
+
+class Search:
+    """One search, step by step: the box and the objective, the global phase (:meth:`screen`),
+    the least-squares stages with the forward model's steps checked and the result
+    (:meth:`finish`), the ensemble (there, or later: :meth:`with_ensemble`). Each step reads what
+    the ones before it left here; ``notes`` and ``evaluations`` (simulations run) add up, and
+    ``seconds`` counts the time spent in the steps (and before the first, from ``started``), not
+    the time other searches ran between them."""
 
     def __init__(self, request: SearchRequest, engine, progress: bool, started: float):
         self.request, self.engine, self.progress, self.started = request, engine, progress, started
         self.notes: list[str] = []
         self.evaluations = 0
+        self.seconds = 0.0
+        self.jacobian_compile = None
+        self.screened = None         # the global phase's points and misfits
+        self.first_records = None    # the starts after the first least-squares stage
+        self.final_state = None      # what the stages left for the result
+        self.result = None
 
     def run(self) -> FitResult:
-        self.problem = self._problem()
-        theta, misfits = self._global_phase()
-        records, added, agreeing = self._stages(theta, misfits)
+        self.screen()
+        return self.finish()
+
+    def prepare(self) -> Problem:
+        """The box and the objective (once): ``problem``."""
+        if not hasattr(self, "problem"):
+            self.problem = self._problem()
+        return self.problem
+
+    def screen(self, compile_beside: bool = True, since: float | None = None) -> float:
+        """The box, the objective and the global phase; the best screened misfit (chi^2/n).
+        ``compile_beside``: the exact Jacobian's module compiles on a thread while the workers
+        screen (else when :meth:`start_jacobian_compile` or a later step asks). The search's
+        time counts from ``since`` (default: its start)."""
+        self.prepare()
+        if compile_beside:
+            self.start_jacobian_compile()
+        self.screened = self._global_phase()
+        self.bars.close()
+        self.seconds += time.perf_counter() - (self.started if since is None else since)
+        return self.screened_misfit
+
+    @property
+    def screened_misfit(self) -> float:
+        """The best misfit (chi^2/n) of the global phase's points."""
+        return float(np.min(self.screened[1]))
+
+    def first_stage(self) -> float:
+        """The first least-squares stage from the screened points (after the exact Jacobian's
+        module is ready); its best misfit (chi^2/n). :meth:`finish` goes on from there."""
+        began = time.perf_counter()
+        self._first_stage()
+        self.bars.close()
+        self.seconds += time.perf_counter() - began
+        return self.first_stage_misfit
+
+    @property
+    def first_stage_misfit(self) -> float | None:
+        """The best misfit (chi^2/n) after the first least-squares stage (None before it; the
+        screened one where the preset has a single stage, which is the last)."""
+        if self.first_records is None:
+            return None
+        finite = [r.misfit for r in self.first_records if not r.failed]
+        return min(finite, default=self.screened_misfit)
+
+    def _first_stage(self) -> None:
+        if self.first_records is not None:
+            return
+        self.start_jacobian_compile()
+        if self.jacobian_compile is not None:
+            self.jacobian_compile.wait()
+        stages = self.request.settings.stages
+        theta, misfits = self.screened
+        self.first_records = first_records(theta, misfits, stages[0][0])
+        if len(stages) > 1:     # a single stage is the last, which runs on the fit's loop (_stages)
+            self.first_records = run_stages(self.problem, self.engine, self.first_records, stages[:1],
+                                            self.bars.stage)
+
+    def start_jacobian_compile(self) -> None:
+        """Start compiling (or loading) the exact Jacobian's module on a thread, once, where the
+        search takes the exact Jacobian (:meth:`screen` chose)."""
+        if self.jacobian_kind == "exact" and self.jacobian_compile is None:
+            self.jacobian_compile = JacobianCompile(self.space.bushing, len(self.space.names), self.progress).start()
+
+    def finish(self, ensemble: bool | None = None) -> FitResult:
+        """The stages from the screened points (the first, where :meth:`first_stage` has not
+        run it) and the result; the ensemble sampled if ``ensemble`` (default: the request's
+        ``sample_ensemble``)."""
+        began = time.perf_counter()
+        records, added, agreeing = self._stages(*self.screened)
         # scored by the objective used from here on; a failed start is skipped (failed_starts)
         final = [r for r in records if r.stage == len(self.request.settings.stages) - 1 and not r.failed]
         best = _best_record(final or records)
@@ -171,7 +253,25 @@ class _Search:
             self.notes.append(f"note: every start of the last stage failed (residuals or Jacobian not finite); the "
                               f"result is the best finite point the search found (stage "
                               f"{best.stage + 1 if best.stage >= 0 else 0})")
-        return self._result(records, final, best, added, agreeing)
+        self.final_state = (records, final, best, added, agreeing, self.evaluations, list(self.notes))
+        self.seconds += time.perf_counter() - began
+        return self._finished(self.request.sample_ensemble if ensemble is None else ensemble)
+
+    def with_ensemble(self) -> FitResult:
+        """The finished search's result again, with the ensemble sampled (profiles, posterior)
+        where :meth:`finish` left it out; the same best fit."""
+        if self.result is not None and self.result.ensemble_sampled:
+            return self.result
+        return self._finished(True)
+
+    def _finished(self, ensemble: bool) -> FitResult:
+        began = time.perf_counter()
+        records, final, best, added, agreeing, evaluations, notes = self.final_state
+        self.evaluations, self.notes = evaluations, list(notes)
+        self.result = self._result(records, final, best, added, agreeing, ensemble)
+        self.seconds += time.perf_counter() - began
+        self.result.seconds = self.seconds
+        return self.result
 
     def _problem(self) -> Problem:
         """The box scaled by the data and the objective; the exact Jacobian where it pays."""
@@ -184,13 +284,10 @@ class _Search:
                                                    table=request.table)
         # with a table, the screening and the early stages run its coarser loop (kdyn_table)
         self.jacobian_kind = request.jacobian_kind
-        self.jacobian_compile = None
         if self.jacobian_kind == "exact":
             self.jacobian_kind, note = _exact_jacobian_or_why_not(request.tests, self.space)
             if note:
                 self.notes.append(note)
-            else:
-                self.jacobian_compile = JacobianCompile(self.space.bushing, len(self.space.names), self.progress).start()
         objective = Objective(request.tests, request.noise, model=self.space.bushing, table=request.table,
                               search=request.table is not None, **multi.objective_arguments())
         self.n, self.d = objective.size, len(self.space.names)     # residuals, coordinates
@@ -240,12 +337,10 @@ class _Search:
         reports (identification.fitting.refinement). A lone best start gets company before the
         check at the best fit (_extend_if_alone)."""
         tests, space, engine, bars = self.request.tests, self.space, self.engine, self.bars
-        if self.jacobian_compile is not None:
-            self.jacobian_compile.wait()
+        self._first_stage()
         *early, last = self.request.settings.stages
         n, d = self.n, self.d
-        records = run_stages(self.problem, engine, first_records(theta, misfits, self.request.settings.stages[0][0]),
-                             early, bars.stage)
+        records = run_stages(self.problem, engine, self.first_records, early[1:], bars.stage, first_stage=1)
         refinement = _check_steps(self.problem, tests, records, n, d)
         problem = Problem(refinement.objective.with_fit_loop(tests), space, self.jacobian_kind)
         records = run_stages(problem, engine, records, [last], bars.stage, first_stage=len(early))
@@ -272,13 +367,13 @@ class _Search:
         self.problem = problem
         return records, added, agreeing
 
-    def _ensemble(self, best: StartRecord, final: list[StartRecord], ident, threshold: float):
+    def _ensemble(self, best: StartRecord, final: list[StartRecord], ident, threshold: float, sample: bool):
         """The ensemble's members (coordinates, the best first), the posterior's sampler (or None)
         and the failed profile tasks: every set within the confidence threshold the profiles, the
         posterior and the final starts found; the best alone where the ensemble is not sampled."""
         problem, space = self.problem, self.space
         n, d = self.n, self.d
-        if not self.request.sample_ensemble:
+        if not sample:
             return [best.theta], None, 0
         limit = best.misfit + threshold
         extremes, extreme_misfits, failed_profiles = profile_extremes(problem, best.theta, best.misfit, ident, limit,
@@ -295,14 +390,14 @@ class _Search:
                                  limit, space.bounds())
         return members, sampler, failed_profiles
 
-    def _result(self, records, final, best: StartRecord, added: int, agreeing: int) -> FitResult:
+    def _result(self, records, final, best: StartRecord, added: int, agreeing: int, sample: bool) -> FitResult:
         request, problem, space = self.request, self.problem, self.space
         n, d = self.n, self.d
         threshold = misfit_threshold(best.misfit, n, d)
         scaled_jacobian = _identifiability_jacobian(problem, best.theta, self.notes)
         ident = identifiability(scaled_jacobian * np.sqrt(n), space.names, threshold * n)
         self.evaluations += simulations_per_jacobian(problem, d, known=False)
-        members, sampler, failed_profiles = self._ensemble(best, final, ident, threshold)
+        members, sampler, failed_profiles = self._ensemble(best, final, ident, threshold, sample)
         rows = space.to_model_parameters(np.array(members))
         ensemble = [dict(zip(space.bushing.parameter_names, map(float, row))) for row in rows]
         parameters = ParameterSet(space.bushing, ensemble[0])
@@ -314,9 +409,10 @@ class _Search:
                            time.perf_counter() - self.started, self.engine.description, space,
                            final_starts=len(final), sampler=sampler, notes=self.notes, steps_per_sample=steps,
                            table=table_fit(request.table, parameters), added_starts=added,
-                           agreed_before_added=agreeing, ensemble_sampled=request.sample_ensemble, residuals=n,
+                           agreed_before_added=agreeing, ensemble_sampled=sample, residuals=n,
                            failed_starts=failed_starts(records) + failed_profiles,
-                           coupling=request.multi.coupling if request.multi.measurements else None)
+                           coupling=request.multi.coupling if request.multi.measurements else None,
+                           screened_misfit=self.screened_misfit, first_stage_misfit=self.first_stage_misfit)
         result.parameters.provenance = result.provenance()
         return result
 
