@@ -5,6 +5,7 @@
 - ``design``: which test to run next (where the ensemble disagrees most);
 - ``parameter_sensitivity``: the force's sensitivity to each parameter (the paper's §4);
 - ``compare``: every model fitted on the same tests, weighed, one recommended;
+- ``race``: compare's race: every model screened, the stages only for those that can still win;
 - ``paper_verification``: the paper's §5 error tables and force plots;
 - ``plots``: the figures (forces, loops, the multistart waterfall, data sheets).
 

@@ -43,7 +43,8 @@ from fmu_src.model.registry import BushingModel, resolve_model
 from identification.fitting.engine import make_engine
 from identification.errors import FitNotConvergedWarning
 from identification.fitting.result import FLOOR_FACTOR, FitResult, TableFit, information_criterion
-from identification.fitting.fit import fit
+from identification.fitting.fit import training_request
+from identification.analysis.race import Stopped, race_models
 from identification.fitting.search import table_fit
 from identification.interrupt import writing
 from identification.measured.kdyn_table import KDYN_UNCERTAINTY, LOSS_ANGLE_UNCERTAINTY_DEG, KdynTable
@@ -68,6 +69,8 @@ class Assessment:
     at_floor: bool
     converged: bool
     seconds: float
+    screened_misfit: float | None = None    # the best chi^2/n of its screening (None: a linear model)
+    first_stage_misfit: float | None = None  # the best chi^2/n after its first least-squares stage
     validation: dict[str, tuple[float, float]] = field(default_factory=dict)   # held-out file: (NRMSE, eq. 10)
     table: TableFit | None = None          # the held-out table at the fitted parameters
 
@@ -90,7 +93,8 @@ class Assessment:
     def of(cls, result: FitResult) -> "Assessment":
         ratios = [t.ratio for t in result.tests] + ([result.table.ratio] if result.table is not None else [])
         return cls(result.model, result.free_parameters, result.residuals, result.misfit,
-                   max(ratios, default=math.nan), result.at_floor, result.converged, result.seconds)
+                   max(ratios, default=math.nan), result.at_floor, result.converged, result.seconds,
+                   result.screened_misfit, result.first_stage_misfit)
 
 
 @dataclass(frozen=True)
@@ -151,62 +155,62 @@ def compare_models(models: Sequence[str | BushingModel], tests: Sequence[RigTest
                    out_dir: Path, preset: str = "default", seed: int = 0, workers: int | None = None,
                    scheduler=None, screening: int | None = None, starts: int | None = None, ensemble: bool = True,
                    table: KdynTable | None = None, multiaxis=(), couplings: Sequence[str] = (),
-                   training_table: KdynTable | None = None) -> dict:
+                   training_table: KdynTable | None = None, race: bool = True, every_ensemble: bool = False,
+                   progress: bool = True) -> dict:
     """Fit every model on ``tests`` and the ``training_table`` (a data sheet, alone or with the
     tests, as ``fit(kdyn=...)``), assess it on the training data, on the ``validation_files``
     and on the held-out dynamic-stiffness ``table``, write the files (module docstring) and
     recommend one. ``models``: names or ``BushingModel``s, each resolved once here and passed on.
+
+    The models race (:func:`race_models`): each is screened, and only those that can still win
+    run the least-squares stages (``race=False``: every model runs them). The ensemble (profiles
+    and posterior, ``ensemble``) is sampled for the recommended model, and for every finished
+    one with ``every_ensemble``.
+
     Returns ``{"parameters": {model: params}, "errors": {(file, model): (nrmse, eq10)},
-    "assessments": [Assessment], "recommendation": Recommendation}`` (keyed by model name)."""
+    "assessments": [Assessment], "recommendation": Recommendation, "stopped": [Stopped]}``
+    (keyed by model name; a model stopped after its screening has no parameters, errors or
+    assessment, only its row in ``stopped``)."""
+    from threadpoolctl import threadpool_limits
     bushings = [resolve_model(model) for model in models]
-    models = [bushing.name for bushing in bushings]
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     validation = [load_measurement(path) for path in validation_files]
     training_names = {Path(t.measurement.source).name for t in tests}
-    parameters, assessments = {}, []
-    with make_engine(workers, scheduler) as engine, warnings.catch_warnings():
+    requests = [training_request(tests, bushing, preset, seed, screening, starts, training_table, False)
+                for bushing in bushings]
+    data = [t.measurement.source for t in tests] + ([training_table.source] if training_table is not None else [])
+    # one BLAS thread, as fit() runs its searches
+    with make_engine(workers, scheduler) as engine, warnings.catch_warnings(), threadpool_limits(limits=1):
         warnings.simplefilter("ignore", FitNotConvergedWarning)   # reported below, per model
-        for bushing in bushings:
-            model = bushing.name
-            print(f"fitting {bushing.title} ...", file=sys.stderr)
-            result = fit(tests, model=bushing, preset=preset, seed=seed, engine=engine, screening=screening,
-                         starts=starts, ensemble=ensemble, kdyn=training_table)
-            result.save(out_dir / f"params_{model}.json", data=[t.measurement.source for t in tests]
-                        + ([training_table.source] if training_table is not None else []))
-            parameters[model] = result.parameters.parameters
-            assessment = Assessment.of(result)
-            if table is not None:
-                assessment.table = table_fit(table, result.parameters)
-            assessments.append(assessment)
-            state = "converged" if result.converged else f"WARNING: {result.warning}"
-            print(f"  misfit {result.misfit:.4f} in {result.seconds:.0f} s; {state}", file=sys.stderr)
-
-    errors = {}
+        results, stopped, searches = race_models(requests, engine, race, progress)
+        bushings = [b for b in bushings if b.name in results]
+        models = [b.name for b in bushings]
+        parameters = {model: results[model].parameters.parameters for model in models}
+        assessments = [_assessed(results[model], table) for model in models]
+        errors, predictions = _validation_errors(validation, bushings, parameters, assessments, training_names)
+        recommendation = recommend(assessments)
+        if ensemble:
+            # the ensemble keeps the best fit: the assessments and the recommendation stand
+            for model in [m for m in models if m in searches and (every_ensemble or m == recommendation.model)]:
+                print(f"sampling the ensemble of {model} (profiles, posterior) ...", file=sys.stderr)
+                results[model] = searches[model].with_ensemble()
+        for model in models:
+            results[model].save(out_dir / f"params_{model}.json", data=data)
     for m in validation:
-        name = Path(m.source).name
-        predictions = {bushing.name: simulate(parameters[bushing.name], m.time_s, m.displacement_mm,
-                                              m.measured_velocity_mm_s, model=bushing)
-                       for bushing in bushings}
-        for assessment in assessments:
-            predicted = predictions[assessment.model]
-            errors[name, assessment.model] = (nrmse(predicted, m.force_N), rms_level_error(predicted, m.force_N))
-            if name not in training_names:
-                assessment.validation[name] = errors[name, assessment.model]
-        plot_comparison(m, predictions, out_dir / f"compare_{measurement_name(m.source)}.png")
+        plot_comparison(m, predictions[Path(m.source).name], out_dir / f"compare_{measurement_name(m.source)}.png")
     if table is not None:
         plot_table_comparison(table, {a.model: a.table for a in assessments}, out_dir / f"compare_{table.name}.png")
-    recommendation = recommend(assessments)
     coupling = weigh_couplings(parameters, bushings, multiaxis, couplings, recommendation.model) if couplings else None
 
-    print(format_assessments(assessments, recommendation))
+    print(format_assessments(assessments, recommendation, stopped))
     if validation:
         print(format_comparison(errors, models, [Path(m.source).name for m in validation], training_names))
     if table is not None:
         print(format_table_errors(table, assessments))
     if coupling is not None:
         print(coupling.format())
-    _write_csvs(out_dir, assessments, recommendation, errors, table)
+    _write_csvs(out_dir, assessments, recommendation, errors, table, stopped)
     if coupling is not None:
         coupling.write(out_dir / "coupling.csv")
     print(f"wrote {out_dir}/comparison.csv, validation.csv{', kdyn_errors.csv' if table is not None else ''}"
@@ -218,7 +222,31 @@ def compare_models(models: Sequence[str | BushingModel], tests: Sequence[RigTest
     print(f"why: {recommendation.reason}")
     print(f"recommended: {recommendation.model}")
     return {"parameters": parameters, "errors": errors, "assessments": assessments, "recommendation": recommendation,
-            "coupling": coupling}
+            "coupling": coupling, "stopped": stopped}
+
+
+def _assessed(result: FitResult, table: KdynTable | None) -> Assessment:
+    assessment = Assessment.of(result)
+    if table is not None:
+        assessment.table = table_fit(table, result.parameters)
+    return assessment
+
+
+def _validation_errors(validation, bushings, parameters: dict, assessments: list[Assessment], training_names: set):
+    """Each model's (NRMSE, eq. 10) on each validation file, entered into its assessment where
+    the file is held out; and the predictions, {file name: {model: force}}."""
+    errors, predictions = {}, {}
+    for m in validation:
+        name = Path(m.source).name
+        predictions[name] = {bushing.name: simulate(parameters[bushing.name], m.time_s, m.displacement_mm,
+                                                    m.measured_velocity_mm_s, model=bushing)
+                             for bushing in bushings}
+        for assessment in assessments:
+            predicted = predictions[name][assessment.model]
+            errors[name, assessment.model] = (nrmse(predicted, m.force_N), rms_level_error(predicted, m.force_N))
+            if name not in training_names:
+                assessment.validation[name] = errors[name, assessment.model]
+    return errors, predictions
 
 
 @dataclass
@@ -278,8 +306,10 @@ def weigh_couplings(parameters: dict, bushings, multiaxis, couplings: Sequence[s
     return CouplingChoice(errors, [m.name for m in multiaxis], tuple(couplings), model, chosen, reason)
 
 
-def format_assessments(assessments: Sequence[Assessment], recommendation: Recommendation) -> str:
-    """One row per model: parameters, training against the noise, BIC, held-out errors."""
+def format_assessments(assessments: Sequence[Assessment], recommendation: Recommendation,
+                       stopped: Sequence[Stopped] = ()) -> str:
+    """One row per model: parameters, training against the noise, BIC, held-out errors; a model
+    stopped after its screening, its screened misfit and why (``race``)."""
     best_bic = min(a.information_criterion for a in assessments)
     lines = [f"{'model':17s} {'params':>6s} {'worst NRMSE/noise':>17s} {'floor':>5s} {'chi2/n':>9s} {'dBIC':>9s} "
              f"{'held-out NRMSE':>14s} {'table err/unc':>13s}"]
@@ -289,6 +319,8 @@ def format_assessments(assessments: Sequence[Assessment], recommendation: Recomm
         mark = "  <- recommended" if a.model == recommendation.model else ""
         lines.append(f"{a.model:17s} {a.free_parameters:6d} {a.training_ratio:17.2f} {'yes' if a.at_floor else 'NO':>5s} "
                      f"{a.misfit:9.3f} {a.information_criterion - best_bic:9.1f} {held:>14s} {table:>13s}{mark}")
+    for s in stopped:
+        lines.append(f"{s.model:17s} {s.free_parameters:6d}  stopped after its screening: {s.reason}")
     lines.append(f"floor: every training test's NRMSE within {FLOOR_FACTOR}x its noise level (a training table's "
                  f"rms error within {FLOOR_FACTOR}x its uncertainty; the column is the worst of them); dBIC: BIC = chi^2 + "
                  "d*ln(n) over the best; held-out NRMSE: the mean over the validation files that are not training "
@@ -319,14 +351,16 @@ def format_table_errors(table: KdynTable, assessments: Sequence[Assessment]) -> 
     return "\n".join(lines)
 
 
-def _write_csvs(out_dir: Path, assessments, recommendation: Recommendation, errors: dict, table) -> None:
+def _write_csvs(out_dir: Path, assessments, recommendation: Recommendation, errors: dict, table,
+                stopped: Sequence[Stopped] = ()) -> None:
     best_bic = min(a.information_criterion for a in assessments)
     with writing(out_dir / "comparison.csv") as temporary, open(temporary, "w", newline="") as handle:
         writer = csv.writer(handle)
         writer.writerow(["model", "free_parameters", "worst_nrmse_over_noise", "at_floor", "converged",
                          "misfit_chi2_per_residual", "residuals", "bic", "delta_bic", "held_out_mean_nrmse",
                          "table_error_over_uncertainty", "table_largest_kdyn_error", "table_largest_loss_angle_error_deg",
-                         "seconds", "recommended"])
+                         "seconds", "recommended", "screened_misfit_chi2_per_residual",
+                         "first_stage_misfit_chi2_per_residual", "stopped_after_screening"])
         for a in assessments:
             kdyn = np.max(np.abs(a.table.kdyn_errors)) if a.table is not None else None
             angle = np.max(np.abs(a.table.angle_errors_deg)) if a.table is not None else None
@@ -334,7 +368,12 @@ def _write_csvs(out_dir: Path, assessments, recommendation: Recommendation, erro
                              _cell(a.misfit), a.residuals, _cell(a.information_criterion),
                              _cell(a.information_criterion - best_bic), _cell(a.validation_error),
                              _cell(a.table_error), _cell(kdyn), _cell(angle), f"{a.seconds:.1f}",
-                             a.model == recommendation.model])
+                             a.model == recommendation.model, _cell(a.screened_misfit),
+                             _cell(a.first_stage_misfit), ""])
+        for s in stopped:
+            writer.writerow([s.model, s.free_parameters, "", False, False, "", "", "", "", "", "", "", "",
+                             f"{s.seconds:.1f}", False, _cell(s.screened_misfit), _cell(s.first_stage_misfit),
+                             s.reason])
     with writing(out_dir / "validation.csv") as temporary, open(temporary, "w", newline="") as handle:
         writer = csv.writer(handle)
         writer.writerow(["file", "model", "nrmse", "eq10_rms_level_error"])

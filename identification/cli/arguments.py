@@ -155,6 +155,12 @@ def _add_compare(subcommands) -> None:
                                      "Fz_N]); each model predicts it with each --coupling; repeatable")
     compare_parser.add_argument("--out", type=Path, required=True,
                                 help="directory for the fitted parameter files, the table (CSV) and the plots")
+    compare_parser.add_argument("--no-race", action="store_true",
+                                help="run every model's least-squares stages (default: a model whose screening "
+                                     "shows it cannot win stops there, and its row says why)")
+    compare_parser.add_argument("--every-ensemble", action="store_true",
+                                help="sample the ensemble (profiles, posterior) of every fitted model, not only of "
+                                     "the recommended one")
 
 
 def _add_predict(subcommands) -> None:

@@ -402,12 +402,15 @@ def compare_command(args) -> int:
     if "spherical" in couplings and planar:
         raise UsageError(f"--coupling spherical needs multi-axis files of three axes (dz_mm, Fz_N); "
                          f"{', '.join(planar)} {'has' if len(planar) == 1 else 'have'} two")
+    if args.no_ensemble and args.every_ensemble:
+        raise UsageError("--every-ensemble samples the ensembles that --no-ensemble skips: give one of them")
     prepare_directory(args.out, "--out")
     validation = args.validate or [Path(t.measurement.source) for t in tests]
     compare_models(models, tests, validation, args.out, preset=args.preset, seed=args.seed, workers=args.workers,
                    scheduler=args.scheduler, screening=args.screening, starts=args.starts,
                    ensemble=not args.no_ensemble, table=table, multiaxis=multiaxis, couplings=couplings,
-                   training_table=training_table)
+                   training_table=training_table, race=not args.no_race, every_ensemble=args.every_ensemble,
+                   progress=not args.quiet)
     return 0
 
 

@@ -32,6 +32,7 @@ import ast
 import builtins
 import inspect
 import sys
+import threading
 import types
 from typing import Callable
 
@@ -119,6 +120,8 @@ def _appendix(model: BushingModel, lanes: int, machinery: str) -> str:
 
 
 _compiled: dict[tuple[str, int], types.ModuleType] = {}
+_compile_locks: dict[tuple[str, int], threading.Lock] = {}
+_locks_lock = threading.Lock()
 
 
 def _generated_module(model: BushingModel, lanes: int) -> types.ModuleType:
@@ -139,13 +142,18 @@ def sensitivity_module(model: str | BushingModel, lanes: int) -> types.ModuleTyp
     generate the source again and load the machine code."""
     bushing = resolve_model(model)
     key = (bushing.name, lanes)
-    if key not in _compiled:
-        module = _generated_module(bushing, lanes)
-        values = np.array([bushing.values({spec.name: 1.0 for spec in bushing.specs})])
-        two = np.array([0.0, 1e-3])
-        module._simulate_sensitivities(values, np.zeros(values.shape + (lanes,)), two, two, two,
-                                       np.arange(2, dtype=np.int64), two, 10, *_step_sizes(two))
-        _compiled[key] = module
+    if key in _compiled:
+        return _compiled[key]
+    with _locks_lock:
+        lock = _compile_locks.setdefault(key, threading.Lock())
+    with lock:      # a second thread asking for the same module waits for the first's compile
+        if key not in _compiled:
+            module = _generated_module(bushing, lanes)
+            values = np.array([bushing.values({spec.name: 1.0 for spec in bushing.specs})])
+            two = np.array([0.0, 1e-3])
+            module._simulate_sensitivities(values, np.zeros(values.shape + (lanes,)), two, two, two,
+                                           np.arange(2, dtype=np.int64), two, 10, *_step_sizes(two))
+            _compiled[key] = module
     return _compiled[key]
 
 

@@ -1,0 +1,187 @@
+"""``compare``'s race: every model is screened, and only the models that can still win run the
+rest of the least-squares stages.
+
+A model's screening here is the search's global phase and its first, short least-squares stage
+(the default preset: 8192 Sobol points, then 128 starts of 10 evaluations). The stages after it
+lower that stage's best misfit (chi^2/n over the training data) by some factor. A model whose
+first-stage misfit, divided by the largest such factor seen on the project's comparison cases
+(``RACE_CLOSING``, with a margin), is still above
+
+- the noise floor's misfit (``FLOOR_FACTOR`` squared: a fit whose chi^2/n is above it has a test
+  or table above the floor), and,
+- where no finished model reaches the floor, the misfit that would give it the lowest BIC
+  (the recommendation's measure then),
+
+cannot be recommended (``compare.recommend``), so it stops there and its row says why. The models
+are finished in the order of their first-stage misfits, best first, so that the bound is set by
+the fits most likely to win. A linear model (Kelvin-Voigt) is fitted outright.
+
+One thing the bound does not see: where no model reaches the floor, ``recommend`` first keeps the
+models that predict the held-out data within 10 % of the best; a model stopped here is assumed
+not to predict held-out data better than one that fits the training data far better.
+
+On a machine's first run the models' compiled modules are what takes longest: they compile one
+after another on a thread of this process (:class:`ModulePipeline`) while the workers screen and
+fit, each before the step that needs it.
+"""
+from __future__ import annotations
+
+import pickle
+import sys
+import threading
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from identification.fitting.fit import fit_linear
+from identification.fitting.result import FLOOR_FACTOR, FitResult, information_criterion
+from identification.fitting.search import Search, SearchRequest, begin
+
+RACE_CLOSING = 1000.0
+"""The factor by which the least-squares stages after the first may still lower a model's best
+misfit. Provisional, stopping almost nothing, until benchmarks/bench_race.py has measured it on
+the project's comparison cases."""
+
+
+@dataclass(frozen=True)
+class Stopped:
+    """A model stopped after its screening: its best screened misfit and first-stage misfit
+    (chi^2/n), the time its screening took [s], and why it cannot win."""
+    model: str
+    free_parameters: int
+    screened_misfit: float
+    first_stage_misfit: float
+    seconds: float
+    reason: str
+
+
+def out_of_race(first_stage_misfit: float, free_parameters: int, residuals: int, finished: list[FitResult],
+                closing: float = RACE_CLOSING) -> str | None:
+    """Why a model whose first least-squares stage reached ``first_stage_misfit`` (chi^2/n, with
+    ``free_parameters`` over ``residuals``) cannot be recommended against the ``finished`` fits,
+    or None while it can."""
+    if not finished:
+        return None
+    least = first_stage_misfit / closing            # the lowest misfit its later stages could reach
+    if least <= FLOOR_FACTOR ** 2:
+        return None
+    at_floor = [r for r in finished if r.at_floor]
+    if at_floor:
+        leader = min(at_floor, key=lambda r: r.misfit)
+        return (f"chi^2/n {first_stage_misfit:.4g} after its first stage: even lowered {closing:g}x it stays above "
+                f"the noise floor's {FLOOR_FACTOR ** 2:.3g}, which {leader.model} reached")
+    leader = min(finished, key=lambda r: r.information_criterion)
+    if information_criterion(least, free_parameters, residuals) > leader.information_criterion:
+        return (f"chi^2/n {first_stage_misfit:.4g} after its first stage: even lowered {closing:g}x it stays above "
+                f"the noise floor and its BIC above {leader.model}'s")
+    return None
+
+
+class ModulePipeline:
+    """The compiled modules the race will need, compiled (or loaded from the disk cache) one after
+    another on a thread of this process while the workers screen and fit: the forward models of
+    the searches after the first (whose workers compile its own at once), by one misfit at the
+    box's centre (what the workers call, compiled with the same types; on a copy of the problem,
+    which the main thread is sending to the workers meanwhile), then the exact Jacobians' modules
+    in the order the models will be finished (:meth:`reorder`). A search that asks for a module
+    the thread is compiling waits for it (``parameter_jacobian.sensitivity_module``), and numba's
+    disk cache gives it to the workers. A module that fails here is left to the search that needs
+    it, which compiles it again and raises there."""
+
+    def __init__(self, searches: list[Search]):
+        self.forward = list(searches[1:])
+        self.jacobians = [s for s in searches if s.jacobian_kind == "exact"]
+        self.lock = threading.Lock()
+        self.thread = threading.Thread(target=self._run, name="compiled modules", daemon=True)
+
+    def start(self) -> "ModulePipeline":
+        self.thread.start()
+        return self
+
+    def reorder(self, searches: list[Search]) -> None:
+        """The Jacobians still to compile, in the order of ``searches`` (the others dropped)."""
+        with self.lock:
+            self.jacobians = [s for s in searches if s in self.jacobians]
+
+    def _next(self):
+        with self.lock:
+            if self.forward:
+                return _forward_model_of(self.forward.pop(0))
+            if self.jacobians:
+                return _jacobian_of(self.jacobians.pop(0))
+            return None
+
+    def _run(self) -> None:
+        while (job := self._next()) is not None:
+            try:
+                job()
+            except Exception:       # left to the search that needs the module
+                pass
+
+
+def _forward_model_of(search: Search):
+    def compile_forward():
+        problem = pickle.loads(pickle.dumps(search.problem))
+        problem.misfit(np.mean(problem.space.bounds(), axis=1)[None, :])
+    return compile_forward
+
+
+def _jacobian_of(search: Search):
+    def compile_jacobian():
+        from identification.forward.parameter_jacobian import sensitivity_module
+        sensitivity_module(search.space.bushing, search.d)
+    return compile_jacobian
+
+
+def race_models(requests: list[SearchRequest], engine, race: bool = True,
+                progress: bool = True) -> tuple[dict[str, FitResult], list[Stopped], dict[str, Search]]:
+    """Fit the models of ``requests`` (each with its ensemble left out) on ``engine``: a linear
+    model outright, every other screened (the global phase, then the first least-squares stage),
+    then, best first-stage misfit first, the stages of those still in the race (every one with
+    ``race=False``), their modules compiled beside
+    (:class:`ModulePipeline`). Returns (results by model, the models stopped, the finished
+    searches by model: ``Search.with_ensemble`` samples an ensemble later)."""
+    results: dict[str, FitResult] = {}
+    searches: dict[str, Search] = {}
+    for request in requests:
+        bushing = request.model
+        if bushing.linear is not None:
+            print(f"fitting {bushing.title} (linear least squares) ...", file=sys.stderr)
+            results[bushing.name] = _reported(fit_linear(request, time.perf_counter()))
+        else:
+            searches[bushing.name] = begin(request, engine, progress, time.perf_counter())
+            searches[bushing.name].prepare()
+    pipeline = ModulePipeline(list(searches.values())).start()
+    for search in searches.values():
+        print(f"screening {search.request.model.title} ...", file=sys.stderr)
+        misfit = search.screen(compile_beside=False, since=time.perf_counter())
+        print(f"  best screened misfit {misfit:.4g} in {search.seconds:.0f} s", file=sys.stderr)
+    order = sorted(searches, key=lambda model: searches[model].screened_misfit)
+    pipeline.reorder([searches[model] for model in order])
+    for model in order:
+        search = searches[model]
+        print(f"first least-squares stage of {search.request.model.title} ...", file=sys.stderr)
+        misfit = search.first_stage()
+        print(f"  best misfit {misfit:.4g} ({search.seconds:.0f} s so far)", file=sys.stderr)
+    order = sorted(searches, key=lambda model: searches[model].first_stage_misfit)
+    stopped = []
+    for model in order:
+        search = searches[model]
+        reason = (out_of_race(search.first_stage_misfit, search.d, search.n, list(results.values())) if race
+                  else None)
+        if reason is not None:
+            stopped.append(Stopped(model, search.d, search.screened_misfit, search.first_stage_misfit,
+                                   search.seconds, reason))
+            del searches[model]
+            print(f"{search.request.model.title}: out of the race ({reason})", file=sys.stderr)
+            continue
+        print(f"fitting {search.request.model.title} ...", file=sys.stderr)
+        results[model] = _reported(search.finish(ensemble=False))
+    return results, stopped, searches
+
+
+def _reported(result: FitResult) -> FitResult:
+    state = "converged" if result.converged else f"WARNING: {result.warning}"
+    print(f"  misfit {result.misfit:.4f} in {result.seconds:.0f} s; {state}", file=sys.stderr)
+    return result
