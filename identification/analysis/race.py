@@ -57,10 +57,11 @@ class Stopped:
 
 
 def out_of_race(first_stage_misfit: float, free_parameters: int, residuals: int, finished: list[FitResult],
-                closing: float = RACE_CLOSING) -> str | None:
+                closing: float | None = None) -> str | None:
     """Why a model whose first least-squares stage reached ``first_stage_misfit`` (chi^2/n, with
     ``free_parameters`` over ``residuals``) cannot be recommended against the ``finished`` fits,
-    or None while it can."""
+    or None while it can; ``closing`` defaults to ``RACE_CLOSING``."""
+    closing = RACE_CLOSING if closing is None else closing
     if not finished:
         return None
     least = first_stage_misfit / closing            # the lowest misfit its later stages could reach

@@ -93,15 +93,29 @@ class JacobianCompile:
     from the disk cache) on a thread of this process while the global phase runs on the workers:
     the compile takes one core for half a minute or more on a machine's first fit, and the
     screening needs only the forward model. :meth:`wait` joins it before the least-squares
-    stages, whose workers then load it from the disk cache instead of each compiling it. A
-    first compile that takes longer than a moment says so, on stderr (``progress``)."""
+    stages, whose workers then load it from the disk cache instead of each compiling it. With
+    ``progress``, a compile that takes longer than a moment says what it compiles and about how
+    long it takes (``parameter_jacobian.expected_compile_seconds``), on stderr, and a wait for it
+    shows a bar of the seconds."""
+
+    NOTICE_AFTER_S = 3.0
+    """A module still busy after this long is being compiled, not loaded from the cache."""
 
     def __init__(self, bushing: BushingModel, lanes: int, progress: bool):
-        self.bushing, self.lanes, self.error = bushing, lanes, None
-        self.message = threading.Timer(3.0, lambda: print(
-            f"compiling the fit's exact Jacobian for the {bushing.name} model beside the search (once per machine: "
-            f"a minute or less; cached in {cache_directory()})", file=sys.stderr, flush=True)) if progress else None
+        self.bushing, self.lanes, self.progress, self.error = bushing, lanes, progress, None
+        self.began = None
+        self.message = threading.Timer(self.NOTICE_AFTER_S, self._notice) if progress else None
         self.thread = threading.Thread(target=self._compile, name="exact Jacobian compile", daemon=True)
+
+    def _expected_s(self) -> float | None:
+        from identification.forward.parameter_jacobian import expected_compile_seconds
+        return expected_compile_seconds(self.bushing, self.lanes)
+
+    def _notice(self):
+        expected = self._expected_s()
+        print(f"compiling the exact Jacobian of the {self.bushing.name} model ({self.lanes} directions) beside the "
+              f"search: once per machine, {f'about {expected:.0f} s on a 2-core VM' if expected else 'a minute or less'}"
+              f"; cached in {cache_directory()}", file=sys.stderr, flush=True)
 
     def _compile(self):
         from identification.forward.parameter_jacobian import sensitivity_module
@@ -114,6 +128,7 @@ class JacobianCompile:
                 self.message.cancel()
 
     def start(self) -> "JacobianCompile":
+        self.began = time.perf_counter()
         if self.message:
             self.message.daemon = True
             self.message.start()
@@ -121,9 +136,22 @@ class JacobianCompile:
         return self
 
     def wait(self) -> None:
-        """Until the module is compiled or loaded; its error, if it failed."""
+        """Until the module is compiled or loaded, with a bar of its seconds where it is still
+        compiling; its error, if it failed."""
+        from identification.fitting.progress import bar
+        seconds = None
         while self.thread.is_alive():
             self.thread.join(0.1)       # in short waits: a Ctrl-C is not held up by the join
+            elapsed = time.perf_counter() - self.began
+            if seconds is None and self.thread.is_alive() and elapsed > self.NOTICE_AFTER_S:
+                expected = self._expected_s() or 60.0
+                seconds = bar(max(round(expected), round(elapsed) + 1), f"compiling the {self.bushing.name} model's "
+                              "exact Jacobian (once per machine)", "s", self.progress) or False
+            if seconds:
+                seconds.total = max(seconds.total, round(elapsed) + 1)
+                seconds.update(min(round(elapsed), seconds.total) - seconds.n)
+        if seconds:
+            seconds.close()
         if self.error is not None:
             raise self.error
 
@@ -172,6 +200,7 @@ class Search:
         self.jacobian_compile = None
         self.screened = None         # the global phase's points and misfits
         self.first_records = None    # the starts after the first least-squares stage
+        self._first_stage_misfit = None
         self.final_state = None      # what the stages left for the result
         self.result = None
 
@@ -216,10 +245,7 @@ class Search:
     def first_stage_misfit(self) -> float | None:
         """The best misfit (chi^2/n) after the first least-squares stage (None before it; the
         screened one where the preset has a single stage, which is the last)."""
-        if self.first_records is None:
-            return None
-        finite = [r.misfit for r in self.first_records if not r.failed]
-        return min(finite, default=self.screened_misfit)
+        return self._first_stage_misfit
 
     def _first_stage(self) -> None:
         if self.first_records is not None:
@@ -233,6 +259,9 @@ class Search:
         if len(stages) > 1:     # a single stage is the last, which runs on the fit's loop (_stages)
             self.first_records = run_stages(self.problem, self.engine, self.first_records, stages[:1],
                                             self.bars.stage)
+        # read now: the later stages go on with these records
+        self._first_stage_misfit = min((r.misfit for r in self.first_records if not r.failed),
+                                       default=self.screened_misfit)
 
     def start_jacobian_compile(self) -> None:
         """Start compiling (or loading) the exact Jacobian's module on a thread, once, where the

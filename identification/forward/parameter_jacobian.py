@@ -122,6 +122,21 @@ def _appendix(model: BushingModel, lanes: int, machinery: str) -> str:
 _compiled: dict[tuple[str, int], types.ModuleType] = {}
 _compile_locks: dict[tuple[str, int], threading.Lock] = {}
 _locks_lock = threading.Lock()
+_source_sizes: dict[tuple[str, int], int] = {}
+
+COMPILE_SECONDS_PER_KB = 0.17
+"""numba's compile time of a generated sensitivity module per kB of its source, on the project's
+2-core VM (2026-11-27, an empty cache, one module at a time): the proposed model's 14 directions
+(202 kB) 33.5 s, Spencer's 8 (91 kB) 12.5 s, the single Bouc-Wen's 6 (34 kB) 4.8 s, the
+fractional model's 6 (84 kB) 16.9 s. An estimate for the progress shown while it compiles."""
+
+
+def expected_compile_seconds(model: str | BushingModel, lanes: int) -> float | None:
+    """About how long the module of ``model`` in ``lanes`` directions takes to compile (from its
+    source's size, ``COMPILE_SECONDS_PER_KB``); None before its source is generated in this
+    process."""
+    size = _source_sizes.get((resolve_model(model).name, lanes))
+    return None if size is None else size / 1000.0 * COMPILE_SECONDS_PER_KB
 
 
 def _generated_module(model: BushingModel, lanes: int) -> types.ModuleType:
@@ -131,6 +146,7 @@ def _generated_module(model: BushingModel, lanes: int) -> types.ModuleType:
     cache key): numba's disk cache holds its machine code from the machine's first process on."""
     machinery = _kernels.integration_module()      # loaded first: the module imports it by name
     source = _kernels.model_source(model, machinery, _appendix(model, lanes, machinery))
+    _source_sizes[model.name, lanes] = len(source)
     return _kernels.load_generated(_kernels.module_name(f"bushing_jacobian{lanes}_{model.name}", source), source)
 
 
