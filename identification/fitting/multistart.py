@@ -107,10 +107,15 @@ class StartRecord:
 
 
 def screen(problem: Problem, engine, count: int, seed: int, progress=None,
-           anchored: dict[int, float] | None = None, anchored_count: int = 0) -> tuple[np.ndarray, np.ndarray]:
+           anchored: dict[int, float] | None = None, anchored_count: int = 0, prefix: Problem | None = None,
+           kept: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
     """``count`` scrambled Sobol points over the box and their misfits; with ``anchored``
     ({coordinate index: value}, from the data: ``identification.fitting.loop_start``), ``anchored_count``
-    more: the first Sobol points with those coordinates set to those values."""
+    more: the first Sobol points with those coordinates set to those values. With ``prefix`` (the
+    problem on the start of each test: ``Objective.prefix``), every point is screened on it first
+    and only the best ``kept`` fraction of them (in their order) is returned, with the misfits of
+    ``problem``: each point's simulation is its own, so a point's misfit has the same bits however
+    it was selected."""
     bounds = problem.space.bounds()
     unit = qmc.Sobol(len(bounds), scramble=True, seed=np.random.default_rng(seed)).random(count)
     theta = bounds[:, 0] + unit * (bounds[:, 1] - bounds[:, 0])
@@ -120,9 +125,17 @@ def screen(problem: Problem, engine, count: int, seed: int, progress=None,
             extra[:, index] = value
         theta = np.vstack([theta, extra])
         count = len(theta)
-    blocks = [theta[i:i + 256] for i in range(0, count, 256)]
-    misfits = engine.map(_misfit_task, blocks, problem, progress=progress and (lambda n: progress(n * 256)))
-    return theta, np.concatenate(misfits)
+    if prefix is not None:
+        partial = _misfits(prefix, engine, theta, progress)
+        chosen = np.sort(np.argsort(partial, kind="stable")[:max(1, math.ceil(kept * count))])
+        theta = theta[chosen]
+    return theta, _misfits(problem, engine, theta, progress)
+
+
+def _misfits(problem: Problem, engine, theta: np.ndarray, progress=None) -> np.ndarray:
+    blocks = [theta[i:i + 256] for i in range(0, len(theta), 256)]
+    return np.concatenate(engine.map(_misfit_task, blocks, problem, progress=progress and (
+        lambda n: progress(n * 256))))
 
 
 def genetic_algorithm(problem: Problem, engine, seed: int, progress=None, population: int = 300,

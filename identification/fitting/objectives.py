@@ -25,7 +25,7 @@ FAILED_RESIDUAL noise levels from there on: worse than any candidate that runs.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Sequence
 
 import numpy as np
@@ -46,6 +46,8 @@ FAILED_RESIDUAL = 1e3
 MIN_NOISE_FRACTION = 1e-3
 """Noise levels below 0.1 % of a test's rms force are taken as 0.1 %: the forward model's own
 accuracy at 1 kHz is about 0.04 % (tests/test_forward_model.py), so a fit cannot resolve less."""
+MIN_PREFIX_SAMPLES = 50
+"""The shortest prefix of a test a candidate is first screened on (``Objective.prefix``)."""
 
 
 @dataclass(frozen=True)
@@ -196,6 +198,22 @@ class Objective:
         sample (the table's loop as it is)."""
         return Objective(tests, self.noise, steps, self.bushing, self._source_table, self.search,
                          self._source_multiaxis, self.multiaxis_noise, self.coupling)
+
+    def prefix(self, tests: Sequence[RigTest], fraction: float) -> "Objective | None":
+        """The same objective (of ``tests``, the ones it was made of) on the first ``fraction``
+        of each test's samples (at least MIN_PREFIX_SAMPLES), with the same noise levels and steps
+        per sample: a cheap first look at a candidate (``multistart.screen``). None where it has a
+        table or multi-axis tests, whose cost no prefix of the time series lowers."""
+        if self.table is not None or self.multiaxis:
+            return None
+        cut = []
+        for test in tests:
+            m = test.measurement
+            k = min(len(m), max(MIN_PREFIX_SAMPLES, math.ceil(fraction * len(m))))
+            # a prefix of a step may end inside its ramp: as a plain time series, whose kind checks nothing
+            cut.append(RigTest(replace(m, time_s=m.time_s[:k], displacement_mm=m.displacement_mm[:k],
+                                       force_N=m.force_N[:k], velocity_mm_s=m.velocity_mm_s[:k])))
+        return Objective(cut, self.noise, self.steps_per_sample, self.bushing)
 
     def with_fit_loop(self, tests: Sequence[RigTest]) -> "Objective":
         """The same objective with the table's fit loop instead of its search loop (itself if it

@@ -26,6 +26,11 @@ class SearchSettings:
     screening: int
     stages: tuple[tuple[int, int], ...]
     global_search: str = SOBOL
+    prefix_fraction: float | None = None
+    """Where the training is time series alone: every Sobol point is screened first on this
+    fraction of each test (its start), and only the best ``prefix_kept`` of them on the whole
+    tests (``multistart.screen``). None: every point on the whole tests."""
+    prefix_kept: float = 1.0 / 8.0
 
     @property
     def genetic(self) -> bool:
@@ -49,11 +54,18 @@ class SearchSettings:
         counts = [starts for starts, _ in self.stages]
         if counts != sorted(counts, reverse=True):
             raise ValueError(f"stage start counts {counts} must not grow")
+        if self.prefix_fraction is not None and not (0.0 < self.prefix_fraction < 1.0 and 0.0 < self.prefix_kept <= 1.0):
+            raise ValueError(f"screening prefix {self.prefix_fraction} of each test, best {self.prefix_kept} kept: "
+                             "both must be fractions in (0, 1)")
 
 
 _STAGES = ((128, 10), (24, 30), (6, 300))
+SCREENING_PREFIX = 0.1
+"""The default preset screens its 8192 Sobol points on the first tenth of each test, then the best
+eighth of them on the whole tests: on the paper's Table 5 sine and step the 128 points that start the
+least squares are the same ones (the worst of them 253rd on the tenth), for 0.46 of the cost."""
 PRESETS = {
-    "default": SearchSettings(screening=8192, stages=_STAGES),
+    "default": SearchSettings(screening=8192, stages=_STAGES, prefix_fraction=SCREENING_PREFIX),
     # the paper's GA as the global stage (its final population ranks the starts)
     "paper": SearchSettings(screening=PAPER_GA["population"], stages=_STAGES, global_search=GENETIC),
 }
@@ -61,10 +73,15 @@ PRESETS = {
 
 def global_phase(preset: str) -> str:
     """What the preset's global phase is, in words."""
-    if PRESETS[preset].genetic:
+    settings = PRESETS[preset]
+    if settings.genetic:
         return (f"the paper's GA (pymoo, population {PAPER_GA['population']}, "
                 f"{PAPER_GA['generations']} generations)")
-    return f"{PRESETS[preset].screening} scrambled Sobol points"
+    if settings.prefix_fraction is not None:
+        # no per cent sign: the command line's help is a %-format
+        return (f"{settings.screening} scrambled Sobol points (with time series alone: screened on the first "
+                f"{settings.prefix_fraction:g} of each test, the best {settings.prefix_kept:g} of them on the whole)")
+    return f"{settings.screening} scrambled Sobol points"
 
 
 def describe(preset: str) -> str:

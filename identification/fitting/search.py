@@ -345,8 +345,13 @@ class Search:
         """The preset's global phase: its points and their misfits, best first."""
         settings, problem = self.request.settings, self.problem
         loop = self._data_start()
-        self.bars = SearchProgress(self.progress, settings, settings.global_evaluations(
-            settings.screening + (LOOP_STARTS if loop else 0)))
+        points = settings.screening + (LOOP_STARTS if loop else 0)
+        prefix = None
+        if settings.prefix_fraction is not None and not settings.genetic:
+            objective = problem.objective.prefix(self.request.tests, settings.prefix_fraction)
+            prefix = objective and Problem(objective, self.space, "difference")
+        kept = math.ceil(settings.prefix_kept * points) if prefix else 0
+        self.bars = SearchProgress(self.progress, settings, settings.global_evaluations(points) + kept)
         if settings.genetic:
             from identification.fitting.multistart import genetic_algorithm
             theta, misfits = genetic_algorithm(problem, self.engine, self.request.seed, self.bars.screening,
@@ -354,8 +359,8 @@ class Search:
         else:
             theta, misfits = screen(problem, self.engine, settings.screening, self.request.seed, self.bars.screening,
                                     anchored=loop and anchored_coordinates(loop, self.space),
-                                    anchored_count=LOOP_STARTS)
-        self.evaluations += settings.global_evaluations(len(misfits))
+                                    anchored_count=LOOP_STARTS, prefix=prefix, kept=settings.prefix_kept)
+        self.evaluations += settings.global_evaluations(points) + kept
         return theta, misfits
 
     def _stages(self, theta, misfits):
