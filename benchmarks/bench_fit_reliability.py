@@ -16,7 +16,9 @@ of the noise drawn, over the rms force), converged (the fit's own verdict, with 
 estimate), the wall time, the worst NRMSE against the noise-free truth over the paper's §5
 grid less the two training cases (16 sines, 9 steps, the random input), and the ensemble's
 band: on every grid case the best fit misses by more than 1 % NRMSE, the fraction of samples
-where the truth lies within the ensemble's envelope widened by the training noise level.
+where the truth lies within the ensemble's envelope widened by the training noise level; and
+(default method) the factor by which the stages after the first lowered the misfit, which bounds
+compare's race (``identification.analysis.race.RACE_CLOSING``).
 
 ``--methods default,de,cma`` adds the previous default (scipy's differential evolution,
 rand1bin, 15 x 14 x 100, then a trust-region polish from its best) and CMA-ES with BIPOP
@@ -155,7 +157,9 @@ def run_default(tests, seed, workers):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         result = fit(tests, seed=seed, workers=workers, progress=False)
-    return result.ensemble, result.converged, [t.nrmse for t in result.tests], result.warning or ""
+    # how far the stages after the first lowered the misfit (compare's race: identification.analysis.race)
+    closing = result.first_stage_misfit / result.misfit
+    return result.ensemble, result.converged, [t.nrmse for t in result.tests], result.warning or "", closing
 
 
 def _problem(tests):
@@ -172,7 +176,7 @@ def _finish(problem, theta, tests):
     params = dict(zip(PARAMETER_NAMES, map(float, problem.space.to_parameters(theta)[0])))
     fits = test_fits(tests, [estimate_noise(t.measurement.force_N) for t in tests],
                       ParameterSet(problem.space.bushing, params))
-    return [params], all(f.at_floor for f in fits), [f.nrmse for f in fits], ""
+    return [params], all(f.at_floor for f in fits), [f.nrmse for f in fits], "", None
 
 
 def run_de(tests, seed, workers):
@@ -230,13 +234,13 @@ def main() -> None:
         for method in args.methods.split(","):
             for seed in args.seeds:
                 started = time.perf_counter()
-                members, converged, nrmses, note = METHODS[method](tests, seed, args.workers)
+                members, converged, nrmses, note, closing = METHODS[method](tests, seed, args.workers)
                 seconds = time.perf_counter() - started
                 at_floor = all(n <= FLOOR * level for n, level in zip(nrmses, noise_levels))
                 worst, coverages = judge(members, truth, sigma_N)
                 row = {"truth": name, "method": method, "seed": seed, "at_floor": at_floor, "converged": converged,
                        "seconds": seconds, "nrmse_over_noise": [n / level for n, level in zip(nrmses, noise_levels)],
-                       "worst_grid_nrmse": worst, "members": len(members), "note": note,
+                       "worst_grid_nrmse": worst, "members": len(members), "note": note, "closing": closing,
                        "band": [{"case": c, "coverage": cov, "nrmse": e} for c, cov, e in coverages]}
                 rows.append(row)
                 band = min((c["coverage"] for c in row["band"]), default=float("nan"))
@@ -245,6 +249,7 @@ def main() -> None:
                       f"NRMSE/noise {' '.join(f'{r:.3f}' for r in row['nrmse_over_noise'])} "
                       f"{seconds:6.1f} s  worst grid {worst:6.2%}  members {len(members):3d}  "
                       f"cases > 1 %: {len(row['band'])}, least band coverage {band:.3f}"
+                      + (f", later stages closed {closing:.3g}x" if closing else "")
                       + (f"\n           ({note})" if note else ""), flush=True)
                 if args.json:
                     args.json.write_text(json.dumps(rows, indent=1))
@@ -261,6 +266,10 @@ def main() -> None:
               f"{np.median([r['seconds'] for r in mine]):9.1f} {max(r['seconds'] for r in mine):8.1f} "
               f"{max(r['worst_grid_nrmse'] for r in mine):11.2%} "
               f"{sum(b >= 0.95 for b in bands):5d} of {len(bands):<5d}")
+    closings = [r["closing"] for r in rows if r["closing"]]
+    if closings:
+        print(f"the stages after the first lowered the misfit by at most {max(closings):.3g}x (median "
+              f"{np.median(closings):.3g}x)")
 
 
 if __name__ == "__main__":
