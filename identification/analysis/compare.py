@@ -1,7 +1,8 @@
 """Choosing the model: fit several models on the same training tests, weigh them on what the user
 has, and recommend one (the paper's comparison study, §3.1, §4.3, Figs. 15-17, made a decision).
 
-Each model is fitted (``fitting.fit``) and assessed on:
+The models race (``analysis.race``): each is screened, the ones that can still win are fitted to
+the end (as ``fitting.fit`` fits them), and each fitted model is assessed on:
 
 - training: its NRMSE against each test's noise level and, where a dynamic-stiffness table is
   training data too (``training_table``, ``compare --kdyn``), the table's rms error in units of
@@ -20,8 +21,10 @@ reaches the floor, the fewest parameters says nothing (a linear bushing that mis
 within the tolerance of the best (all, without held-out data), and of those the lowest BIC, with
 a note that no model describes the data to their noise and by how much the chosen one misses.
 
-Writes into the output directory: ``params_<model>.json`` per model (with provenance),
-``comparison.csv`` (one row per model: everything above and whether it is the recommendation),
+Writes into the output directory: ``params_<model>.json`` per fitted model (with provenance; the
+ensemble sampled for the recommended one), ``comparison.csv`` (one row per model: everything above
+and whether it is the recommendation; for a model stopped after its screening, its screened and
+first-stage chi^2/n and why it stopped),
 ``validation.csv`` (NRMSE and eq. 10 per file and model), ``kdyn_errors.csv`` (per row of the
 table and model), one PNG per validation file (force over time and force-displacement loops) and
 one for the table, each whole or not at all (``interrupt.writing``). Prints the tables; the last
