@@ -250,8 +250,7 @@ def _settings(base: SearchSettings, screening: int | None, starts: int | None) -
         base = replace(base, stages=stages)
     if screening is not None:
         base = replace(base, screening=screening)
-    return SearchSettings(base.screening, base.stages, base.global_search, base.prefix_fraction,
-                          base.prefix_kept)   # validates
+    return base     # a preset's settings, or replace()'s, which validates them again
 
 
 def linear_solution(bushing: BushingModel, measurements) -> dict[str, float]:

@@ -198,7 +198,9 @@ class Search:
         self.jacobian_compile = None
         self.screened = None         # the global phase's points and misfits
         self.first_records = None    # the starts after the first least-squares stage
-        self._first_stage_misfit = None
+        self.first_stage_misfit = None  # the best chi^2/n after the first least-squares stage (the
+        # screened one where the preset has a single stage, which is the last)
+        self.problem = None
         self.final_state = None      # what the stages left for the result
         self.result = None
 
@@ -208,7 +210,7 @@ class Search:
 
     def prepare(self) -> Problem:
         """The box and the objective (once): ``problem``."""
-        if not hasattr(self, "problem"):
+        if self.problem is None:
             self.problem = self._problem()
         return self.problem
 
@@ -239,12 +241,6 @@ class Search:
         self.seconds += time.perf_counter() - began
         return self.first_stage_misfit
 
-    @property
-    def first_stage_misfit(self) -> float | None:
-        """The best misfit (chi^2/n) after the first least-squares stage (None before it; the
-        screened one where the preset has a single stage, which is the last)."""
-        return self._first_stage_misfit
-
     def _first_stage(self) -> None:
         if self.first_records is not None:
             return
@@ -258,7 +254,7 @@ class Search:
             self.first_records = run_stages(self.problem, self.engine, self.first_records, stages[:1],
                                             self.bars.stage)
         # read now: the later stages go on with these records
-        self._first_stage_misfit = min((r.misfit for r in self.first_records if not r.failed),
+        self.first_stage_misfit = min((r.misfit for r in self.first_records if not r.failed),
                                        default=self.screened_misfit)
 
     def start_jacobian_compile(self) -> None:
@@ -272,7 +268,7 @@ class Search:
         run it) and the result; the ensemble sampled if ``ensemble`` (default: the request's
         ``sample_ensemble``)."""
         began = time.perf_counter()
-        records, added, agreeing = self._stages(*self.screened)
+        records, added, agreeing = self._stages()
         # scored by the objective used from here on; a failed start is skipped (failed_starts)
         final = [r for r in records if r.stage == len(self.request.settings.stages) - 1 and not r.failed]
         best = _best_record(final or records)
@@ -361,8 +357,8 @@ class Search:
         self.evaluations += settings.global_evaluations(points) + kept
         return theta, misfits
 
-    def _stages(self, theta, misfits):
-        """The least-squares stages from the global phase's best points: (records, starts added to
+    def _stages(self):
+        """The least-squares stages from the global phase's best points (after the first stage): (records, starts added to
         the last stage, starts that agreed before). The forward model's steps per sample are
         checked where the result is decided: at the best start before the last stage, and at the
         best fit; if that changes them, the last stage runs once more, and a third check only
