@@ -58,7 +58,7 @@ class MeasurementWarning(UserWarning):
 
 
 class FitNotConvergedWarning(UserWarning):
-    """A fit that ended above the noise floor or whose starts do not agree. Warned by ``fit``
+    """A fit that ended above its floor or whose starts do not agree. Warned by ``fit``
     (its text is ``FitResult.warning``; ``FitResult.converged`` is then False)."""
 
 

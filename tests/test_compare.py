@@ -28,7 +28,7 @@ def test_the_simplest_model_at_the_floor_that_predicts_within_ten_percent_of_the
     choice = recommend([assessment("many", 14, 1.0, held_out=0.0100), assessment("few", 6, 1.1, held_out=0.0108),
                         assessment("linear", 2, 40.0, held_out=0.2)])
     assert choice.model == "few"
-    assert "2 of 3 at the noise floor" in choice.reason and "fewest free parameters" in choice.reason
+    assert "2 of 3 at the floor" in choice.reason and "fewest free parameters" in choice.reason
 
 
 def test_a_simpler_model_that_predicts_worse_by_more_than_ten_percent_is_not_recommended():
@@ -45,7 +45,7 @@ def test_every_kind_of_held_out_data_must_be_predicted_well():
 def test_without_a_model_at_the_floor_the_best_predictor_is_recommended_and_the_reason_says_so():
     choice = recommend([assessment("a", 6, 3.0, held_out=0.05), assessment("b", 14, 2.0, held_out=0.03),
                         assessment("c", 2, 50.0, held_out=0.30)])
-    assert choice.model == "b" and choice.reason.startswith("no model reaches the noise floor")
+    assert choice.model == "b" and choice.reason.startswith("no model reaches the floor")
 
 
 def test_without_a_model_at_the_floor_or_held_out_data_the_lowest_bic_is_recommended_not_the_fewest_parameters():
@@ -57,8 +57,8 @@ def test_without_a_model_at_the_floor_or_held_out_data_the_lowest_bic_is_recomme
     linear = assessment("kelvin_voigt", 2, 142.0, misfit=142.0 ** 2, residuals=n)
     choice = recommend([linear, bouc_wen, proposed])
     assert choice.model == "proposed"
-    assert choice.reason.startswith("no model reaches the noise floor") and "lowest BIC" in choice.reason
-    assert "no model describes these data to their noise level" in choice.caveat
+    assert choice.reason.startswith("no model reaches the floor") and "lowest BIC" in choice.reason
+    assert "no model describes these data to their floor" in choice.caveat
     assert "proposed" in choice.caveat and "70x the noise" in choice.caveat
 
 

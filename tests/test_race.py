@@ -28,6 +28,7 @@ class Finished:
     at_floor: bool
     free_parameters: int = 14
     residuals: int = 1000
+    floor_misfit: float = 1.0
 
     @property
     def information_criterion(self) -> float:
@@ -46,6 +47,15 @@ def test_a_model_that_could_still_reach_the_floor_runs_on():
 def test_a_model_that_cannot_reach_the_floor_a_finished_model_reached_is_stopped_and_told_why():
     reason = out_of_race(15.7, 6, 1000, [Finished("leader", 1.0, True)], closing=10.0)
     assert reason is not None and "leader" in reason and "15.7" in reason and "10x" in reason
+
+
+def test_where_the_device_repeats_less_than_its_noise_the_floor_is_its_repeatability():
+    # a sine whose cycles differ by 10x its noise level: a fit at that floor has chi^2/n up to 100
+    # (in noise units), so a model whose later stages could reach 150 may still reach it, one at 160 not
+    leader = Finished("leader", 90.0, True, floor_misfit=100.0)
+    assert out_of_race(1500.0, 6, 1000, [leader], closing=10.0) is None
+    reason = out_of_race(1600.0, 6, 1000, [leader], closing=10.0)
+    assert reason is not None and "156" in reason and "leader" in reason
 
 
 def test_without_a_model_at_the_floor_the_bic_decides():

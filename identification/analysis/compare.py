@@ -4,7 +4,9 @@ has, and recommend one (the paper's comparison study, §3.1, §4.3, Figs. 15-17,
 The models race (``analysis.race``): each is screened, the ones that can still win are fitted to
 the end (as ``fitting.fit`` fits them), and each fitted model is assessed on:
 
-- training: its NRMSE against each test's noise level and, where a dynamic-stiffness table is
+- training: its NRMSE against each test's floor (its noise level or, for a sine whose device
+  repeats less than that, what it repeats from cycle to cycle:
+  ``measured.repeatability``) and, where a dynamic-stiffness table is
   training data too (``training_table``, ``compare --kdyn``), the table's rms error in units of
   its uncertainty (at the floor: each within ``result.FLOOR_FACTOR`` of it), chi^2/n, and
   Schwarz's information criterion BIC = chi^2 + d*ln(n) over its d free parameters;
@@ -12,14 +14,14 @@ the end (as ``fitting.fit`` fits them), and each fitted model is assessed on:
   a dynamic-stiffness table (|K*| and loss-angle errors per amplitude and frequency, and their
   rms in units of the table's uncertainty, ``kdyn_table``).
 
-The recommendation (:func:`recommend`) is the simplest model that reaches the noise floor and
+The recommendation (:func:`recommend`) is the simplest model that reaches the floor and
 predicts best: among the models at the floor, those whose held-out errors are within
 ``PREDICTION_TOLERANCE`` of the best on each kind of held-out data (all of them, if none is held
 out); of those the one with the fewest free parameters, then the lowest BIC. Where no model
 reaches the floor, the fewest parameters says nothing (a linear bushing that misses the data by
 140x its noise is not simpler than one that misses by 70x, it is worse): the models that predict
 within the tolerance of the best (all, without held-out data), and of those the lowest BIC, with
-a note that no model describes the data to their noise and by how much the chosen one misses.
+a note that no model describes the data to their floor and by how much the chosen one misses.
 
 Writes into the output directory: ``params_<model>.json`` per fitted model (with provenance; the
 ensemble sampled for the recommended one), ``comparison.csv`` (one row per model: everything above
@@ -68,10 +70,11 @@ class Assessment:
     free_parameters: int
     residuals: int
     misfit: float                          # chi^2/n over the training data (tests and a training table)
-    training_ratio: float                  # the largest NRMSE over the noise level of a training test or table
+    training_ratio: float                  # the largest NRMSE over its floor of a training test (or table's error over its uncertainty)
     at_floor: bool
     converged: bool
     seconds: float
+    floor: str = "the noise"                # what sets the worst training test's floor (RigTestFit.floor_words)
     screened_misfit: float | None = None    # the best chi^2/n of its screening (None: a linear model)
     first_stage_misfit: float | None = None  # the best chi^2/n after its first least-squares stage
     validation: dict[str, tuple[float, float]] = field(default_factory=dict)   # held-out file: (NRMSE, eq. 10)
@@ -95,8 +98,10 @@ class Assessment:
     @classmethod
     def of(cls, result: FitResult) -> "Assessment":
         ratios = [t.ratio for t in result.tests] + ([result.table.ratio] if result.table is not None else [])
+        worst = max(result.tests, key=lambda t: t.ratio, default=None)
+        floor = worst.floor_words if worst is not None and worst.ratio == max(ratios) else "the noise"
         return cls(result.model, result.free_parameters, result.residuals, result.misfit,
-                   max(ratios, default=math.nan), result.at_floor, result.converged, result.seconds,
+                   max(ratios, default=math.nan), result.at_floor, result.converged, result.seconds, floor,
                    result.screened_misfit, result.first_stage_misfit)
 
 
@@ -105,32 +110,33 @@ class Recommendation:
     model: str
     reason: str
     caveat: str = ""
-    """Where no model reaches the noise floor: that none describes the data to their noise, the
+    """Where no model reaches the floor: that none describes the data to their floor, the
     recommended model's miss (its worst training test against its noise level); else empty."""
 
 
 def recommend(assessments: Sequence[Assessment], tolerance: float = PREDICTION_TOLERANCE) -> Recommendation:
     """The model to use (module docstring), why, and a caveat where none reaches the floor.
 
-    Where some models reach the noise floor: of those, the ones that predict every kind of held-out
+    Where some models reach the floor: of those, the ones that predict every kind of held-out
     data (files, then the table) within ``tolerance`` of the best; of those the one with the fewest
     free parameters, then the lowest BIC. Where none does, parsimony says nothing (every model misses
     the data): the ones that predict within ``tolerance`` of the best, where held-out data are given,
     and of those (of all, without) the lowest BIC, which weighs the fit itself against its
     parameters."""
     pool = [a for a in assessments if a.at_floor]
-    why = [f"{len(pool)} of {len(assessments)} at the noise floor"]
+    why = [f"{len(pool)} of {len(assessments)} at the floor"]
     if not pool:
         pool = list(assessments)
-        why = [f"no model reaches the noise floor (none of the {len(pool)} describes the data to their noise)"]
+        why = [f"no model reaches the floor (none of the {len(pool)} describes the data to their noise, or to what "
+               "the device repeats)"]
     held_out = _predicting_best(pool, tolerance, why)
     filtered = len(held_out) < len(pool) or len(why) > 1
     if why[0].startswith("no model"):
         chosen = min(held_out, key=lambda a: (a.information_criterion, a.free_parameters))
         why.append(f"{chosen.model} has the lowest BIC{' of those' if filtered else ''}")
-        caveat = (f"no model describes these data to their noise level; the best, {chosen.model}, misses its worst "
-                  f"training data by {chosen.training_ratio:.3g}x the noise (or a training table's uncertainty; the floor is "
-                  f"{FLOOR_FACTOR}x): treat "
+        caveat = (f"no model describes these data to their floor; the best, {chosen.model}, misses its worst "
+                  f"training data by {chosen.training_ratio:.3g}x {chosen.floor} (or a training table's uncertainty; the floor "
+                  f"is {FLOOR_FACTOR}x): treat "
                   "its predictions as approximate")
         return Recommendation(chosen.model, "; ".join(why), caveat)
     chosen = min(held_out, key=lambda a: (a.free_parameters, a.information_criterion))
@@ -314,7 +320,7 @@ def format_assessments(assessments: Sequence[Assessment], recommendation: Recomm
     """One row per model: parameters, training against the noise, BIC, held-out errors; a model
     stopped after its screening, its screened misfit and why (``race``)."""
     best_bic = min(a.information_criterion for a in assessments)
-    lines = [f"{'model':17s} {'params':>6s} {'worst NRMSE/noise':>17s} {'floor':>5s} {'chi2/n':>9s} {'dBIC':>9s} "
+    lines = [f"{'model':17s} {'params':>6s} {'worst NRMSE/floor':>17s} {'floor':>5s} {'chi2/n':>9s} {'dBIC':>9s} "
              f"{'held-out NRMSE':>14s} {'table err/unc':>13s}"]
     for a in assessments:
         held = f"{a.validation_error:.2%}" if a.validation_error is not None else "-"
@@ -324,7 +330,8 @@ def format_assessments(assessments: Sequence[Assessment], recommendation: Recomm
                      f"{a.misfit:9.3f} {a.information_criterion - best_bic:9.1f} {held:>14s} {table:>13s}{mark}")
     for s in stopped:
         lines.append(f"{s.model:17s} {s.free_parameters:6d}  stopped after its screening: {s.reason}")
-    lines.append(f"floor: every training test's NRMSE within {FLOOR_FACTOR}x its noise level (a training table's "
+    lines.append(f"floor: every training test's NRMSE within {FLOOR_FACTOR}x its noise level or, for a sine whose "
+                 "device repeats less than that from cycle to cycle, its repeatability (a training table's "
                  f"rms error within {FLOOR_FACTOR}x its uncertainty; the column is the worst of them); dBIC: BIC = chi^2 + "
                  "d*ln(n) over the best; held-out NRMSE: the mean over the validation files that are not training "
                  f"files; table err/unc: rms error in units of {KDYN_UNCERTAINTY:.0%} on |K*| and "
@@ -359,7 +366,7 @@ def _write_csvs(out_dir: Path, assessments, recommendation: Recommendation, erro
     best_bic = min(a.information_criterion for a in assessments)
     with writing(out_dir / "comparison.csv") as temporary, open(temporary, "w", newline="") as handle:
         writer = csv.writer(handle)
-        writer.writerow(["model", "free_parameters", "worst_nrmse_over_noise", "at_floor", "converged",
+        writer.writerow(["model", "free_parameters", "worst_nrmse_over_floor", "at_floor", "converged",
                          "misfit_chi2_per_residual", "residuals", "bic", "delta_bic", "held_out_mean_nrmse",
                          "table_error_over_uncertainty", "table_largest_kdyn_error", "table_largest_loss_angle_error_deg",
                          "seconds", "recommended", "screened_misfit_chi2_per_residual",

@@ -7,8 +7,9 @@ lower that stage's best misfit (chi^2/n over the training data) by some factor. 
 first-stage misfit, divided by the largest such factor seen on the project's comparison cases
 (``RACE_CLOSING``, with a margin), is still above
 
-- the noise floor's misfit (``FLOOR_FACTOR`` squared: a fit whose chi^2/n is above it has a test
-  or table above the floor), and,
+- the floor's misfit (``FLOOR_FACTOR`` squared, times ``FitResult.floor_misfit`` where a sine's
+  device repeats less than its noise says: a fit whose chi^2/n is above it has a test or table
+  above its floor), and,
 - where no finished model reaches the floor, the misfit that would give it the lowest BIC
   (the recommendation's measure then),
 
@@ -69,17 +70,18 @@ def out_of_race(first_stage_misfit: float, free_parameters: int, residuals: int,
     if not finished:
         return None
     least = first_stage_misfit / closing            # the lowest misfit its later stages could reach
-    if least <= FLOOR_FACTOR ** 2:
+    floor = FLOOR_FACTOR ** 2 * finished[0].floor_misfit      # the same training data for every model
+    if least <= floor:
         return None
     at_floor = [r for r in finished if r.at_floor]
     if at_floor:
         leader = min(at_floor, key=lambda r: r.misfit)
         return (f"chi^2/n {first_stage_misfit:.4g} after its first stage: even lowered {closing:g}x it stays above "
-                f"the noise floor's {FLOOR_FACTOR ** 2:.3g}, which {leader.model} reached")
+                f"the floor's {floor:.3g}, which {leader.model} reached")
     leader = min(finished, key=lambda r: r.information_criterion)
     if information_criterion(least, free_parameters, residuals) > leader.information_criterion:
         return (f"chi^2/n {first_stage_misfit:.4g} after its first stage: even lowered {closing:g}x it stays above "
-                f"the noise floor and its BIC above {leader.model}'s")
+                f"the floor and its BIC above {leader.model}'s")
     return None
 
 

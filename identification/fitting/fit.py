@@ -11,7 +11,7 @@
    processes, or a Dask cluster; the same seed gives the same bits on each);
 3. the evidence (pyPESTO's multi-start practice, ``identification.fitting.result``): how many of the last stage's starts reach
    the best misfit within the ensemble threshold, and whether every training test is at its
-   noise floor (NRMSE <= FLOOR_FACTOR x its noise level). A fit that is not both is
+   floor (NRMSE <= FLOOR_FACTOR x its noise level, or a sine's repeatability where that is larger). A fit that is not both is
    ``converged = False`` and says why (``FitResult.warning``);
 4. how sure (``identification.fitting.ensemble``): the singular values of the residual Jacobian and
    the ensemble: distinct start end points and posterior draws (emcee) pushed to the edge of

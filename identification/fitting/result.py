@@ -2,9 +2,11 @@
 
 :class:`FitResult` is the front door's answer (``identification.fit``); :class:`RigTestFit` one
 training test at the fitted parameters, :class:`TableFit` a dynamic-stiffness table's. A fit
-is ``converged`` when every test is at its noise floor (NRMSE <= ``FLOOR_FACTOR`` x its noise
-level) and at least ``MIN_AGREEING`` starts of the last stage reach the best misfit within the
-95 % confidence threshold; otherwise ``warning`` says why, with its figures.
+is ``converged`` when every test is at its floor (NRMSE <= ``FLOOR_FACTOR`` x the larger of its
+noise level and, for a sine, what the device repeats from cycle to cycle:
+``identification.measured.repeatability``) and at least ``MIN_AGREEING`` starts of the last stage
+reach the best misfit within the 95 % confidence threshold; otherwise ``warning`` says why, with
+its figures.
 
 Units: forces in N, NRMSE and noise levels as fractions of the rms force, misfit chi^2/n
 (1 at the noise floor), loss angles in degrees.
@@ -24,6 +26,7 @@ from identification.errors import FitNotConvergedWarning, IdentificationError  #
 from identification.interrupt import deferred, writing
 from identification.measured.kdyn_table import FIT_CYCLES, KDYN_UNCERTAINTY, LOSS_ANGLE_UNCERTAINTY_DEG
 from identification.measured.noise import NoiseEstimate
+from identification.measured.repeatability import Repeatability
 from identification.fitting.objectives import MIN_NOISE_FRACTION
 from identification.fitting.presets import describe
 
@@ -33,18 +36,21 @@ if TYPE_CHECKING:
     from identification.fitting.search_space import SearchSpace
 
 FLOOR_FACTOR = 1.25
-"""A test is at its noise floor when the fit's NRMSE on it is at most this times its noise level."""
+"""A test is at its floor when the fit's NRMSE on it is at most this times its floor (the larger
+of its noise level and its repeatability)."""
 MIN_AGREEING = 2
 """Starts of the last stage that must reach the best misfit for a fit to be converged."""
 
 
 @dataclass
 class RigTestFit:
-    """One training test at the fitted parameters."""
+    """One training test at the fitted parameters: its noise level, for a sine what the device
+    repeats from cycle to cycle (``repeatability``; None for other tests), and the NRMSE."""
     name: str
     kind: str
     noise: NoiseEstimate
     nrmse: float
+    repeatability: Repeatability | None = None
 
     @property
     def noise_fraction(self) -> float:
@@ -53,17 +59,53 @@ class RigTestFit:
         return max(self.noise.relative, MIN_NOISE_FRACTION)
 
     @property
-    def ratio(self) -> float:
+    def repeat_fraction(self) -> float | None:
+        """What the device does not repeat, as a fraction of the rms force (None: not a sine, or
+        too few steady cycles)."""
+        if self.repeatability is None or not self.repeatability.known:
+            return None
+        return self.repeatability.relative
+
+    @property
+    def floor_source(self) -> str:
+        """What sets the floor: "repeatability" where the device repeats less than its noise
+        says, else "noise"."""
+        repeat = self.repeat_fraction
+        return "repeatability" if repeat is not None and repeat > self.noise_fraction else "noise"
+
+    @property
+    def floor_fraction(self) -> float:
+        """The NRMSE no model driven by the displacement can go below: the larger of the noise
+        level and the repeatability."""
+        return self.repeat_fraction if self.floor_source == "repeatability" else self.noise_fraction
+
+    @property
+    def floor_words(self) -> str:
+        """What the floor is, for reports: "the noise" or "what the device repeats"."""
+        return "what the device repeats" if self.floor_source == "repeatability" else "the noise"
+
+    @property
+    def noise_ratio(self) -> float:
+        """The NRMSE over the noise level alone."""
         return self.nrmse / self.noise_fraction
+
+    @property
+    def ratio(self) -> float:
+        """The NRMSE over the floor (:attr:`floor_fraction`)."""
+        return self.nrmse / self.floor_fraction
 
     @property
     def at_floor(self) -> bool:
         return bool(self.ratio <= FLOOR_FACTOR)
 
     def as_dict(self) -> dict:
-        return {"file": self.name, "kind": self.kind, "noise_N": round_for_file(self.noise_fraction * self.noise.rms_force_N),
-                "noise_fraction": round_for_file(self.noise_fraction), "nrmse": round_for_file(self.nrmse),
-                "nrmse_over_noise": round_for_file(self.ratio), "at_floor": self.at_floor}
+        out = {"file": self.name, "kind": self.kind, "noise_N": round_for_file(self.noise_fraction * self.noise.rms_force_N),
+               "noise_fraction": round_for_file(self.noise_fraction), "nrmse": round_for_file(self.nrmse),
+               "nrmse_over_noise": round_for_file(self.noise_ratio)}
+        if self.repeat_fraction is not None:
+            out["repeatability_fraction"] = round_for_file(self.repeat_fraction)
+        out.update({"floor": self.floor_source, "nrmse_over_floor": round_for_file(self.ratio), "at_floor": self.at_floor})
+        return out
 
 
 @dataclass
@@ -186,6 +228,14 @@ class FitResult:
         return all(t.at_floor for t in self.tests) and (self.table is None or self.table.at_floor)
 
     @property
+    def floor_misfit(self) -> float:
+        """The largest chi^2/n (which is in noise units) a fit at the floor of every test can
+        have, but for FLOOR_FACTOR: 1 where the noise sets every floor, (repeatability/noise)^2 of
+        the test with the most where the device repeats less than its noise says (the race's
+        bound, ``identification.analysis.race``)."""
+        return max([(t.floor_fraction / t.noise_fraction) ** 2 for t in self.tests], default=1.0)
+
+    @property
     def converged(self) -> bool:
         enough = self.agreeing >= MIN_AGREEING or self.space is None   # Kelvin-Voigt: exact optimum
         return self.at_floor and enough
@@ -199,7 +249,7 @@ class FitResult:
         worst = max(self.tests, key=lambda t: t.ratio) if self.tests else None
         if worst is not None and not worst.at_floor:
             reasons.append(f"training NRMSE {worst.nrmse:.2%} on {worst.name} is {worst.ratio:.2f}x "
-                           f"its noise level {worst.noise_fraction:.2%} (the floor is {FLOOR_FACTOR}x)")
+                           f"{worst.floor_words} ({worst.floor_fraction:.2%}; the floor is {FLOOR_FACTOR}x)")
         if self.table is not None and not self.table.at_floor:
             reasons.append(f"the table {self.table.name} is matched to {self.table.ratio:.2f}x its uncertainty "
                            f"({KDYN_UNCERTAINTY:.0%} on |K*|, {LOSS_ANGLE_UNCERTAINTY_DEG:g} deg; the floor is "
@@ -212,9 +262,12 @@ class FitResult:
                     "describe these data may lie outside the box (see identification/fitting/search_space.py)")
         elif self.space is not None and self.agreeing < MIN_AGREEING:
             hint = "more starts (--starts, --screening) may find a better optimum"
+        elif worst is not None and worst.floor_source == "repeatability":
+            hint = ("the starts agree, so the model does not describe what the device repeats from cycle to cycle: "
+                    "a model with more of the device's physics may (bushing-identify compare)")
         else:
             hint = ("the starts agree, so the model may not describe these data to their noise level "
-                    "(or the noise estimate is low: correlated noise reads low)")
+                    "(or the noise estimate is low: correlated noise reads low; a sine's repeatability tells)")
         return f"not converged: {'; '.join(reasons)}; {hint}"
 
     def at_box_edge(self, tolerance: float = 1e-3) -> list[str]:
@@ -276,10 +329,14 @@ class FitResult:
         lines = [f"{self.parameters.model.title} fitted to {fitted}, preset {self.preset!r}, "
                  f"seed {self.seed}, {self.evaluations} simulations in {self.seconds:.1f} s on {self.engine}",
                  f"misfit chi^2/n = {self.misfit:.4f} (1 = the noise floor)"]
-        lines.append(f"{'test':44s} {'kind':7s} {'noise':>8s} {'NRMSE':>8s} {'ratio':>6s}  floor")
+        lines.append(f"{'test':44s} {'kind':7s} {'noise':>8s} {'repeats':>8s} {'NRMSE':>8s}  over the floor")
         for t in self.tests:
-            lines.append(f"{t.name:44s} {t.kind:7s} {t.noise_fraction:8.2%} {t.nrmse:8.2%} "
-                         f"{t.ratio:6.2f}  {'yes' if t.at_floor else 'NO'}")
+            repeats = f"{t.repeat_fraction:8.2%}" if t.repeat_fraction is not None else f"{'-':>8s}"
+            lines.append(f"{t.name:44s} {t.kind:7s} {t.noise_fraction:8.2%} {repeats} {t.nrmse:8.2%}  "
+                         f"{t.ratio:.2f}x {t.floor_words}: {'at the floor' if t.at_floor else 'NOT at the floor'}")
+        unknown = [t for t in self.tests if t.kind == "sine" and t.repeat_fraction is None and t.repeatability]
+        for t in unknown:
+            lines.append(f"note: {t.name}: {t.repeatability.describe()}; its floor is the noise level alone")
         if self.table is not None:
             lines.append(self.table.format())
             if self.table.cycles_error > 0.1 * KDYN_UNCERTAINTY:

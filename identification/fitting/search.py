@@ -31,6 +31,7 @@ from identification.measured.measurements import Measurement
 from identification.measured.multiaxis import MultiAxisMeasurement, vector_nrmse
 from identification.fitting.multistart import (Problem, StartRecord, failed_starts, first_records, jacobian, run_stages,
                                                screen, simulations_per_jacobian)
+from identification.measured.repeatability import estimate_repeatability
 from identification.measured.noise import NoiseEstimate
 from identification.fitting.objectives import Objective, nrmse
 from identification.fitting.presets import PAPER_GA, SearchSettings
@@ -493,14 +494,15 @@ def _check_steps(problem: Problem, tests, records, n: int, d: int):
 
 
 def test_fits(tests, noise, parameters: ParameterSet, steps=None) -> list[RigTestFit]:
-    """Each test's noise and NRMSE at ``parameters``, simulated with ``steps`` per sample (per
-    test; default: chosen from the signal)."""
+    """Each test's noise, repeatability (a sine's) and NRMSE at ``parameters``, simulated with
+    ``steps`` per sample (per test; default: chosen from the signal)."""
     fits = []
     for test, level, m_steps in zip(tests, noise, steps or [None] * len(tests)):
         m = test.measurement
         predicted = simulate(parameters, m.time_s, m.displacement_mm, m.measured_velocity_mm_s,
                              steps_per_sample=m_steps)
-        fits.append(RigTestFit(test.name, test.kind, level, nrmse(predicted, m.force_N)))
+        repeats = estimate_repeatability(m.time_s, m.displacement_mm, m.force_N) if test.kind == "sine" else None
+        fits.append(RigTestFit(test.name, test.kind, level, nrmse(predicted, m.force_N), repeats))
     return fits
 
 
