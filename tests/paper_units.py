@@ -20,6 +20,11 @@ PARAMETER_UNITS = {
     "spencer": {"c0": "N.s/mm", "k0": "N/mm", "c1": "N.s/mm", "k1": "N/mm", "x0": "mm", **_block("")},
     "single_bouc_wen": {"c0": "N.s/mm", "k0": "N/mm", **_block("")},
     "kelvin_voigt": {"k": "N/mm", "c": "N.s/mm", "preload": "N"},
+    # F = c0*v + k0*x + z with z = A*D(e) and de/dt = v*(1 - (|z|/Z)^n): A turns a deflection in mm
+    # into N (N/mm); the yields zp, zn are forces; (|z|/Z)^n and the breakaway factor 1 + eps*q are
+    # pure numbers; the play gap, its width and the breakaway's travel delta are lengths
+    "asymmetric_bouc_wen": {"c0": "N.s/mm", "k0": "N/mm", "A": "N/mm", "zp": "N", "zn": "N", "n": "1", "gap": "mm",
+                            "width": "mm", "eps": "1", "delta": "mm"},
     # F = k0*x + k3*x^3 + F_f(x; Ff_max, x2) + ...: k3*x^3 is a force with x in mm; the friction's
     # limit is a force and x2 a travel; Maxwell elements k*(x - q), dq/dt = k*(x - q)/c;
     # b*D^alpha x is a force with D^alpha x in mm/s^alpha

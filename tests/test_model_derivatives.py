@@ -54,12 +54,22 @@ _spec = importlib.util.spec_from_file_location("free_decoupler_mount", REFERENCE
 free_decoupler_mount = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(free_decoupler_mount)   # numpy and scipy only
 
+_spec = importlib.util.spec_from_file_location("generate_references", REFERENCES / "generate_references.py")
+references = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(references)   # numpy and scipy only
+ASYMMETRIC = {"c0": 1.5, "k0": 400.0, "A": 3000.0, "zp": 1500.0, "zn": 1000.0, "n": 2.0, "gap": 0.3, "width": 0.05,
+              "eps": 0.3, "delta": 0.2}
+"""data/params_asymmetric_bouc_wen_illustrative.json's values: the states drawn below (e ~ N(0, 0.6 mm))
+put the element inside its play, across its corners and loaded either way, z near and over its yield."""
+
 CASES = {
     # model: (parameters, independent right-hand side(p, state, x, v), state scale)
     "proposed": (paper_parameters("table5"),
                  lambda p, s, x, v: paper_equations(0.0, s, p, lambda t: x, lambda t: v), (1.0, 500.0, 1.0, 50.0)),
     "spencer": (SPENCER, spencer_rhs, (1.0, 500.0)),
     "single_bouc_wen": (BOUC_WEN, bouc_wen_rhs, (500.0,)),
+    "asymmetric_bouc_wen": (ASYMMETRIC, lambda p, s, x, v: references.asymmetric_rhs(0.0, s, p, lambda t: (x, v)),
+                            (0.6, 0.5)),
     "berg": (dict(FILLED_RUBBER, k1=150.0, c1=15.0, k2=250.0, c2=0.5), berg_rhs, (1.0, 50.0, 1.0, 100.0, 100.0)),
     "fractional": (dict(FILLED_RUBBER, b=70.0, alpha=0.22), fractional_rhs, (1.0, 50.0, 1.0) + (100.0,) * 20),
     "hydraulic": (HYDRAULIC, hydraulic_rhs, (1.0, 100.0, 50.0)),
@@ -107,6 +117,15 @@ def test_the_friction_models_switch_where_the_velocity_changes_sign_and_reverse_
         turned = bushing.update(constants, state, 0.4, -2.0)
         friction = params["Ff_max"] * 0.4 / (params["x2"] + 0.4)    # from rest, typed: Ff_max*x/(x2 + x)
         assert turned[:3] == (0.0, pytest.approx(friction, rel=1e-14), -1.0) and turned[3:] == state[3:]
+
+
+def test_the_asymmetric_element_switches_where_the_velocity_the_force_and_the_plays_corners_change_sign():
+    bushing = MODELS["asymmetric_bouc_wen"]
+    constants = bushing.constants(ASYMMETRIC)
+    e, q = 0.5, 0.4
+    z = 3000.0 * float(references.asymmetric_play(ASYMMETRIC, e))
+    assert bushing.switches(constants, (e, q), 0.7, -12.0) == pytest.approx((-12.0, z, 0.5 - 0.3, 0.5 + 0.3), rel=1e-14)
+    assert bushing.update is None          # the state is continuous: an event changes only the branch
 
 
 def test_the_hydraulic_model_has_no_switches():

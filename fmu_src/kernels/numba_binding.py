@@ -18,8 +18,9 @@ The contract a model module keeps for this (checked on its syntax tree by
 anything else):
 
 - its imports are at the module's top and of these forms only: ``from __future__ import ...``,
-  ``import math``, ``from ..model.integration import names`` (the shared machinery: in the
-  generated module they come from the compiled machinery), ``from ..model.<module> import names``
+  ``import math``, ``from ..model.integration import names`` and ``from ..model.elements import
+  names`` (the shared machinery and elements: in the generated module they come from their
+  compiled copies), ``from ..model.<module> import names``
   (the contract: ``definition``, ``parameter_specs``, ``search_coordinates``) and
   ``from .<sibling> import names`` (another model's module): plain-Python values, such as specs,
   constants and ``BushingModel``; a function imported from there stays uncompiled, and numba
@@ -51,7 +52,7 @@ import types
 import warnings
 from pathlib import Path
 
-from ..model import integration
+from ..model import elements, integration
 from .generated_source import check_bound_names
 from ..model.definition import ModelContractError, check_step_kernels
 from .unrolling import unroll
@@ -136,10 +137,14 @@ def load_generated(name: str, source: str, check: bool = True) -> types.ModuleTy
 
 
 ALLOWED_IMPORTS = ("from __future__ import ..., import math, from ..model.integration import <names>, "
-                   "from ..model.<module> import <names>, from .<model module> import <names>")
+                   "from ..model.elements import <names>, from ..model.<module> import <names>, "
+                   "from .<model module> import <names>")
 MACHINERY = "model.integration"
 """The shared machinery, as the models' package's parent names it: what a kernel module's imports of
 it are pointed at in the generated module (the compiled machinery)."""
+ELEMENTS = "model.elements"
+"""The shared elements (``fmu_src/model/elements.py``), compiled as the machinery is: a kernel
+module's imports of them are pointed at their compiled copy (:func:`elements_module`)."""
 
 
 def checked_imports(tree: ast.Module, module: str, machinery: str | None, package: str) -> ast.Module:
@@ -171,6 +176,8 @@ def checked_imports(tree: ast.Module, module: str, machinery: str | None, packag
                                "model contract, and its names)")
         elif node.level == 2 and node.module == MACHINERY and machinery is not None:
             node.module, node.level = machinery, 0
+        elif node.level == 2 and node.module == ELEMENTS and machinery is not None:
+            node.module, node.level = elements_module(), 0
         elif node.level == 2:
             node.module, node.level = f"{package.rpartition('.')[0]}.{node.module}", 0
         else:
@@ -188,9 +195,20 @@ def kernel_source(module: types.ModuleType, machinery: str | None = None) -> str
 
 def integration_module() -> str:
     """The name of the compiled copy of the shared machinery (generated and loaded)."""
-    source = (kernel_source(integration, None) + "\n\n# ---- appended by fmu_src/kernels/numba_binding.py ----\n"
+    return _shared_module(integration, "bushing_integration")
+
+
+def elements_module() -> str:
+    """The name of the compiled copy of the shared elements (generated and loaded)."""
+    return _shared_module(elements, "bushing_elements")
+
+
+def _shared_module(module: types.ModuleType, prefix: str) -> str:
+    """The name of the compiled copy of a shared kernel module (generated and loaded): its source
+    unchecked (the machinery's step protocol is a template bound in each model's module)."""
+    source = (kernel_source(module, None) + "\n\n# ---- appended by fmu_src/kernels/numba_binding.py ----\n"
               + _NUMBA_IMPORT + _JIT_KERNELS)
-    name = module_name("bushing_integration", source)
+    name = module_name(prefix, source)
     load_generated(name, source, check=False)
     return name
 

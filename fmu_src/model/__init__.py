@@ -8,6 +8,8 @@
 - ``search_coordinates``: the fit's coordinate kinds (map, inverse, bounds);
 - ``integration``: the shared integration machinery (the Bouc-Wen block, friction, Maxwell
   elements, vector algebra) and the step protocol, written in the kernel language;
+- ``elements``: the elements the models share (free play, the softplus corner), in the kernel
+  language, compiled and translated as ``integration`` is;
 - ``registry``: every model of ``fmu_src.models``, by name and identifier.
 
 May import: nothing of fmu_src but itself (``registry`` finds ``models`` by name, at import).

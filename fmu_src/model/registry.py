@@ -7,6 +7,8 @@ model is adding such a module; this registry, the FMUs, parameter files, the fit
 - ``spencer``: Spencer et al. (1997), Fig. 7 of the paper (``spencer_model``);
 - ``single_bouc_wen``: the classic single Bouc-Wen element, Fig. 6 of the paper (``single_bouc_wen_model``;
   ``bouc_wen`` is accepted as an alias in files and on the command line);
+- ``asymmetric_bouc_wen``: a Bouc-Wen element whose yield differs by direction, with free play
+  and breakaway (``asymmetric_bouc_wen_model``);
 - ``berg``: Berg (1998), a progressive spring, Berg's rate-independent friction and two Maxwell
   elements, for filled rubber (``berg_model``);
 - ``fractional``: the same spring and friction with a fractional-derivative element b*D^alpha x

@@ -39,7 +39,7 @@ from typing import Callable
 import numpy as np
 
 from fmu_src.kernels import numba_binding as _kernels, tangents
-from fmu_src.model import integration
+from fmu_src.model import elements, integration
 from fmu_src.model.registry import BushingModel, DEFAULT_MODEL, resolve_model
 from fmu_src.kernels.jit import numba
 from identification.forward.population import (_input_arrays, _population_loop, _step_sizes, output_points,
@@ -62,8 +62,9 @@ def _tangent_names(model: BushingModel, generator: tangents.Generator) -> dict[s
 
 
 def _machinery_imports(model: BushingModel, source: str, machinery: str) -> str:
-    """The imports from the compiled machinery of the globals the tangents read that the model's
-    module does not have (the tangents of ``integration``'s functions read its globals)."""
+    """The imports from the compiled machinery and elements of the globals the tangents read that
+    the model's module does not have (the tangents of ``integration``'s and ``elements``'
+    functions read their own module's globals)."""
     module = sys.modules[model.kernel_module]
     tree = ast.parse(source)
     defined = {node.name for node in tree.body if isinstance(node, ast.FunctionDef)}
@@ -74,19 +75,23 @@ def _machinery_imports(model: BushingModel, source: str, machinery: str) -> str:
         elif isinstance(n, ast.arg):
             assigned.add(n.arg)
     names = sorted(loaded - defined - assigned - set(tangents.HELPERS))
-    needed = []
+    shared = ((machinery, integration), (_kernels.elements_module(), elements))
+    needed: dict[str, list[str]] = {}
     for name in names:
         if name in module.__dict__:
-            if name in integration.__dict__ and module.__dict__[name] is not integration.__dict__[name]:
-                raise ValueError(f"{module.__name__} defines {name!r}, which the tangents of integration's "
-                                 "functions also read as integration's: rename it")
+            for _, kernels in shared:
+                if name in kernels.__dict__ and module.__dict__[name] is not kernels.__dict__[name]:
+                    raise ValueError(f"{module.__name__} defines {name!r}, which the tangents of "
+                                     f"{kernels.__name__.rpartition('.')[2]}'s functions also read as its own: "
+                                     "rename it")
             continue
-        if name in integration.__dict__:
-            needed.append(name)
+        owner = next((compiled for compiled, kernels in shared if name in kernels.__dict__), None)
+        if owner is not None:
+            needed.setdefault(owner, []).append(name)
         elif name != "math" and not hasattr(builtins, name):
             raise ValueError(f"the tangents of the {model.name} model read {name!r}, found in neither its module "
-                             "nor integration")
-    return f"from {machinery} import {', '.join(needed)}\n" if needed else ""
+                             "nor integration nor elements")
+    return "".join(f"from {compiled} import {', '.join(found)}\n" for compiled, found in needed.items())
 
 
 def _tuple_of_lanes(values: int, lanes: int) -> str:
@@ -183,8 +188,8 @@ def python_sensitivities(model: str | BushingModel, lanes: int) -> Callable:
     loop_names = _tangent_names(bushing, generator)
     source = generator.lane_source()
     namespace: dict = {}
-    # integration's globals under the model's own (_machinery_imports refuses a name both have)
-    for function in (integration.block_gain, bushing.prepare):
+    # integration's and elements' globals under the model's own (_machinery_imports refuses a name both have)
+    for function in (integration.block_gain, elements.softplus, bushing.prepare):
         namespace.update(generator.namespace(function))
     namespace.update(numba=numba, np=np, _OK=integration.OK)
     exec(compile(source, f"<vector tangents of {bushing.name}>", "exec"), namespace)

@@ -71,6 +71,10 @@ MODELS = {
     "single_bouc_wen": ("params_single_bouc_wen_fit_synthetic_table5.json",
                         "single Bouc-Wen element, the paper's Fig. 6, as the project fitted it to the synthetic "
                         "Table 5 tests"),
+    "asymmetric_bouc_wen": ("params_asymmetric_bouc_wen_illustrative.json",
+                            "a spring with free play +-gap (corners rounded over width) in series with a slider "
+                            "whose yield is zp one way and zn the other, sharpness n, breakaway eps over delta; "
+                            "k0 and c0 in parallel; an illustrative bushing"),
     "kelvin_voigt": ("params_kelvin_voigt_fit_synthetic_table5.json",
                      "Kelvin-Voigt F = k*x + c*dx/dt + preload, as the project fitted it to the synthetic "
                      "Table 5 tests"),
@@ -176,6 +180,41 @@ def single_bouc_wen_start(p, x0):
     return [0.0]
 
 
+def softplus(z):
+    """log(1 + exp(z)) without overflow (numpy's logaddexp)."""
+    return np.logaddexp(0.0, z)
+
+
+def asymmetric_play(p, e):
+    """The play: width*(softplus((e - gap)/width) - softplus((-e - gap)/width)) [mm]."""
+    w, g = p["width"], p["gap"]
+    return w * (softplus((e - g) / w) - softplus((-e - g) / w))
+
+
+def asymmetric_rhs(t, state, p, signal):
+    """d/dt (e, q): de/dt = dx/dt*(1 - s), dq/dt = ((1 - q)*(1 - s) - q*s)*|dx/dt|/delta with the
+    sliding share s = (|z|/Z)^n where z*dx/dt > 0 (else 0), z = A*play(e), and the yield
+    Z = (zp if z > 0 else zn)*(1 + eps*q)."""
+    e, q = state
+    _, xd = signal(t)
+    z = p["A"] * asymmetric_play(p, e)
+    s = 0.0
+    if z * xd > 0.0:
+        level = (p["zp"] if z > 0.0 else p["zn"]) * (1.0 + p["eps"] * q)
+        s = (abs(z) / level) ** p["n"]
+    return [xd * (1.0 - s), ((1.0 - q) * (1.0 - s) - q * s) * abs(xd) / p["delta"]]
+
+
+def asymmetric_force(p, states, x, xd):
+    """F = c0*dx/dt + k0*x + A*play(e)."""
+    return p["c0"] * xd + p["k0"] * x + p["A"] * asymmetric_play(p, states[0])
+
+
+def asymmetric_start(p, x0):
+    """At rest: e = 0 (the play's centre), q = 1 (stuck)."""
+    return [0.0, 1.0]
+
+
 def hydraulic_track(p, x, y):
     """(kb*(x - y - u), dp) of the hydraulic mount: the fluid path's force on the mount [N] and
     the pressure difference that drives the inertia track [N], with the chambers' pressure
@@ -213,6 +252,7 @@ EQUATIONS = {
     "proposed": (proposed_rhs, proposed_force, proposed_start, [ATOL_MM, ATOL_N, ATOL_MM, ATOL_N]),
     "spencer": (spencer_rhs, spencer_force, spencer_start, [ATOL_MM, ATOL_N]),
     "single_bouc_wen": (single_bouc_wen_rhs, single_bouc_wen_force, single_bouc_wen_start, [ATOL_N]),
+    "asymmetric_bouc_wen": (asymmetric_rhs, asymmetric_force, asymmetric_start, [ATOL_MM, ATOL_MM]),
     "hydraulic": (hydraulic_rhs, hydraulic_force, hydraulic_start, [ATOL_MM, ATOL_MM_S, ATOL_N]),
     "hydraulic_free_decoupler": (free_decoupler_mount.rhs, free_decoupler_mount.force, free_decoupler_mount.start,
                                  [ATOL_MM, ATOL_MM_S, ATOL_N]),
