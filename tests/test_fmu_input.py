@@ -61,7 +61,8 @@ def test_the_table_is_the_forward_models_continuous_path_in_si_units(measurement
     table = fmu_input(measurement)
     driven = prepare_input(measurement.time_s, measurement.displacement_mm, measurement.measured_velocity_mm_s)
     assert table.dtype.names == ("time", "x", "v")
-    assert driven.steps_per_sample > 1   # the Hermite path of a quantised displacement: substeps
+    # the slow sine's noise asks for no substeps (input_path.turning_rate): one row per sample
+    assert driven.steps_per_sample == 1
     np.testing.assert_array_equal(table["time"], driven.time_s)
     np.testing.assert_array_equal(table["x"], driven.displacement_mm / 1000.0)
     # v is the secant of each step: x_j + v_j*h_j lands on x_(j+1) (no jump), to rounding

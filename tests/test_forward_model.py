@@ -58,6 +58,22 @@ def test_steps_per_sample_follow_the_signals_frequency():
     assert counts == {1.0: 1, 10.0: 1, 30.0: 3, 80.0: 8}
 
 
+@pytest.mark.parametrize("frequency_hz, steps", [(0.5, 1), (2.0, 1), (30.0, 3)])
+def test_a_measured_displacements_noise_does_not_ask_for_steps_its_signal_does_not_need(frequency_hz, steps):
+    # a rig's sine: 1024 Hz samples, the displacement with 1.5 um of noise and the rig's own
+    # velocity signal with 2 mm/s (the real friction damper's). At most 0.07 rad of the sine's
+    # phase per step: 2*pi*f/1024 Hz is 0.003 and 0.012 rad at 0.5 and 2 Hz (1 step), 0.18 at 30 Hz (3)
+    t = np.arange(0.0, 6.0, 1.0 / 1024.0)
+    rng = np.random.default_rng(4)
+    displacement, velocity = sine_functions(25.0, frequency_hz)
+    x = displacement(t) + rng.normal(0.0, 1.5e-3, t.size)
+    v = velocity(t) + rng.normal(0.0, 2.0, t.size)
+    assert prepare_input(t, x, v).steps_per_sample == steps
+    assert prepare_input(t, x).steps_per_sample == steps
+    # without the noise the sample-scale x'' is the sine's own: the same counts
+    assert prepare_input(t, displacement(t), velocity(t)).steps_per_sample == steps
+
+
 def test_a_decimated_hold_gives_the_same_forces_at_the_samples_it_keeps():
     params = paper_parameters("table5")
     t = sample_times(3.0, 1000.0)

@@ -18,7 +18,8 @@ the input path between samples. So the fit drives the same compiled kernel with:
   split into ``m`` equal communication steps with the interpolant's displacement at their
   ends and the secant velocity over each (a continuous piecewise-linear path, no jumps),
   where ``m`` is the smallest number such that the input turns by at most
-  ``MAX_PHASE_PER_STEP_RAD`` per step (with the test's rms frequency rms(x'')/rms(x')); the
+  ``MAX_PHASE_PER_STEP_RAD`` per step (with the test's rms frequency rms(x'')/rms(x'); for a
+  displacement measured with noise, x'' over several samples, not the noise's: ``turning_rate``); the
   fit raises it where the candidate's response is sharper than the input
   (``identification.fitting.refinement``);
 - the output: eq. 5 at each sample instant with the interpolant's velocity there.
@@ -42,8 +43,15 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.interpolate import CubicHermiteSpline, CubicSpline
 
+from identification.measured.noise import MIN_SAMPLES, estimate_noise
+
 MAX_PHASE_PER_STEP_RAD = 0.07
 MAX_STEPS_PER_SAMPLE = 8
+NOISY_SHARE = 0.1
+"""A displacement whose noise makes more than this share of its sample-scale x'' is read for its
+turning over several samples (:func:`turning_rate`)."""
+WIDE_PHASE_RAD = 0.1
+"""The phase of the input's mean frequency a noisy displacement's wide second difference spans."""
 HOLD_DECIMATION = 10
 HOLD_SETTLE_SAMPLES = 10
 """Samples next to a change of the displacement (after it and before it) that a decimated hold
@@ -73,13 +81,48 @@ def steps_per_sample(time_s: np.ndarray, displacement_mm: np.ndarray, velocity_m
                      interpolant) -> int:
     """m: communication steps per sample interval so that the input turns by at most
     MAX_PHASE_PER_STEP_RAD per step at its rms frequency rms(x'')/rms(x') (capped at
-    MAX_STEPS_PER_SAMPLE)."""
+    MAX_STEPS_PER_SAMPLE); x'' the interpolant's at the samples, or, where the displacement is
+    measured with noise, its second differences over several samples (:func:`turning_rate`)."""
     rms_velocity = math.sqrt(float(np.mean(velocity_mm_s ** 2)))
     if rms_velocity == 0.0:
         return 1
-    rms_acceleration = math.sqrt(float(np.mean(interpolant(time_s, 2) ** 2)))
-    phase = rms_acceleration / rms_velocity * float(np.median(np.diff(time_s)))
+    h = float(np.median(np.diff(time_s)))
+    rms_acceleration = turning_rate(displacement_mm, h, rms_velocity)
+    if rms_acceleration is None:
+        rms_acceleration = math.sqrt(float(np.mean(interpolant(time_s, 2) ** 2)))
+    phase = rms_acceleration / rms_velocity * h
     return int(min(MAX_STEPS_PER_SAMPLE, max(1, math.ceil(phase / MAX_PHASE_PER_STEP_RAD))))
+
+
+def turning_rate(displacement_mm: np.ndarray, h: float, rms_velocity: float) -> float | None:
+    """rms(x'') [mm/s^2] of a displacement measured with noise, or None where its noise is too
+    small to matter (a signal computed, not measured: then the interpolant's x'' at the samples
+    counts, which the noise would otherwise dominate).
+
+    At the sample scale white noise of sigma gives the second difference
+    (x_k+1 - 2x_k + x_k-1)/h^2 an rms of sqrt(6)*sigma/h^2, which on a rig's slow sine is many
+    times the signal's (on the real friction damper's 0.5 Hz sine, 1.5 um of displacement noise
+    and the rig's velocity signal read as 1.6e4 mm/s^2 against the sine's 1.5e2). Where that
+    share exceeds NOISY_SHARE of the interpolant's rms x'', the second differences over w samples
+    count instead, w the widest that keeps WIDE_PHASE_RAD of the input's mean frequency
+    rms(x')/rms(x - mean) within the window: their noise is w^2 times smaller. The noise is the
+    eighth-difference estimate (``identification.measured.noise``), which a ramp's corners do not
+    raise."""
+    x = np.asarray(displacement_mm, dtype=float)
+    if x.size < max(MIN_SAMPLES, 3):
+        return None
+    sigma = estimate_noise(x).sigma_N          # the estimator reads any signal; here mm
+    spread = math.sqrt(float(np.mean((x - np.mean(x)) ** 2)))
+    if spread == 0.0:
+        return None
+    second = np.diff(x, 2) / h ** 2
+    if math.sqrt(6.0) * sigma / h ** 2 <= NOISY_SHARE * math.sqrt(float(np.mean(second ** 2))):
+        return None
+    w = max(1, int(WIDE_PHASE_RAD / (rms_velocity / spread * h)))
+    if 2 * w >= x.size:
+        return None
+    wide = (x[2 * w:] - 2.0 * x[w:-w] + x[:-2 * w]) / (w * h) ** 2
+    return math.sqrt(float(np.mean(wide ** 2)))
 
 
 def prepare_input(time_s, displacement_mm, velocity_mm_s=None, decimate_holds: bool = False,
