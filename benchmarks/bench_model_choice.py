@@ -14,7 +14,9 @@ trained on the 0.5 Hz, 1 in sine; held out: every other sine (with ``--no-held-o
 none of them and decides from the training sine alone; they only score its choice). Prints, per
 file, the recommended model's NRMSE over that of a least-squares Kelvin-Voigt fitted to the file
 itself (the best linear bushing there) and over the Kelvin-Voigt trained on the same sine (target
-<= 0.5).
+<= 0.5), and over what the device repeats from cycle to cycle (identification.measured.repeatability;
+issue 55's targets: the training sine <= 1.5x, the five other 0.25-0.5 Hz sines' mean NRMSE <= 10 %,
+each 1 and 2 Hz sine <= 2x).
 
 Both run ``compare`` (identification.analysis.compare) with the default preset, seed 0, on every core, and
 print each model's fit time (target for the filled-rubber models: <= 3 min on 2 cores).
@@ -39,6 +41,7 @@ from identification.analysis.compare import compare_models  # noqa: E402
 from identification.measured.kdyn_table import load_kdyn_table  # noqa: E402
 from identification.measured.measurements import load_measurement  # noqa: E402
 from identification.fitting.objectives import nrmse  # noqa: E402
+from identification.measured.repeatability import estimate_repeatability  # noqa: E402
 from identification.measured.rig_tests import training_tests  # noqa: E402
 from identification.fitting.search_space import KelvinVoigtFit  # noqa: E402
 
@@ -76,23 +79,31 @@ def friction_damper(out: Path, models, ensemble: bool, held_out: bool = True) ->
     print(f"\n{date.today()}, {platform.machine()}, Python {platform.python_version()}: "
           f"python benchmarks/bench_model_choice.py friction-damper{'' if held_out else ' --no-held-out'}")
     given = "held-out sines given to compare" if held_out else "trained on one sine, no held-out file given to compare"
-    print(f"recommended: {chosen} ({given}); NRMSE per held-out sine, and over a least-squares Kelvin-Voigt fitted "
-          "to the file itself and over the one trained on the same sine (target <= 0.5)")
+    print(f"recommended: {chosen} ({given}); NRMSE per sine, over a least-squares Kelvin-Voigt fitted to the file "
+          "itself, over the one trained on the same sine (target <= 0.5), and over what the device repeats")
+    print(f"  {'file':42s} {'NRMSE':>7s}   {'/ own KV':>8s} {'/ trained KV':>12s} {'repeats':>8s} {'/ repeats':>9s}")
     worst = worst_trained = 0.0
-    for path in others:
+    slow = []
+    for path in [training] + others:
         m = load_measurement(path)
         own = KelvinVoigtFit.fit([m], nonnegative=True)
         own_error = nrmse(own.force(m.displacement_mm, m.velocity_mm_s), m.force_N)
         error = prediction_error(result, chosen, m)
-        worst = max(worst, error / own_error)
+        repeats = estimate_repeatability(m.time_s, m.displacement_mm, m.force_N).relative
+        if path != training:
+            worst = max(worst, error / own_error)
+            if "_0.25Hz" in path.name or "_0.5Hz" in path.name:
+                slow.append(error)
         trained = "     -"
         if trained_kv is not None:
             ratio = error / prediction_error(result, "kelvin_voigt", m)
-            worst_trained = max(worst_trained, ratio)
+            worst_trained = max(worst_trained, ratio if path != training else 0.0)
             trained = f"{ratio:6.2f}"
-        print(f"  {path.name:42s} {error:7.2%}   {error / own_error:6.2f}   {trained}")
+        name = path.name + (" (training)" if path == training else "")
+        print(f"  {name:42s} {error:7.2%}   {error / own_error:8.2f} {trained:>12s} {repeats:8.2%} {error / repeats:9.2f}")
     print(f"largest ratio to the file's own Kelvin-Voigt: {worst:.2f}"
           + (f"; to the trained Kelvin-Voigt: {worst_trained:.2f}" if trained_kv is not None else ""))
+    print(f"mean NRMSE of the other 0.25-0.5 Hz sines: {np.mean(slow):.2%} (issue 55's target <= 10 %)")
     for a in result["assessments"]:
         print(f"  fit time {a.model:17s} {a.seconds:6.0f} s")
 

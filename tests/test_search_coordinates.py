@@ -16,7 +16,8 @@ from identification.fitting.search_space import SearchSpace
 ROOT = Path(__file__).resolve().parents[1]
 SPACE = SearchSpace(1850.0, 2.7, 4400.0, 0.001, x_ref=2.0)
 # what the kinds that read other parameters read, at plausible values of a proposed-model set
-OTHERS = {"k1": 400.0, "k2": 50.0, "n": 0.8, "beta": 2e-3, "c1": 30.0, "mf": 0.07}
+OTHERS = {"k1": 400.0, "k2": 50.0, "n": 0.8, "beta": 2e-3, "c1": 30.0, "mf": 0.07,
+          "backbone_F3": -150.0, "backbone_x3": -1.0, "backbone_x4": 1.5}
 COORDINATES = {
     "stiffness": SearchCoordinate("p", KIND.stiffness, -3.0, 1.0),
     "damping": SearchCoordinate("p", KIND.damping, -4.0, 2.0),
@@ -33,6 +34,11 @@ COORDINATES = {
     "resonance": SearchCoordinate("p", KIND.resonance, -0.5, 2.5, over=("k1", "k2")),
     "damping_ratio": SearchCoordinate("p", KIND.damping_ratio, -3.0, 0.5, over=("k1", "k2"), partner="mf"),
     "quadratic_damping": SearchCoordinate("p", KIND.quadratic_damping, -6.0, 1.0),
+    "offset_force": SearchCoordinate("p", KIND.offset_force, -0.5, 0.5),
+    "offset_travel": SearchCoordinate("p", KIND.offset_travel, -0.25, 0.25),
+    # a backbone's knot 4 from its neighbour 3, 2.5 mm apart
+    "segment": SearchCoordinate("p", KIND.segment, -4.0, 2.0, over=("backbone_x4", "backbone_x3"),
+                                partner="backbone_F3"),
 }
 
 

@@ -168,6 +168,9 @@ class Translation:
     def source(self) -> str:
         """The C: typedefs, constants, prototypes, definitions (all ``static``)."""
         lines = [PRELUDE] + [HELPERS[name] for name in HELPERS if name in self.helpers] + [""]
+        for f in self.order:        # an argument only indexed, never unpacked, has its struct too
+            for t in f.argument_types:
+                self.c_type(t)
         for t, name in self.structs.items():
             fields = " ".join(f"{self.c_type(e)} f{i};" for i, e in enumerate(t)) or "int unused;"
             lines.append(f"typedef struct {{ {fields} }} {name};   /* {describe(t)} */")

@@ -10,6 +10,8 @@
   elements, vector algebra) and the step protocol, written in the kernel language;
 - ``elements``: the elements the models share (free play, the softplus corner), in the kernel
   language, compiled and translated as ``integration`` is;
+- ``derived``: a model with options any model takes (a measured backbone, travel limits, the
+  rig's offsets), generated as a kernel module of its own;
 - ``registry``: every model of ``fmu_src.models``, by name and identifier.
 
 May import: nothing of fmu_src but itself (``registry`` finds ``models`` by name, at import).

@@ -174,14 +174,16 @@ class LinearForce:
 class SearchBox:
     """Where the fit searches a model: its ``coordinates`` (one per free parameter), the
     Bouc-Wen weights held at 1 (``unit_weights``: each block's alpha, which the force does not
-    identify apart from its A, beta and gamma), the parameters held at 0 (``zeros``) and the
-    spring and friction a slow loop gives starts for (``loop_start``, a :class:`SlowLoop`, or None)
-    and the fluid track a data sheet gives starts for (``table_start``, a :class:`TrackStart`, or None)."""
+    identify apart from its A, beta and gamma), the parameters held at 0 (``zeros``) and at other
+    values (``held``: (name, value) pairs), the spring and friction a slow loop gives starts for
+    (``loop_start``, a :class:`SlowLoop`, or None) and the fluid track a data sheet gives starts
+    for (``table_start``, a :class:`TrackStart`, or None)."""
     coordinates: tuple[SearchCoordinate, ...]
     unit_weights: tuple[str, ...] = ()
     zeros: tuple[str, ...] = ()
     loop_start: SlowLoop | None = None
     table_start: TrackStart | None = None
+    held: tuple[tuple[str, float], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -289,6 +291,14 @@ class BushingModel:
     on each axis alone: Kelvin-Voigt, whose linear elements couple nothing)."""
     rotational: bool = False
     """On a rotational axis (``axes.model_on_axis``): its units read rad for mm, N.mm for N."""
+    static_spring: tuple[str, ...] = ()
+    """The parameters of the spring that carries the model's static force in parallel (k0, and a
+    cubic k3): what a measured backbone replaces (``derived``: held at 0). Empty: the backbone adds
+    to the model's force (a static spring that also carries hysteresis, as the paper's k0)."""
+    base: "BushingModel | None" = field(default=None, repr=False, compare=False)
+    """A derived model's base (``derived``: the model with options); None for a registered model."""
+    options: object = None
+    """A derived model's ``derived.Options``; None for a registered model."""
     step: Callable = field(init=False, repr=False, compare=False)
     """step(constants, state, state_x, x, v, h, max_substeps) -> (state, substeps, status): the
     step protocol of ``integration.step`` bound to this model's ``jump`` and ``integrate``."""

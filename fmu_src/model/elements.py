@@ -2,6 +2,10 @@
 
 - ``softplus``: log(1 + exp(z)), the smooth corner every element below rounds with;
 - ``dead_zone``: free play of +-gap around a centre, its corners rounded over a width (0: hard);
+- ``ramp``, ``smooth_step``, ``limit_force``: a travel limit (a gap, then a stiffness with an
+  exponent and a damping that ramps in over a depth), as the multibody tools' bushing limits;
+- ``pchip_slope``, ``pchip_end_slope``, ``hermite``: the monotone cubic through a measured static
+  curve's knots (scipy's PchipInterpolator), for a backbone;
 
 Like ``integration``, this module is compiled by numba once for every model that imports it
 (``fmu_src/kernels/numba_binding.py``), translated into C with the kernels that call it, and
@@ -38,3 +42,65 @@ def dead_zone(e, gap, width):
             return e + gap
         return 0.0
     return width * (softplus((e - gap) / width) - softplus((-e - gap) / width))
+
+
+def ramp(d, width):
+    """max(d, 0) with its corner rounded over ``width`` (width*softplus(d/width)); the hard corner
+    where ``width`` = 0. Same unit as d."""
+    if width <= 0.0:
+        if d > 0.0:
+            return d
+        return 0.0
+    return width * softplus(d / width)
+
+
+def smooth_step(s):
+    """0 for s <= 0, 1 for s >= 1 and 3s^2 - 2s^3 between: a step with no corner in its value or
+    slope (MSC Adams' STEP, which its IMPACT function ramps a contact's damping in with)."""
+    if s <= 0.0:
+        return 0.0
+    if s >= 1.0:
+        return 1.0
+    return s * s * (3.0 - 2.0 * s)
+
+
+def limit_force(u, v, gap, stiffness, exponent, damping, depth, width):
+    """The force [N] of a travel limit on the positive side at displacement u [mm] and velocity v
+    [mm/s]: nothing within ``gap`` [mm]; beyond it, at penetration d = ramp(u - gap, width),
+    stiffness*d^exponent [N/mm^exponent] and a damping [N.s/mm] that ramps in over ``depth`` [mm]
+    (smooth_step(d/depth)*damping*v). The negative side is -limit_force(-u, -v, ...)."""
+    d = ramp(u - gap, width)
+    if d <= 0.0:
+        return 0.0
+    return stiffness * d ** exponent + damping * smooth_step(d / depth) * v
+
+
+def pchip_slope(h0, h1, s0, s1):
+    """The slope at an interior knot of the monotone cubic (Fritsch and Carlson; scipy's
+    PchipInterpolator): 0 where the secants s0 (of the interval before, length h0) and s1 (after,
+    h1) differ in sign or either is 0, else their weighted harmonic mean."""
+    if s0 * s1 <= 0.0:
+        return 0.0
+    w1 = 2.0 * h1 + h0
+    w2 = h1 + 2.0 * h0
+    return (w1 + w2) / (w1 / s0 + w2 / s1)
+
+
+def pchip_end_slope(h0, h1, s0, s1):
+    """The slope at an end knot (scipy's PchipInterpolator: the three-point estimate from the end
+    interval h0, s0 and the next h1, s1, set to 0 where its sign differs from s0's and limited to
+    3*s0 where s0 and s1 differ in sign)."""
+    d = ((2.0 * h0 + h1) * s0 - h0 * s1) / (h0 + h1)
+    if d * s0 <= 0.0:
+        return 0.0
+    if s0 * s1 < 0.0 and abs(d) > abs(3.0 * s0):
+        return 3.0 * s0
+    return d
+
+
+def hermite(u, xa, xb, fa, fb, da, db):
+    """The cubic Hermite interpolant on [xa, xb] with values fa, fb and slopes da, db, at u."""
+    h = xb - xa
+    t = (u - xa) / h
+    return (fa * (1.0 + 2.0 * t) * (1.0 - t) * (1.0 - t) + da * h * t * (1.0 - t) * (1.0 - t)
+            + fb * t * t * (3.0 - 2.0 * t) - db * h * t * t * (1.0 - t))

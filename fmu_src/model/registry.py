@@ -22,6 +22,7 @@ import pkgutil
 
 from .parameter_specs import ParameterError
 from .definition import BushingModel
+from .derived import derive, split_name
 
 MODEL_MODULE_SUFFIX = "_model"
 MODELS_PACKAGE = "models"
@@ -59,13 +60,19 @@ of F = k*x + c*v), and the rigid spring ``assemble --rigid-missing`` puts on a m
 
 
 def get_model(name: str) -> BushingModel:
-    """The model called ``name`` (command-line name or FMI identifier)."""
+    """The model called ``name`` (command-line name or FMI identifier), or a registered model
+    with options (``proposed+limits``, ``BoucWenBushing_Limits``: ``derived``), made on demand."""
+    if isinstance(name, BushingModel):
+        return name
     name = ALIASES.get(name, name)
     if name in MODELS:
         return MODELS[name]
     for model in MODELS.values():
         if model.identifier == name:
             return model
+    base, options = split_name(name)
+    if options and base != name:
+        return derive(get_model(base), options)
     raise ParameterError(f"unknown model {name!r}; choose one of {', '.join(MODEL_NAMES)} "
                          f"(identifiers {', '.join(m.identifier for m in MODELS.values())})")
 

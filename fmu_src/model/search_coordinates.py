@@ -89,6 +89,38 @@ class Exponent(CoordinateKind):
         return value
 
 
+class Linear(CoordinateKind):
+    """value/scale, scale the data's reference named ``scale`` (F_ref, x_ref): a signed offset
+    (a load cell's zero, a displacement zero, a backbone's force at its middle knot)."""
+
+    def __init__(self, name: str, scale: str):
+        self.name, self.scale = name, scale
+
+    def to_parameter(self, c, u, values, scales):
+        return u * getattr(scales, self.scale)
+
+    def to_coordinate(self, c, value, params, scales):
+        return value / getattr(scales, self.scale)
+
+
+class Segment(CoordinateKind):
+    """log10 of a backbone segment's secant stiffness over k_ref: the knot's force is its
+    neighbour's (``c.partner``) plus 10^value*k_ref times the knots' distance (``c.over``: this
+    knot's position, the neighbour's), so that a backbone built outward from its middle knot is
+    monotone by construction."""
+    name = "segment"
+
+    def reads(self, c):
+        return (c.partner, *c.over)
+
+    def to_parameter(self, c, u, values, scales):
+        return values[c.partner] + 10.0 ** u * scales.k_ref * (values[c.over[0]] - values[c.over[1]])
+
+    def to_coordinate(self, c, value, params, scales):
+        secant = (value - params[c.partner]) / (params[c.over[0]] - params[c.over[1]])
+        return _log_ratio(max(secant, 1e-12 * scales.k_ref), scales.k_ref)
+
+
 class Cubic(CoordinateKind):
     """value*x_ref^2/k_ref: a cubic spring's share of the force at the largest amplitude, in k_ref's."""
     name = "cubic"
@@ -246,7 +278,9 @@ KIND = _Kinds(
     LogScaled("damping", "c_ref"),        # log10(value/c_ref)
     LogScaled("force", "F_ref"),          # log10(value/F_ref): a friction force limit
     LogScaled("travel", "x_ref"),         # log10(value/x_ref): a friction's travel, x_ref the largest amplitude
-    Gain(), Exponent(), Cubic(), TimeConstant(), Slower(), Shape(), ShapeSum(), PowerLaw(), Resonance(), DampingRatio(),
+    Linear("offset_force", "F_ref"),      # value/F_ref: a signed force (a load cell's zero)
+    Linear("offset_travel", "x_ref"),     # value/x_ref: a signed displacement (a rig's displacement zero)
+    Segment(), Gain(), Exponent(), Cubic(), TimeConstant(), Slower(), Shape(), ShapeSum(), PowerLaw(), Resonance(), DampingRatio(),
     QuadraticDamping())
 """Every kind of coordinate, by name: ``KIND.stiffness``, ``KIND.time_constant``, ..."""
 

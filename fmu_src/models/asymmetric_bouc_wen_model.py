@@ -200,4 +200,5 @@ MODEL = BushingModel(
                   StateSpec("play_lower", 3, "m", "e + gap: the play's lower corner")),
     search=SEARCH, plot_style=("C5", "-."), rank=25,
     description="A Bouc-Wen element whose yield differs by direction, with free play and breakaway, in "
-                "parallel with a spring and a dashpot (inputs x [m], v [m/s]; output F [N]).")
+                "parallel with a spring and a dashpot (inputs x [m], v [m/s]; output F [N]).",
+    static_spring=("k0",))

@@ -225,4 +225,5 @@ MODEL = BushingModel(
         COUPLED_STATES + (StateSpec("f1", 2, "N", "force of the first Maxwell element"),
                           StateSpec("f2", 3, "N", "force of the second Maxwell element")),
         initial_state_coupled, jump_coupled, integrate_coupled, force_coupled, derivatives_coupled, switches_coupled,
-        (StateSpec("dv", 0, "m2/s", "d.v: where it turns negative the friction reverses"),), update=update_coupled))
+        (StateSpec("dv", 0, "m2/s", "d.v: where it turns negative the friction reverses"),), update=update_coupled),
+    static_spring=("k0", "k3"))

@@ -247,4 +247,5 @@ MODEL = BushingModel(
     coupled=CoupledKernels(
         COUPLED_STATES + tuple(StateSpec(spec.name, 2 + i, "N", spec.meaning) for i, spec in enumerate(_mode_states())),
         initial_state_coupled, jump_coupled, integrate_coupled, force_coupled, derivatives_coupled, switches_coupled,
-        (StateSpec("dv", 0, "m2/s", "d.v: where it turns negative the friction reverses"),), update=update_coupled))
+        (StateSpec("dv", 0, "m2/s", "d.v: where it turns negative the friction reverses"),), update=update_coupled),
+    static_spring=("k0", "k3"))

@@ -16,7 +16,7 @@ The plate is massless: it sits where the pressure across it, P - (kb + kc)*u, ba
 centring spring kd*u and, beyond its free travel gap, the cage kcage*(|u| - gap). That balance
 is piecewise linear in P, and u above is its solution with the cage's corner rounded by a
 softplus over a width of about ``width`` [mm] of plate travel (D is the dead zone of the
-pressure: 0 inside +-K*gap, P -+ K*gap beyond). So, while |P| < K*gap, the plate follows the
+pressure: 0 inside +-K*gap, P -+ K*gap beyond: ``elements.dead_zone``). So, while |P| < K*gap, the plate follows the
 pressure (u = P/K), the track sees only dp = P*kd/K, a few percent of it, and the fluid path is
 the bulge in series with the bellows, almost without damping; beyond, the plate rests on its cage
 and the column is driven by nearly the whole pressure: the loss-angle peak near the track's
@@ -44,6 +44,7 @@ from __future__ import annotations
 import math
 
 from ..model.parameter_specs import SPRING, ParameterSpec
+from ..model.elements import dead_zone
 from ..model.integration import NOT_FINITE, OK, TOO_MANY_SUBSTEPS, maxwell_decay, maxwell_step
 from ..model.definition import BushingModel, SearchBox, SearchCoordinate, StateSpec, TrackStart
 from ..model.search_coordinates import KIND
@@ -77,39 +78,12 @@ def prepare(p):
             kcage / (stiffness * (stiffness + kcage)), 1.0 / stiffness)
 
 
-SOFTPLUS_FLOOR = -37.0
-"""Below it log(1 + exp(z)) < 8.6e-17, under half a unit of the last place of 1: :func:`softplus` is
-0 there, and the dead zone's far side (and the near one, away from the cage) costs no exp."""
-
-
-def softplus(z):
-    """log(1 + exp(z)), written so that exp never overflows (both branches are the same analytic
-    function); 0 below SOFTPLUS_FLOOR."""
-    if z > 0.0:
-        return z + math.log(1.0 + math.exp(-z))
-    if z < SOFTPLUS_FLOOR:
-        return 0.0
-    return math.log(1.0 + math.exp(z))
-
-
-def pressure_dead_zone(pressure, free, width):
-    """D(P) [N] (module docstring): 0 inside +-``free`` = K*gap, P -+ free beyond, the corners
-    rounded over ``width`` = K*width [N]; the hard corners where ``width`` = 0."""
-    if width <= 0.0:
-        if pressure > free:
-            return pressure - free
-        if pressure < -free:
-            return pressure + free
-        return 0.0
-    return width * (softplus((pressure - free) / width) - softplus((-pressure - free) / width))
-
-
 def track_force(kb, kc, free, width, cage, compliance, y, x):
     """(the force kb*(x - y - u) the fluid path puts on the mount [N], the pressure difference dp
     that drives the track [N]) at mount displacement x and fluid displacement y [mm]; ``free``,
     ``width``, ``cage`` and ``compliance`` are ``prepare``'s K*gap, K*width, kcage/(K*(K + kcage)) and 1/K."""
     pressure = kb * (x - y) - kc * y
-    u = pressure * compliance - cage * pressure_dead_zone(pressure, free, width)
+    u = pressure * compliance - cage * dead_zone(pressure, free, width)
     return kb * (x - y - u), pressure - (kb + kc) * u
 
 
@@ -235,4 +209,5 @@ MODEL = BushingModel(
     description="Hydraulic engine mount with a free decoupler plate (one axis): a rubber path (progressive spring, "
                 "dashpot, Maxwell element) in parallel with a fluid path (bulge stiffness, inertia track with linear "
                 "and turbulent damping, lower chamber, a plate free within +-gap, then caged); FMI ports in SI units, "
-                "parameters in N-mm-s.")
+                "parameters in N-mm-s.",
+    static_spring=("k0", "k3"))

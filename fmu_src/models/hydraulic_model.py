@@ -214,4 +214,5 @@ MODEL = BushingModel(
     search=SEARCH, plot_style=("C6", "-"), rank=50, settling_s=2.0,
     description="Hydraulic bushing or engine mount (one axis): a rubber path (spring, dashpot, Maxwell element) "
                 "in parallel with a fluid path (bulge stiffness, inertia track with linear and turbulent damping, "
-                "lower chamber, decoupler); FMI ports in SI units, parameters in N-mm-s.")
+                "lower chamber, decoupler); FMI ports in SI units, parameters in N-mm-s.",
+    static_spring=("k0",))

@@ -52,4 +52,5 @@ MODEL = BushingModel(
     "kelvin_voigt", "KelvinVoigtBushing", "Kelvin-Voigt (linear)", PARAMETER_SPECS, (),
     "params_kelvin_voigt_fit_synthetic_table5.json", prepare, initial_state, jump, integrate, force,
     derivatives, switches, plot_style=("C3", "--"), rank=90,
-    linear=LinearForce((("k", "displacement"), ("c", "velocity")), held=(("preload", 0.0),)))
+    linear=LinearForce((("k", "displacement"), ("c", "velocity")), held=(("preload", 0.0),)),
+    static_spring=("k",))

@@ -137,4 +137,5 @@ MODEL = BushingModel(
     search=SEARCH, plot_style=("C1", ":"), rank=20,
     coupled=CoupledKernels((StateSpec("z", 0, "N", "hysteretic force"),), initial_state_coupled,
                            jump_coupled, integrate_coupled, force_coupled, derivatives_coupled, switches_coupled,
-                           (StateSpec("zv", 0, "N.m/s", "z.v: the element's branch"),)))
+                           (StateSpec("zv", 0, "N.m/s", "z.v: the element's branch"),)),
+    static_spring=("k0",))

@@ -218,4 +218,5 @@ MODEL = BushingModel(
         (StateSpec("y", 0, "m", "internal displacement (between the Bouc-Wen element and c1)"),
          StateSpec("z", 1, "N", "hysteretic force")),
         initial_state_coupled, jump_coupled, integrate_coupled, force_coupled, derivatives_coupled, switches_coupled,
-        (StateSpec("zu", 0, "N.m/s", "z.u: the element's branch"),), zero_parameters=("x0",)))
+        (StateSpec("zu", 0, "N.m/s", "z.u: the element's branch"),), zero_parameters=("x0",)),
+    static_spring=("k1", "x0"))

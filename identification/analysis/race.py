@@ -136,8 +136,8 @@ def _forward_model_of(search: Search):
 
 def _jacobian_of(search: Search):
     def compile_jacobian():
-        from identification.forward.parameter_jacobian import sensitivity_module
-        sensitivity_module(search.space.bushing, search.d)
+        from identification.forward.parameter_jacobian import lane_chunk, sensitivity_module
+        sensitivity_module(search.space.bushing, lane_chunk(search.d))
     return compile_jacobian
 
 

@@ -86,7 +86,7 @@ def as_multiaxis(multiaxis) -> list[MultiAxisMeasurement]:
 def fit(measurements, model: str | BushingModel = DEFAULT_MODEL, preset: str = "default", seed: int = 0,
         workers: int | None = None, scheduler=None, engine=None, progress: bool = True, screening: int | None = None,
         starts: int | None = None, kdyn=None, ensemble: bool = True, jacobian: str = "exact", multiaxis=(),
-        coupling: str | None = None) -> FitResult:
+        coupling: str | None = None, fixed=None) -> FitResult:
     """Identify a model's parameters from rig tests, and say how sure the fit is.
 
     Parameters
@@ -134,6 +134,8 @@ def fit(measurements, model: str | BushingModel = DEFAULT_MODEL, preset: str = "
         model on each axis alone), ``radial`` (its coupled form on x and y, z alone) or
         ``spherical`` (on x, y and z). The fitted set is the one-axis set either way, which
         ``assemble --coupling`` turns into a six-axis file.
+    fixed : mapping of str to float, optional
+        Parameters held at these values (the model's units), not searched: a backbone's knots.
 
     Returns
     -------
@@ -164,7 +166,7 @@ def fit(measurements, model: str | BushingModel = DEFAULT_MODEL, preset: str = "
     from threadpoolctl import threadpool_limits
     started = time.perf_counter()
     request = training_request(measurements, model, preset, seed, screening, starts, kdyn, ensemble, jacobian,
-                               multiaxis, coupling)
+                               multiaxis, coupling, fixed)
     # One BLAS thread here as in every task: a multi-threaded BLAS may sum in another order,
     # and the scales and the Jacobian's SVD computed here must not depend on the engine.
     with threadpool_limits(limits=1):
@@ -184,7 +186,7 @@ def fit(measurements, model: str | BushingModel = DEFAULT_MODEL, preset: str = "
 
 def training_request(measurements, model: str | BushingModel = DEFAULT_MODEL, preset: str = "default", seed: int = 0,
                      screening: int | None = None, starts: int | None = None, kdyn=None, ensemble: bool = True,
-                     jacobian: str = "exact", multiaxis=(), coupling: str | None = None) -> SearchRequest:
+                     jacobian: str = "exact", multiaxis=(), coupling: str | None = None, fixed=None) -> SearchRequest:
     """``fit``'s arguments (the same names) read and checked: what one fit fits and how, for
     :func:`fit_linear` (a model whose force is linear in its parameters) or
     ``search.begin`` (every other; ``compare`` runs those step by step). Raises
@@ -193,7 +195,7 @@ def training_request(measurements, model: str | BushingModel = DEFAULT_MODEL, pr
     if preset not in PRESETS:
         raise IdentificationError(f"unknown preset {preset!r}; choose one of {', '.join(PRESETS)}")
     return SearchRequest(tests, noise, bushing, preset, _settings(PRESETS[preset], screening, starts), seed, table,
-                         multi, jacobian, ensemble)
+                         multi, jacobian, ensemble, tuple(dict(fixed or {}).items()))
 
 
 def _training(measurements, model, seed: int, jacobian: str, kdyn, multiaxis, coupling: str | None):

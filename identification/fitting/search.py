@@ -108,8 +108,8 @@ class JacobianCompile:
         self.thread = threading.Thread(target=self._compile, name="exact Jacobian compile", daemon=True)
 
     def _expected_s(self) -> float | None:
-        from identification.forward.parameter_jacobian import expected_compile_seconds
-        return expected_compile_seconds(self.bushing, self.lanes)
+        from identification.forward.parameter_jacobian import expected_compile_seconds, lane_chunk
+        return expected_compile_seconds(self.bushing, lane_chunk(self.lanes))
 
     def _notice(self) -> str:
         expected = self._expected_s()
@@ -118,9 +118,9 @@ class JacobianCompile:
                 f"; cached in {cache_directory()}")
 
     def _compile(self):
-        from identification.forward.parameter_jacobian import sensitivity_module
+        from identification.forward.parameter_jacobian import lane_chunk, sensitivity_module
         try:
-            sensitivity_module(self.bushing, self.lanes)
+            sensitivity_module(self.bushing, lane_chunk(self.lanes))
         except BaseException as error:          # raised again by wait(), in the search's thread
             self.error = error
         finally:
@@ -170,6 +170,7 @@ class SearchRequest:
     multi: MultiAxisTraining = MultiAxisTraining([], [], "none")
     jacobian_kind: str = "exact"
     sample_ensemble: bool = True
+    fixed: tuple[tuple[str, float], ...] = ()     # parameters held at given values (SearchSpace.fixed)
 
 
 def run(request: SearchRequest, engine, progress: bool, started: float) -> FitResult:
@@ -305,7 +306,7 @@ class Search:
         self.space = SearchSpace.from_measurements(measurements, request.model,
                                                    steps=[t.kind == "step" for t in request.tests]
                                                    + [False] * (len(measurements) - len(request.tests)),
-                                                   table=request.table)
+                                                   table=request.table, fixed=request.fixed)
         # with a table, the screening and the early stages run its coarser loop (kdyn_table)
         self.jacobian_kind = request.jacobian_kind
         if self.jacobian_kind == "exact":

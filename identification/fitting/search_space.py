@@ -82,12 +82,23 @@ class SearchSpace:
     sample_interval_s: float      # the shortest median sample interval of the tests
     model: str = DEFAULT_MODEL
     x_ref: float = 1.0            # mm: the tests' largest displacement amplitude
+    fixed: tuple[tuple[str, float], ...] = ()
+    """Parameters held at given values instead of searched ((name, value) pairs in the model's
+    units: a backbone's stated knot positions, a value the user knows)."""
 
     def __post_init__(self):
         bushing = resolve_model(self.model)
         if not isinstance(self.model, str):
             object.__setattr__(self, "model", bushing.name)
         object.__setattr__(self, "_bushing", bushing)
+        object.__setattr__(self, "fixed", tuple((str(name), float(value)) for name, value in dict(self.fixed).items()))
+        unknown = sorted(name for name, _ in self.fixed if name not in bushing.parameter_names)
+        if unknown:
+            raise IdentificationError(f"fixed parameters {unknown} are not parameters of the {bushing.name} model; "
+                                      f"its parameters: {', '.join(bushing.parameter_names)}")
+        bad = [f"{name} = {value}" for name, value in self.fixed if not math.isfinite(value)]
+        if bad:
+            raise IdentificationError(f"fixed parameters must be finite numbers: {', '.join(bad)}")
 
     def __getstate__(self):
         return {name: value for name, value in self.__dict__.items() if name != "_bushing"}
@@ -99,10 +110,12 @@ class SearchSpace:
 
     @classmethod
     def from_measurements(cls, measurements: Sequence[Measurement], model: str | BushingModel = DEFAULT_MODEL,
-                          steps: Sequence[bool] = (), table=None) -> "SearchSpace":
+                          steps: Sequence[bool] = (), table=None, fixed=()) -> "SearchSpace":
         """The space for these tests; ``steps`` marks which are step tests (left out of the
         scales unless all are). ``table``: a dynamic-stiffness table (``kdyn_table.KdynTable``),
-        which sets the scales when no test other than steps is given (:meth:`from_table`)."""
+        which sets the scales when no test other than steps is given (:meth:`from_table`).
+        ``fixed``: parameters held at given values (a mapping or (name, value) pairs)."""
+        fixed = tuple(dict(fixed).items())
         model = resolve_model(model)
         if model.search is None:
             searched = [name for name, bushing in MODELS.items() if bushing.search is not None]
@@ -117,7 +130,7 @@ class SearchSpace:
                 peak = max([from_table.F_ref] + [float(np.max(np.abs(m.force_N))) for m in measurements])
                 interval = min([from_table.sample_interval_s] + [float(np.median(np.diff(m.time_s)))
                                                                  for m in measurements])
-                return cls(from_table.k_ref, from_table.c_ref, peak, interval, model, from_table.x_ref)
+                return cls(from_table.k_ref, from_table.c_ref, peak, interval, model, from_table.x_ref, fixed)
         scaling = scaling or list(measurements)
         kelvin_voigt = KelvinVoigtFit.fit(scaling)
         peak = max(float(np.max(np.abs(m.force_N))) for m in scaling)
@@ -133,7 +146,7 @@ class SearchSpace:
         interval = min(float(np.median(np.diff(m.time_s))) for m in measurements)
         if table is not None:
             interval = min(interval, from_table.sample_interval_s)
-        return cls(k_ref, c_ref, peak, interval, model, amplitude)
+        return cls(k_ref, c_ref, peak, interval, model, amplitude, fixed)
 
     @classmethod
     def from_table(cls, table, model: str | BushingModel = DEFAULT_MODEL) -> "SearchSpace":
@@ -154,7 +167,9 @@ class SearchSpace:
 
     @property
     def coordinates(self) -> tuple[SearchCoordinate, ...]:
-        return self.bushing.search.coordinates
+        """The model's box's coordinates but those of fixed parameters."""
+        fixed = {name for name, _ in self.fixed}
+        return tuple(c for c in self.bushing.search.coordinates if c.parameter not in fixed)
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -186,9 +201,11 @@ class SearchSpace:
         differentiates it by complex step)."""
         theta = np.atleast_2d(np.asarray(coordinates, dtype=complex if np.iscomplexobj(coordinates) else float))
         names = self.bushing.parameter_names
-        value = {name: np.zeros(theta.shape[0]) for name in names}   # fixed parameters (x0) stay 0
+        value = {name: np.zeros(theta.shape[0]) for name in names}   # parameters held at 0 (x0) stay 0
         for name in self.bushing.search.unit_weights:
             value[name] = np.ones(theta.shape[0])
+        for name, held in self.bushing.search.held + self.fixed:
+            value[name] = np.full(theta.shape[0], held)
         column = {c.parameter: i for i, c in enumerate(self.coordinates)}
         for c in evaluation_order(self.coordinates):
             value[c.parameter] = c.kind.to_parameter(c, theta[:, column[c.parameter]], value, self)

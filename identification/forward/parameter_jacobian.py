@@ -124,6 +124,20 @@ def _appendix(model: BushingModel, lanes: int, machinery: str) -> str:
             + "\n\n_simulate_sensitivities = numba.njit(error_model='numpy', cache=True)(_population_loop)\n")
 
 
+MAX_LANES = 24
+"""The most directions one compiled module carries: more are computed in equal chunks of at most
+this many (numba's bytecode reader fails on some tuple displays of 30-odd elements, and a
+module's compile time grows faster than its lanes)."""
+
+
+def lane_chunk(lanes: int) -> int:
+    """The directions of each chunk ``lanes`` directions are computed in: all of them up to
+    MAX_LANES, else equal chunks of at most MAX_LANES (the last padded with zero directions), so
+    that one module carries them."""
+    count = -(-lanes // MAX_LANES)
+    return -(-lanes // count)
+
+
 _compiled: dict[tuple[str, int], types.ModuleType] = {}
 _compile_locks: dict[tuple[str, int], threading.Lock] = {}
 _locks_lock = threading.Lock()
@@ -209,7 +223,8 @@ def population_sensitivities(parameter_sets, seeds, time_s, displacement_mm, vel
     """Forces [N], shape (P, outputs), as ``population.simulate_population_at`` gives them (the
     same bits), and their derivatives, shape (P, outputs, K), in the K directions ``seeds`` (P, m,
     K): the derivatives of each row's m parameters (in the model's order) along each direction.
-    NaN (both) from where a candidate fails."""
+    NaN (both) from where a candidate fails. More than MAX_LANES directions run in chunks
+    (:func:`lane_chunk`)."""
     t, x, v = _input_arrays(time_s, displacement_mm, velocity_mm_s)
     out_index, out_velocity = output_points(t, output_index, output_velocity_mm_s)
     bushing = resolve_model(model)
@@ -218,6 +233,18 @@ def population_sensitivities(parameter_sets, seeds, time_s, displacement_mm, vel
     if seeds.ndim != 3 or seeds.shape[:2] != matrix.shape:
         raise ValueError(f"seeds must have shape (P, m, K) = ({matrix.shape[0]}, {matrix.shape[1]}, K), "
                          f"got {seeds.shape}")
-    module = sensitivity_module(bushing, seeds.shape[2])
-    return module._simulate_sensitivities(matrix, seeds, t, x, v, out_index, out_velocity, max_substeps,
-                                          *_step_sizes(t))
+    lanes = seeds.shape[2]
+    size = lane_chunk(lanes)
+    module = sensitivity_module(bushing, size)
+    if size == lanes:
+        return module._simulate_sensitivities(matrix, seeds, t, x, v, out_index, out_velocity, max_substeps,
+                                              *_step_sizes(t))
+    forces, parts = None, []
+    for first in range(0, lanes, size):
+        chunk = np.zeros(seeds.shape[:2] + (size,))
+        chunk[:, :, :min(size, lanes - first)] = seeds[:, :, first:first + size]
+        values, derivatives = module._simulate_sensitivities(matrix, chunk, t, x, v, out_index, out_velocity,
+                                                             max_substeps, *_step_sizes(t))
+        forces = values if forces is None else forces      # the same bits from every chunk
+        parts.append(derivatives)
+    return forces, np.concatenate(parts, axis=2)[:, :, :lanes]

@@ -39,12 +39,17 @@ def c_string(text: str) -> str:
     return json.dumps(text)      # a C string literal for ASCII text (json escapes as C does)
 
 
+def c_identifier(model_name: str) -> str:
+    """A model's name as C names it: a derived model's ``+`` (``proposed+limits``) as ``__``."""
+    return model_name.replace("+", "__")
+
+
 class ModelCode:
     """One model's translated kernels and the C types of their tuples."""
 
     def __init__(self, translation: Translation, model: BushingModel, coupled: bool = False):
         self.model = model
-        self.name = model.name
+        self.name = c_identifier(model.name)
         parameters = (DOUBLE,) * len(model.specs)
         self.parameters_type = parameters
         prepare = translation.function(model.prepare, (parameters,))
@@ -343,7 +348,7 @@ def model_source(axis_models, identifier: str, groups=()) -> GeneratedModel:
     kernels = translation.source()
 
     parts = [kernels, "\ntypedef union {"]
-    parts += [f"    {translation.c_type(code.constants_type)} {name};" for name, code in models.items()]
+    parts += [f"    {translation.c_type(code.constants_type)} {code.name};" for code in models.values()]
     parts.append("} bw_constants;\n")
     for code in models.values():
         parts.append(code.wrappers())
@@ -375,7 +380,7 @@ def _axis_table(axis_models) -> list[str]:
             f"    {{{c_string(axis.name)}, {c_string(axis.label)}, {c_string(axis.displacement)}, {c_string(axis.velocity)}, "
             f"{c_string(axis.output)}, {int(axis.rotational)}, {exact_text(axis.to_kernel)}, {exact_text(axis.from_kernel)}, "
             f"{exact_text(axis.plausible_travel)}, {exact_text(plausible[0])}, {exact_text(plausible[1])}, "
-            f"&bw_model_{model.name}{suffix}, bw_defaults_{position}}}")
+            f"&bw_model_{c_identifier(model.name)}{suffix}, bw_defaults_{position}}}")
     parts.append("\nstatic const bw_axis_spec bw_axis_specs[BW_AXES] = {\n" + ",\n".join(axis_lines) + "\n};\n")
     return parts
 

@@ -1,0 +1,269 @@
+"""Options any model takes (fmu_src.model.derived): a measured backbone, travel limits, the rig's
+offsets. Each against what it is by its definition, typed here or taken from scipy: the backbone
+scipy's PchipInterpolator, the limits a contact force written out with numpy, the rig's offsets a
+shift of the base model's input and output; neutral options leave every model bit for bit; the
+paths (plain Python, numba, C, the tangents, both FMUs) agree on a derived model as on any."""
+from __future__ import annotations
+
+import math
+import shutil
+
+import numpy as np
+import pytest
+from scipy.interpolate import PchipInterpolator
+
+from conftest import DATA
+from fmu_src.model.derived import Options, split_name
+from fmu_src.model.parameter_specs import ParameterError
+from fmu_src.model.registry import MODELS, get_model
+from fmu_src.parameter_files import read_parameter_set, save_parameters
+from identification.measured.signals import Random, sample_times
+from python_core import simulate_python_core
+
+T = sample_times(0.3, 1000.0)
+X, V = Random(2.0, 0.3, seed=5).signals(T)
+X = X + 0.01 * np.sin(2 * np.pi * 50 * T)        # a displacement jump at every step, as the FMU may see
+
+LIMITS = dict(limit_gap_pos=1.0, limit_gap_neg=0.5, limit_k_pos=300.0, limit_k_neg=500.0, limit_exponent_pos=2.0,
+              limit_exponent_neg=1.5, limit_c_pos=2.0, limit_c_neg=1.0, limit_depth_pos=0.3, limit_depth_neg=0.2,
+              limit_width=0.05)
+NO_LIMITS = dict(LIMITS, limit_k_pos=0.0, limit_k_neg=0.0, limit_c_pos=0.0, limit_c_neg=0.0)
+BACKBONE = dict(backbone_x1=-3.0, backbone_x2=-1.0, backbone_x3=0.5, backbone_x4=3.0,
+                backbone_F1=-900.0, backbone_F2=-200.0, backbone_F3=50.0, backbone_F4=1200.0)
+
+
+def defaults(name: str) -> dict[str, float]:
+    model = get_model(name)
+    return dict(read_parameter_set(DATA / model.default_file, name).parameters)
+
+
+def test_a_derived_model_is_named_by_its_base_and_options_either_way():
+    model = get_model("proposed+rig+limits")
+    assert model.name == "proposed+limits+rig" and model.identifier == "BoucWenBushing_Limits_Rig"
+    assert get_model("BoucWenBushing_Limits_Rig") is model
+    assert get_model("hydraulic_free_decoupler+backbone7").identifier == "HydraulicFreeDecoupler_Backbone7"
+    assert split_name("HydraulicFreeDecoupler_Backbone7") == ("HydraulicFreeDecoupler", Options(knots=7))
+    assert model.base is MODELS["proposed"] and model.options == Options(limits=True, rig=True)
+    with pytest.raises(ParameterError, match="unknown model option 'stops'.*limits"):
+        get_model("proposed+stops")
+    with pytest.raises(ParameterError, match="1 knots: give 2 to 32"):
+        get_model("proposed+backbone1")
+
+
+@pytest.mark.parametrize("base", list(MODELS))
+def test_neutral_options_leave_every_model_bit_for_bit(base):
+    # limits without stiffness or damping, the rig's zeros at 0: the same floats as the base
+    params = defaults(base)
+    derived = get_model(f"{base}+limits+rig")
+    neutral = dict(params, **NO_LIMITS, rig_displacement_zero=0.0, rig_force_zero=0.0)
+    np.testing.assert_array_equal(simulate_python_core(neutral, T, X, V, model=derived.name),
+                                  simulate_python_core(params, T, X, V, model=base))
+
+
+@pytest.mark.parametrize("base", ["single_bouc_wen", "berg", "kelvin_voigt"])
+def test_a_straight_backbone_is_the_static_spring_it_replaces(base):
+    # a linear static spring k0*x (Kelvin-Voigt's k) as a two-knot backbone through 0
+    params = defaults(base)
+    model = get_model(base)
+    spring = model.static_spring[0]
+    derived = get_model(f"{base}+backbone2")
+    replaced = {name: value for name, value in params.items() if name not in model.static_spring}
+    if "k3" in params:      # the cubic stays out of the comparison: a straight backbone has none
+        params = dict(params, k3=0.0)
+    replaced.update(backbone_x1=-1.0, backbone_x2=1.0, backbone_F1=-params[spring], backbone_F2=params[spring])
+    got = simulate_python_core(replaced, T, X, V, model=derived.name)
+    want = simulate_python_core(params, T, X, V, model=base)
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-12 * np.max(np.abs(want)))
+
+
+def kelvin_voigt_with(options: str, **values) -> tuple:
+    """A Kelvin-Voigt bushing with no spring or dashpot of its own and ``options``: the options'
+    force alone (``force`` of the model at rest, for displacement u and velocity v)."""
+    model = get_model(f"kelvin_voigt+{options}")
+    own = {name: 0.0 for name in ("k", "c", "preload") if name in model.parameter_names}
+    params = model.check(dict(own, **values))
+    constants = model.constants(params)
+    return model, constants
+
+
+def test_the_backbone_is_scipys_monotone_cubic_and_straight_beyond_its_end_knots():
+    x = np.array([-4.0, -2.5, -1.0, 0.0, 1.5, 2.0, 5.0])
+    force = np.array([-3000.0, -400.0, -150.0, 0.0, 200.0, 900.0, 5200.0])     # a void closing, a bump stop
+    values = {f"backbone_x{i + 1}": float(a) for i, a in enumerate(x)}
+    values.update({f"backbone_F{i + 1}": float(f) for i, f in enumerate(force)})
+    model, constants = kelvin_voigt_with("backbone7", **values)
+    state = model.initial_state(constants, 0.0)
+    reference = PchipInterpolator(x, force)
+    slope = reference.derivative()
+    u = np.linspace(-7.0, 8.0, 601)
+    got = np.array([model.force(constants, state, a, 0.0) for a in u])
+    want = np.where(u < x[0], force[0] + slope(x[0]) * (u - x[0]),
+                    np.where(u > x[-1], force[-1] + slope(x[-1]) * (u - x[-1]), reference(np.clip(u, x[0], x[-1]))))
+    np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-9)
+    assert np.all(np.diff(got) >= 0.0)      # monotone data, monotone curve
+
+
+def softplus(z):
+    return np.logaddexp(0.0, z)
+
+
+def typed_limit(u, v, gap, k, exponent, c, depth, width):
+    """One side's contact force, written out: penetration d = width*softplus((u - gap)/width), then
+    k*d^e plus the damping c*v ramped in by 3s^2 - 2s^3, s = d/depth clipped to [0, 1]."""
+    d = width * softplus((u - gap) / width)
+    s = np.clip(d / depth, 0.0, 1.0)
+    return k * d ** exponent + c * s * s * (3.0 - 2.0 * s) * v
+
+
+def test_the_travel_limits_are_the_contact_force_on_each_side():
+    model, constants = kelvin_voigt_with("limits", **LIMITS)
+    state = model.initial_state(constants, 0.0)
+    p = LIMITS
+    for u in np.linspace(-3.0, 3.0, 121):
+        for v in (-40.0, 0.0, 25.0):
+            want = (typed_limit(u, v, p["limit_gap_pos"], p["limit_k_pos"], p["limit_exponent_pos"], p["limit_c_pos"],
+                                p["limit_depth_pos"], p["limit_width"])
+                    - typed_limit(-u, -v, p["limit_gap_neg"], p["limit_k_neg"], p["limit_exponent_neg"],
+                                  p["limit_c_neg"], p["limit_depth_neg"], p["limit_width"]))
+            assert model.force(constants, state, u, v) == pytest.approx(want, rel=1e-12, abs=1e-9)
+    # inside both gaps, more than 37 widths from either corner: nothing (the softplus is 0 there)
+    narrow, narrow_constants = kelvin_voigt_with("limits", **dict(LIMITS, limit_width=0.01))
+    assert narrow.force(narrow_constants, state, 0.2, 30.0) == 0.0
+    # the corners are the switches a model-exchange host locates
+    assert model.switches(constants, state, 0.7, 1.0) == pytest.approx((0.7 - 1.0, 0.7 + 0.5))
+
+
+def test_hard_limits_engage_at_their_gaps():
+    model, constants = kelvin_voigt_with("limits", **dict(LIMITS, limit_width=0.0, limit_c_pos=0.0, limit_c_neg=0.0))
+    state = model.initial_state(constants, 0.0)
+    assert model.force(constants, state, 0.99, 0.0) == 0.0 and model.force(constants, state, -0.49, 0.0) == 0.0
+    assert model.force(constants, state, 1.5, 0.0) == pytest.approx(300.0 * 0.5 ** 2)
+    assert model.force(constants, state, -1.5, 0.0) == pytest.approx(-500.0 * 1.0 ** 1.5)
+
+
+@pytest.mark.parametrize("base", ["single_bouc_wen", "asymmetric_bouc_wen", "hydraulic"])
+def test_the_rig_offsets_shift_the_base_models_input_and_output(base):
+    params = defaults(base)
+    derived = get_model(f"{base}+rig")
+    shifted = dict(params, rig_displacement_zero=0.4, rig_force_zero=-35.0)
+    got = simulate_python_core(shifted, T, X, V, model=derived.name)
+    want = simulate_python_core(params, T, X - 0.4, V, model=base) - 35.0
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-9 * np.max(np.abs(want)))
+
+
+@pytest.mark.parametrize("bad, message", [
+    (dict(backbone_x2=-3.5), r"backbone_x2 - backbone_x1 = -0.5 mm must be > 0 \(the backbone's knots must increase\)"),
+    (dict(backbone_F3=-300.0), r"backbone_F3 - backbone_F2 = -100.0 N must be >= 0 \(a backbone is monotone"),
+    (dict(limit_gap_pos=-1.0), r"limit_gap_pos = -1.0 \[mm\] must be >= 0"),
+    (dict(limit_exponent_neg=0.5), r"limit_exponent_neg = 0.5 \[1\] must be >= 1"),
+    (dict(limit_width=-0.1), r"limit_width = -0.1 \[mm\] must be >= 0"),
+    (dict(limit_k_pos=-5.0), r"limit_k_pos = -5.0 \[N/mm\] must be >= 0"),
+])
+def test_bad_backbones_and_limits_are_refused_with_value_unit_and_range(bad, message):
+    model = get_model("kelvin_voigt+backbone4+limits")
+    params = dict(c=1.0, preload=0.0, **BACKBONE, **LIMITS)
+    model.check(params)
+    with pytest.raises(ParameterError, match=message):
+        model.check(dict(params, **bad))
+
+
+@pytest.mark.parametrize("base", ["single_bouc_wen", "asymmetric_bouc_wen"])
+def test_the_compiled_derived_model_equals_its_python_kernels_bitwise(base):
+    from identification.forward.population import simulate_population_held
+    derived = get_model(f"{base}+backbone4+limits+rig")
+    params = {name: value for name, value in defaults(base).items() if name not in get_model(base).static_spring}
+    params.update(BACKBONE, **LIMITS, rig_displacement_zero=0.1, rig_force_zero=20.0)
+    compiled = simulate_population_held([derived.check(params)], T, X, V, model=derived)[0]
+    np.testing.assert_array_equal(compiled, simulate_python_core(params, T, X, V, model=derived.name))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("base", list(MODELS))
+def test_every_derived_model_compiles_equal_to_its_python_kernels(base):
+    test_the_compiled_derived_model_equals_its_python_kernels_bitwise(base)
+
+
+@pytest.mark.parametrize("base", ["single_bouc_wen", "berg"])
+def test_the_derived_kernels_tangents_are_their_complex_step_derivatives(base):
+    from fmu_src.kernels.tangents import tangent
+    from test_tangents import Cs, STEP, flat, on_complex_numbers
+    derived = get_model(f"{base}+backbone4+limits+rig")
+    params = {name: value for name, value in defaults(base).items() if name not in get_model(base).static_spring}
+    params.update(BACKBONE, **LIMITS, rig_displacement_zero=0.1, rig_force_zero=20.0)
+    m = derived.constants(derived.check(params))
+    force_tangent = tangent(derived.force)
+    rng = np.random.default_rng(8)
+    for _ in range(60):
+        x, v = float(rng.uniform(-4.0, 4.0)), float(rng.uniform(-50.0, 50.0))
+        state = tuple(float(s) for s in np.asarray(derived.initial_state(m, x)) + rng.normal(0.0, 0.3, len(derived.states)))
+        d_state = tuple(float(d) for d in rng.normal(0.0, 1.0, len(state)))
+        d_x, d_v = float(rng.normal()), float(rng.normal())
+        value, derivative = force_tangent(m, state, x, v, d_state, d_x, d_v)
+        assert value == derived.force(m, state, x, v)
+        stepped = on_complex_numbers(derived.force)(m, tuple(Cs(complex(s, STEP * d)) for s, d in zip(state, d_state)),
+                                                    Cs(complex(x, STEP * d_x)), Cs(complex(v, STEP * d_v)))
+        want = complex(stepped).imag / STEP
+        assert derivative == pytest.approx(want, rel=1e-9, abs=1e-9 * max(1.0, abs(want)))
+
+
+@pytest.fixture(scope="module")
+def derived_parameter_file(tmp_path_factory):
+    params = {name: value for name, value in defaults("single_bouc_wen").items() if name != "k0"}
+    params.update({k: v for k, v in BACKBONE.items()}, **LIMITS)
+    path = tmp_path_factory.mktemp("derived") / "params.json"
+    save_parameters(path, params, "single_bouc_wen+backbone4+limits")
+    return path
+
+
+@pytest.mark.parametrize("kind", ["pythonfmu", "native2", "native3"])
+def test_both_fmus_of_a_derived_model_equal_its_forward_model(kind, derived_parameter_file, tmp_path):
+    import subprocess
+    import sys
+    from fmpy import simulate_fmu
+    from fmpy.validation import validate_fmu
+    from conftest import REPO
+    from identification.forward.population import simulate_population_held
+    if kind != "pythonfmu" and shutil.which("gcc") is None and shutil.which("cc") is None:
+        pytest.skip("no C compiler for the native FMU")
+    extra = {"pythonfmu": [], "native2": ["--native"], "native3": ["--native", "--fmi-version", "3"]}[kind]
+    run = subprocess.run([sys.executable, str(REPO / "build_fmu.py"), "--params", str(derived_parameter_file),
+                          "--out", str(tmp_path), *extra], capture_output=True, text=True, cwd=REPO, timeout=600)
+    assert run.returncode == 0, run.stderr[-2000:]
+    path = tmp_path / "SingleBoucWenBushing_Backbone4_Limits.fmu"
+    assert validate_fmu(str(path)) == []
+    t = np.arange(0.0, 0.6, 1e-3)
+    w = 2 * np.pi * 3.0
+    signals = np.zeros(t.size, dtype=[("time", float), ("x", float), ("v", float)])
+    signals["time"], signals["x"], signals["v"] = t, 3.5e-3 * np.sin(w * t), 3.5e-3 * w * np.cos(w * t)
+    result = simulate_fmu(str(path), stop_time=t[-1], step_size=1e-3, output_interval=1e-3, input=signals, output=["F"])
+    parameters = read_parameter_set(derived_parameter_file)
+    want = simulate_population_held([parameters.parameters], t, signals["x"] * 1e3, signals["v"] * 1e3,
+                                    model=parameters.model)[0]
+    np.testing.assert_allclose(result["F"], want[:len(result)], rtol=0, atol=1e-12 * np.max(np.abs(want)))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("base", ["single_bouc_wen", "asymmetric_bouc_wen", "hydraulic_free_decoupler"])
+def test_the_fits_exact_jacobian_of_a_derived_model_equals_central_differences(base):
+    # every parameter a direction (33 for the free plate: more than one module carries, so in chunks)
+    from identification.forward.parameter_jacobian import population_sensitivities
+    from identification.forward.population import simulate_population_at
+    derived = get_model(f"{base}+backbone4+limits+rig")
+    params = {name: value for name, value in defaults(base).items() if name not in get_model(base).static_spring}
+    params.update(BACKBONE, **LIMITS, rig_displacement_zero=0.1, rig_force_zero=20.0)
+    t = sample_times(0.2, 1000.0)
+    x, v = Random(2.0, 0.3, seed=5).signals(t)
+    row = np.array([derived.values(derived.check(params))])
+    directions = row.shape[1]
+    outputs = np.arange(t.size)
+    forces, sensitivities = population_sensitivities(row, np.eye(directions)[None], t, x, v, outputs, v, model=derived)
+    np.testing.assert_array_equal(forces[0], simulate_population_at(row, t, x, v, outputs, v, model=derived)[0])
+    for j in range(directions):
+        h = 1e-6 * max(1.0, abs(row[0, j]))
+        up, down = row.copy(), row.copy()
+        up[0, j] += h
+        down[0, j] -= h
+        central = (simulate_population_at(up, t, x, v, outputs, v, model=derived)[0]
+                   - simulate_population_at(down, t, x, v, outputs, v, model=derived)[0]) / (2 * h)
+        scale = np.max(np.abs(central)) + 1e-9
+        assert np.max(np.abs(central - sensitivities[0, :, j])) <= 1e-5 * scale, derived.parameter_names[j]
