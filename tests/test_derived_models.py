@@ -52,10 +52,11 @@ def test_a_derived_model_is_named_by_its_base_and_options_either_way():
 
 @pytest.mark.parametrize("base", list(MODELS))
 def test_neutral_options_leave_every_model_bit_for_bit(base):
-    # limits without stiffness or damping, the rig's zeros at 0: the same floats as the base
+    # limits without stiffness or damping, a Maxwell element without a spring, the rig's zeros at 0:
+    # the same floats as the base
     params = defaults(base)
-    derived = get_model(f"{base}+limits+rig")
-    neutral = dict(params, **NO_LIMITS, rig_displacement_zero=0.0, rig_force_zero=0.0)
+    derived = get_model(f"{base}+limits+maxwell+rig")
+    neutral = dict(params, **NO_LIMITS, maxwell_k=0.0, maxwell_c=1.0, rig_displacement_zero=0.0, rig_force_zero=0.0)
     np.testing.assert_array_equal(simulate_python_core(neutral, T, X, V, model=derived.name),
                                   simulate_python_core(params, T, X, V, model=base))
 
@@ -131,6 +132,20 @@ def test_the_travel_limits_are_the_contact_force_on_each_side():
     assert narrow.force(narrow_constants, state, 0.2, 30.0) == 0.0
     # the corners are the switches a model-exchange host locates
     assert model.switches(constants, state, 0.7, 1.0) == pytest.approx((0.7 - 1.0, 0.7 + 0.5))
+
+
+def test_the_maxwell_element_relaxes_exactly_as_its_equation_says():
+    # a ramp x = v*t from rest: df/dt = k*v - (k/c)*f gives f = c*v*(1 - exp(-k*t/c)), exactly
+    model, constants = kelvin_voigt_with("maxwell", maxwell_k=300.0, maxwell_c=3.0)
+    assert [s.name for s in model.states] == ["maxwell_f"]
+    t = np.arange(0.0, 0.05, 1e-3)
+    v = 12.0
+    forces = simulate_python_core(model.check(dict(k=0.0, c=0.0, preload=0.0, maxwell_k=300.0, maxwell_c=3.0)),
+                                  t, v * t, np.full(t.size, v), model=model.name)
+    np.testing.assert_allclose(forces, 3.0 * v * (1.0 - np.exp(-100.0 * t)), rtol=1e-12, atol=1e-10)
+    # its rate for model exchange, and a jump loads its spring at once
+    assert model.derivatives(constants, (5.0,), 0.0, 2.0) == pytest.approx((300.0 * 2.0 - 100.0 * 5.0,))
+    assert model.jump(constants, (5.0,), 0.01) == ((5.0 + 3.0,), 0)
 
 
 def test_hard_limits_engage_at_their_gaps():
@@ -209,9 +224,9 @@ def test_the_derived_kernels_tangents_are_their_complex_step_derivatives(base):
 @pytest.fixture(scope="module")
 def derived_parameter_file(tmp_path_factory):
     params = {name: value for name, value in defaults("single_bouc_wen").items() if name != "k0"}
-    params.update({k: v for k, v in BACKBONE.items()}, **LIMITS)
+    params.update({k: v for k, v in BACKBONE.items()}, **LIMITS, maxwell_k=200.0, maxwell_c=2.0)
     path = tmp_path_factory.mktemp("derived") / "params.json"
-    save_parameters(path, params, "single_bouc_wen+backbone4+limits")
+    save_parameters(path, params, "single_bouc_wen+backbone4+limits+maxwell")
     return path
 
 
@@ -229,7 +244,7 @@ def test_both_fmus_of_a_derived_model_equal_its_forward_model(kind, derived_para
     run = subprocess.run([sys.executable, str(REPO / "build_fmu.py"), "--params", str(derived_parameter_file),
                           "--out", str(tmp_path), *extra], capture_output=True, text=True, cwd=REPO, timeout=600)
     assert run.returncode == 0, run.stderr[-2000:]
-    path = tmp_path / "SingleBoucWenBushing_Backbone4_Limits.fmu"
+    path = tmp_path / "SingleBoucWenBushing_Backbone4_Limits_Maxwell.fmu"
     assert validate_fmu(str(path)) == []
     t = np.arange(0.0, 0.6, 1e-3)
     w = 2 * np.pi * 3.0
@@ -267,3 +282,39 @@ def test_the_fits_exact_jacobian_of_a_derived_model_equals_central_differences(b
                    - simulate_population_at(down, t, x, v, outputs, v, model=derived)[0]) / (2 * h)
         scale = np.max(np.abs(central)) + 1e-9
         assert np.max(np.abs(central - sensitivities[0, :, j])) <= 1e-5 * scale, derived.parameter_names[j]
+
+
+def test_a_six_axis_fmus_axis_takes_a_derived_model_in_both_fmus(tmp_path):
+    # a jounce bump stop on z: a Kelvin-Voigt axis with a limit on its positive side only
+    import json
+    import subprocess
+    import sys
+    from fmpy import simulate_fmu
+    from fmpy.validation import validate_fmu
+    from conftest import REPO
+    if shutil.which("gcc") is None and shutil.which("cc") is None:
+        pytest.skip("no C compiler for the native FMU")
+    document = json.loads((DATA / "params_six_axis_illustrative.json").read_text())
+    document["axes"]["z"] = {"model": "KelvinVoigtBushing_Limits", "parameters": dict(
+        k=300.0, c=1.0, preload=0.0, **dict(LIMITS, limit_gap_pos=2.0, limit_gap_neg=100.0, limit_k_neg=0.0))}
+    params = tmp_path / "six.json"
+    params.write_text(json.dumps(document))
+    forces = []
+    for kind, extra in (("python", []), ("native", ["--native"])):
+        out = tmp_path / kind
+        run = subprocess.run([sys.executable, str(REPO / "build_fmu.py"), "--model", "six_axis", "--params",
+                              str(params), "--out", str(out), *extra], capture_output=True, text=True, cwd=REPO,
+                             timeout=600)
+        assert run.returncode == 0, run.stderr[-2000:]
+        path = out / "SixAxisBushing.fmu"
+        assert validate_fmu(str(path)) == []
+        t = np.arange(0.0, 0.5, 1e-3)
+        names = ["dx", "vx", "dy", "vy", "dz", "vz", "rx", "wx", "ry", "wy", "rz", "wz"]
+        signals = np.zeros(t.size, dtype=[("time", float)] + [(name, float) for name in names])
+        w = 2 * np.pi * 2.0
+        signals["time"], signals["dz"], signals["vz"] = t, 4e-3 * np.sin(w * t), 4e-3 * w * np.cos(w * t)
+        forces.append(simulate_fmu(str(path), stop_time=t[-1], step_size=1e-3, output_interval=1e-3,
+                                   input=signals, output=["Fz"])["Fz"])
+    # 4 mm into a stop at 2 mm: k*x + the stop's 300 N/mm^2 * 2^2 more at the peak, the same in both FMUs
+    np.testing.assert_array_equal(forces[0], forces[1])
+    assert np.max(forces[0]) > 300.0 * 4.0 + 300.0 * 2.0 ** 2 * 0.9

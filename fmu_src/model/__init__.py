@@ -10,8 +10,10 @@
   elements, vector algebra) and the step protocol, written in the kernel language;
 - ``elements``: the elements the models share (free play, the softplus corner), in the kernel
   language, compiled and translated as ``integration`` is;
-- ``derived``: a model with options any model takes (a measured backbone, travel limits, the
-  rig's offsets), generated as a kernel module of its own;
+- ``derived``: a model with options any model takes (a measured backbone, travel limits, a
+  Maxwell element, the rig's offsets): their parameters, names, search box, the model;
+- ``derived_source``: that model's kernel module, written as source (the base's kernels renamed,
+  the options' wrappers);
 - ``registry``: every model of ``fmu_src.models``, by name and identifier.
 
 May import: nothing of fmu_src but itself (``registry`` finds ``models`` by name, at import).

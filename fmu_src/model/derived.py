@@ -16,18 +16,19 @@ A derived model is a registered model (its *base*) with options, named
   ramps in over ``limit_depth_*`` [mm], the corners rounded over ``limit_width`` [mm] (0: hard
   corners, stated as switches), as MSC Adams' bushing limits, Altair's mount limits and
   RecurDyn's clearance describe them;
+- ``maxwell``: a Maxwell element in parallel (``maxwell_k`` [N/mm] in series with ``maxwell_c``
+  [N.s/mm]: a relaxation of time constant c/k, filled rubber's rate dependence), its force a state
+  of its own (``maxwell_f``, after the base's), stepped exactly;
 - ``rig``: a displacement zero ``rig_displacement_zero`` [mm] and a load-cell zero
   ``rig_force_zero`` [N] of a measured test, F_measured = F(x - zero) + force zero: what a fit
   estimates as nuisance parameters and keeps out of the FMU (an FMU takes them, where asked, as
   its mounting's ``offset`` and ``preload``).
 
 Every option works on the base's displacement u = x - the displacement zero (x where there is no
-rig option): F = base(u) + backbone(u) + limits(u, v) + force zero.
+rig option): F = base(u) + backbone(u) + limits(u, v) + Maxwell force + force zero.
 
-One definition. The derived model is a kernel module of its own, generated as source text and
-registered beside the models (``<package>.<base>__<options>``): the base's kernels and the
-functions and numeric constants they reach, renamed ``base_<name>``, then the wrapper kernels
-the options need. It imports nothing but ``math`` and the shared machinery and elements, so numba
+One definition. The derived model is a kernel module of its own, generated as source text
+(``derived_source``) and registered beside the models (``<package>.<base>__<options>``): numba
 compiles it, the C translator translates it and the tangent generator differentiates it as it
 does any model module; the base model itself, its generated C and its compiled module are
 unchanged. ``registry.get_model`` makes a derived model from its name or identifier on demand
@@ -35,26 +36,22 @@ unchanged. ``registry.get_model`` makes a derived model from its name or identif
 """
 from __future__ import annotations
 
-import ast
-import builtins
-import inspect
 import linecache
+import math
 import re
 import sys
 import types
 from dataclasses import dataclass, replace
 
-from . import elements, integration
 from .definition import BushingModel, ModelContractError, SearchBox, SearchCoordinate, StateSpec
+from .derived_source import derived_source
 from .parameter_specs import Constraint, ParameterError, ParameterSpec
 from .search_coordinates import KIND
 
 SEPARATOR = "+"
-BACKBONE, LIMITS, RIG = "backbone", "limits", "rig"
+BACKBONE, LIMITS, MAXWELL, RIG = "backbone", "limits", "maxwell", "rig"
 MAX_KNOTS = 32
 """The most knots a backbone takes (a static curve needs a few; each is two FMU parameters)."""
-KERNELS = ("prepare", "initial_state", "jump", "integrate", "force", "derivatives", "switches")
-"""The base's kernels a derived model wraps (``update`` and ``prepare_step`` too, where it has them)."""
 LIMIT_SIDES = (("pos", "positive"), ("neg", "negative"))
 LIMIT_HELD = (("limit_exponent_pos", 2.0), ("limit_exponent_neg", 2.0), ("limit_c_pos", 0.0), ("limit_c_neg", 0.0),
               ("limit_depth_pos", 1.0), ("limit_depth_neg", 1.0))
@@ -64,10 +61,12 @@ LIMIT_HELD = (("limit_exponent_pos", 2.0), ("limit_exponent_neg", 2.0), ("limit_
 
 @dataclass(frozen=True)
 class Options:
-    """Which options a derived model has: ``knots`` of a backbone (0: none), ``limits``, ``rig``."""
+    """Which options a derived model has: ``knots`` of a backbone (0: none), ``limits``, ``rig``,
+    ``maxwell``."""
     knots: int = 0
     limits: bool = False
     rig: bool = False
+    maxwell: bool = False
 
     def __post_init__(self):
         if self.knots and not 2 <= self.knots <= MAX_KNOTS:
@@ -75,9 +74,9 @@ class Options:
 
     @property
     def tokens(self) -> tuple[str, ...]:
-        """The options' names in their one order: backbone<K>, limits, rig."""
+        """The options' names in their one order: backbone<K>, limits, maxwell, rig."""
         return ((f"{BACKBONE}{self.knots}",) if self.knots else ()) + ((LIMITS,) if self.limits else ()) \
-            + ((RIG,) if self.rig else ())
+            + ((MAXWELL,) if self.maxwell else ()) + ((RIG,) if self.rig else ())
 
     def __bool__(self) -> bool:
         return bool(self.tokens)
@@ -87,8 +86,8 @@ class Options:
 
     @classmethod
     def parse(cls, tokens) -> "Options":
-        """From option names (``backbone5``, ``limits``, ``rig``; any order, any case)."""
-        knots, limits, rig = 0, False, False
+        """From option names (``backbone5``, ``limits``, ``maxwell``, ``rig``; any order, any case)."""
+        knots, limits, rig, maxwell = 0, False, False, False
         for token in tokens:
             word = token.strip().lower()
             match = re.fullmatch(rf"{BACKBONE}(\d+)", word)
@@ -98,10 +97,12 @@ class Options:
                 limits = True
             elif word == RIG:
                 rig = True
+            elif word == MAXWELL:
+                maxwell = True
             else:
                 raise ParameterError(f"unknown model option {token!r}; the options are {BACKBONE}<K> (a backbone of "
-                                     f"K knots, 2 to {MAX_KNOTS}), {LIMITS} and {RIG}")
-        return cls(knots, limits, rig)
+                                     f"K knots, 2 to {MAX_KNOTS}), {LIMITS}, {MAXWELL} and {RIG}")
+        return cls(knots, limits, rig, maxwell)
 
 
 def split_name(name: str) -> tuple[str, Options]:
@@ -110,12 +111,11 @@ def split_name(name: str) -> tuple[str, Options]:
     if SEPARATOR in name:
         base, *tokens = name.split(SEPARATOR)
         return base, Options.parse(tokens)
-    base, *tokens = name.split("_")
     # an identifier: the base's (which may hold underscores) and then the options' capitalised words
     words = name.split("_")
     for cut in range(1, len(words) + 1):
         tail = words[cut:]
-        if all(re.fullmatch(r"(Backbone\d+|Limits|Rig)", word) for word in tail):
+        if all(re.fullmatch(r"(Backbone\d+|Limits|Maxwell|Rig)", word) for word in tail):
             return "_".join(words[:cut]), Options.parse(tail)
     return name, Options()
 
@@ -168,6 +168,13 @@ def limit_specs() -> tuple[ParameterSpec, ...]:
     return tuple(out)
 
 
+def maxwell_specs() -> tuple[ParameterSpec, ...]:
+    return (ParameterSpec("maxwell_k", "N/mm", "the parallel Maxwell element's spring", minimum=0.0,
+                          why="a negative spring is unstable"),
+            ParameterSpec("maxwell_c", "N.s/mm", "the parallel Maxwell element's dashpot (time constant c/k)",
+                          minimum=0.0, exclusive=True, why="a Maxwell element without a dashpot is a spring"))
+
+
 def rig_specs() -> tuple[ParameterSpec, ...]:
     return (ParameterSpec("rig_displacement_zero", "mm", "the rig's displacement zero: the model sees x - it",
                           bound_powers=None),
@@ -177,209 +184,7 @@ def rig_specs() -> tuple[ParameterSpec, ...]:
 
 def option_specs(options: Options) -> tuple[ParameterSpec, ...]:
     return ((backbone_specs(options.knots) if options.knots else ()) + (limit_specs() if options.limits else ())
-            + (rig_specs() if options.rig else ()))
-
-
-# ------------------------------------------------------------------------------ source
-def _reached(base: BushingModel, module: types.ModuleType) -> tuple[list[str], dict[str, object], set[str]]:
-    """(the functions of the base's module its kernels reach, in source order; the numeric
-    constants they read; the names they import from the machinery or the elements). Raises
-    ModelContractError for a global of another kind."""
-    tree = ast.parse(inspect.getsource(module))
-    defined = {node.name: node for node in tree.body if isinstance(node, ast.FunctionDef)}
-    roots = [getattr(base, name).__name__ for name in KERNELS]
-    roots += [name for name in ("prepare_step",) if name in defined]
-    if base.update is not None:
-        roots.append(base.update.__name__)
-    seen, constants, shared, pending = set(), {}, set(), list(roots)
-    while pending:
-        name = pending.pop()
-        if name in seen:
-            continue
-        seen.add(name)
-        node = defined[name]
-        local = {a.arg for a in node.args.args} | {n.id for n in ast.walk(node)
-                                                   if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Store)}
-        for n in ast.walk(node):
-            if not (isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)) or n.id in local:
-                continue
-            value = vars(module).get(n.id)
-            if n.id in defined:
-                pending.append(n.id)
-            elif n.id == "math" or (value is None and hasattr(builtins, n.id)):
-                continue
-            elif any(value is vars(shared_module).get(n.id) for shared_module in (integration, elements)):
-                shared.add(n.id)
-            elif isinstance(value, (int, float)) and not isinstance(value, bool):
-                constants[n.id] = value
-            else:
-                raise ModelContractError(f"{module.__name__}.{name} reads {n.id!r} ({type(value).__name__}): a "
-                                         "derived model takes a base's functions, numbers and the shared machinery "
-                                         "only")
-    return [name for name in defined if name in seen], constants, shared
-
-
-class _Rename(ast.NodeTransformer):
-    """Module-level names of the base, read in its functions, renamed ``base_<name>`` (a local of
-    the same name is left alone)."""
-
-    def __init__(self, names: set[str]):
-        self.names = names
-        self.local: set[str] = set()
-
-    def visit_FunctionDef(self, node: ast.FunctionDef):
-        outer = self.local
-        self.local = {a.arg for a in node.args.args} | {n.id for n in ast.walk(node)
-                                                        if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Store)}
-        if node.name in self.names:
-            node.name = f"base_{node.name}"
-        node.body = [self.visit(statement) for statement in node.body]
-        self.local = outer
-        return node
-
-    def visit_Name(self, node: ast.Name):
-        if isinstance(node.ctx, ast.Load) and node.id in self.names and node.id not in self.local:
-            node.id = f"base_{node.id}"
-        return node
-
-
-def base_source(base: BushingModel) -> tuple[str, set[str]]:
-    """The base's kernels and what they reach, renamed ``base_<name>``, as source; and the
-    shared names they import."""
-    module = sys.modules[base.kernel_module]
-    functions, constants, shared = _reached(base, module)
-    tree = ast.parse(inspect.getsource(module))
-    renamer = _Rename(set(functions) | set(constants))
-    lines = [f"base_{name} = {value!r}" for name, value in sorted(constants.items())]
-    for node in tree.body:
-        if isinstance(node, ast.FunctionDef) and node.name in functions:
-            node.decorator_list = []
-            lines.append(ast.unparse(renamer.visit(node)))
-    return "\n\n\n".join(lines), shared
-
-
-def _tuple(names) -> str:
-    names = list(names)
-    return "(" + ", ".join(names) + ("," if len(names) == 1 else "") + ")"
-
-
-def wrapper_source(base: BushingModel, options: Options) -> tuple[str, set[str]]:
-    """The derived model's kernels, delegating to the renamed base's (module docstring); and the
-    shared names they import."""
-    held = set(base.static_spring) if options.knots else set()
-    base_values = [("0.0" if spec.name in held else None) for spec in base.specs]
-    index = 0
-    for i, value in enumerate(base_values):
-        if value is None:
-            base_values[i] = f"p[{index}]"
-            index += 1
-    parts, slots = [f"base_prepare({_tuple(base_values)})"], []
-    if options.knots:
-        k = options.knots
-        parts.append(f"backbone_prepare({_tuple(f'p[{index + i}]' for i in range(2 * k))})")
-        slots.append(("backbone", len(parts) - 1))
-        index += 2 * k
-    if options.limits:
-        parts.append(_tuple(f"p[{index + i}]" for i in range(11)))
-        slots.append(("limits", len(parts) - 1))
-        index += 11
-    if options.rig:
-        parts.append(_tuple(f"p[{index + i}]" for i in range(2)))
-        slots.append(("rig", len(parts) - 1))
-        index += 2
-    slot = dict(slots)
-    zero = f" - m[{slot['rig']}][0]" if options.rig else ""
-    u = "x" + zero
-    has_step = "prepare_step" in vars(sys.modules[base.kernel_module])
-    source = [f"def prepare(p):\n    return {_tuple(parts)}\n"]
-    if has_step:
-        rest = ", ".join(f"m[{i}]" for i in range(1, len(parts)))
-        source.append(f"def prepare_step(m, h):\n    return (base_prepare_step(m[0], h), {rest})\n" if rest else
-                      "def prepare_step(m, h):\n    return (base_prepare_step(m[0], h),)\n")
-    source.append(f"def initial_state(m, x0):\n    return base_initial_state(m[0], x0{zero})\n")
-    source.append("def jump(m, state, jump_mm):\n    return base_jump(m[0], state, jump_mm)\n")
-    source.append(f"def integrate(m, state, x, v, h, max_substeps):\n"
-                  f"    return base_integrate(m[0], state, {u}, v, h, max_substeps)\n")
-    force = [f"    u = {u}", "    f = base_force(m[0], state, u, v)"]
-    if options.knots:
-        force.append(f"    f = f + backbone_force(m[{slot['backbone']}], u)")
-    if options.limits:
-        force.append(f"    f = f + limits_force(m[{slot['limits']}], u, v)")
-    if options.rig:
-        force.append(f"    f = f + m[{slot['rig']}][1]")
-    source.append("def force(m, state, x, v):\n" + "\n".join(force) + "\n    return f\n")
-    source.append(f"def derivatives(m, state, x, v):\n    return base_derivatives(m[0], state, {u}, v)\n")
-    switches = len(base.switch_specs)
-    own = [f"s[{i}]" for i in range(switches)]
-    if options.limits:
-        own += [f"u - m[{slot['limits']}][0]", f"u + m[{slot['limits']}][5]"]
-    body = f"    u = {u}\n"
-    body += f"    s = base_switches(m[0], state, u, v)\n" if switches else ""
-    source.append("def switches(m, state, x, v):\n" + body + f"    return {_tuple(own) if own else '()'}\n")
-    if base.update is not None:
-        source.append(f"def update(m, state, x, v):\n    return base_update(m[0], state, {u}, v)\n")
-    shared = set()
-    if options.knots:
-        source.append(backbone_source(options.knots))
-        shared |= {"pchip_slope", "pchip_end_slope", "hermite"}
-    if options.limits:
-        source.append(LIMITS_SOURCE)
-        shared.add("limit_force")
-    return "\n\n".join(source), shared
-
-
-LIMITS_SOURCE = '''def limits_force(c, u, v):
-    """Both travel limits' force [N] at u [mm], v [mm/s]; c = (gap, k, exponent, damping, depth)
-    of the positive side, then of the negative, then the width."""
-    gp, kp, ep, cp, dp, gn, kn, en, cn, dn, width = c
-    return limit_force(u, v, gp, kp, ep, cp, dp, width) - limit_force(-u, -v, gn, kn, en, cn, dn, width)
-'''
-
-
-def backbone_source(knots: int) -> str:
-    """``backbone_prepare(q)`` (the knots and forces -> the knots, forces and the monotone cubic's
-    slopes) and ``backbone_force(b, u)`` for ``knots`` knots, written out."""
-    k = knots
-    xs = [f"x{i}" for i in range(k)]
-    fs = [f"f{i}" for i in range(k)]
-    ds = [f"d{i}" for i in range(k)]
-    lines = ["def backbone_prepare(q):", f"    {', '.join(xs + fs)} = q"]
-    for i in range(k - 1):
-        lines.append(f"    h{i} = x{i + 1} - x{i}")
-        lines.append(f"    s{i} = (f{i + 1} - f{i}) / h{i}")
-    if k == 2:
-        lines += ["    d0 = s0", "    d1 = s0"]
-    else:
-        lines.append("    d0 = pchip_end_slope(h0, h1, s0, s1)")
-        for i in range(1, k - 1):
-            lines.append(f"    d{i} = pchip_slope(h{i - 1}, h{i}, s{i - 1}, s{i})")
-        lines.append(f"    d{k - 1} = pchip_end_slope(h{k - 2}, h{k - 3}, s{k - 2}, s{k - 3})")
-    lines.append(f"    return {_tuple(xs + fs + ds)}")
-    prepare = "\n".join(lines) + "\n"
-    lines = ["def backbone_force(b, u):", f"    {', '.join(xs + fs + ds)} = b",
-             "    if u <= x0:", "        return f0 + d0 * (u - x0)"]
-    for i in range(k - 1):
-        lines += [f"    if u <= x{i + 1}:",
-                  f"        return hermite(u, x{i}, x{i + 1}, f{i}, f{i + 1}, d{i}, d{i + 1})"]
-    lines.append(f"    return f{k - 1} + d{k - 1} * (u - x{k - 1})")
-    return prepare + "\n\n" + "\n".join(lines) + "\n"
-
-
-def derived_source(base: BushingModel, options: Options) -> str:
-    """The derived model's whole module: its docstring, imports, the renamed base, the wrappers."""
-    body, shared = base_source(base)
-    wrappers, own = wrapper_source(base, options)
-    shared |= own
-    machinery = sorted(name for name in shared if name in vars(integration))
-    element_names = sorted(name for name in shared if name not in vars(integration))
-    imports = "from __future__ import annotations\n\nimport math\n\n"
-    if machinery:
-        imports += f"from ..model.integration import {', '.join(machinery)}\n"
-    if element_names:
-        imports += f"from ..model.elements import {', '.join(element_names)}\n"
-    doc = (f'"""The {base.name} model with {", ".join(options.tokens)}: generated by fmu_src/model/derived.py from '
-           f'{base.kernel_module.rpartition(".")[2]} (its kernels renamed base_*) and the options\' wrappers."""\n')
-    return doc + imports + "\n\n" + body + "\n\n\n" + wrappers
+            + (maxwell_specs() if options.maxwell else ()) + (rig_specs() if options.rig else ()))
 
 
 # ------------------------------------------------------------------------------ the model
@@ -434,12 +239,27 @@ def _search(base: BushingModel, options: Options) -> SearchBox:
                             SearchCoordinate(f"limit_k_{side}", KIND.stiffness, -2.0, 3.0))
         coordinates += (SearchCoordinate("limit_width", KIND.travel, -4.0, -1.0),)
         held = held + LIMIT_HELD
+    if options.maxwell:
+        coordinates += (SearchCoordinate("maxwell_k", KIND.stiffness, -4.0, 1.0),
+                        SearchCoordinate("maxwell_c", KIND.time_constant, -math.inf, 4.0, over=("maxwell_k",)))
     if options.rig:
         coordinates += (SearchCoordinate("rig_displacement_zero", KIND.offset_travel, -0.25, 0.25),
                         SearchCoordinate("rig_force_zero", KIND.offset_force, -0.5, 0.5))
-    return SearchBox(coordinates, unit_weights=unit_weights, zeros=zeros, held=held,
-                     loop_start=base.search.loop_start if base.search is not None and not options.knots else None,
-                     table_start=None)
+    loop = base.search.loop_start if base.search is not None and not options.knots else None
+    if loop is not None:       # the friction alone: the options' neutral values too
+        loop = replace(loop, friction_alone=loop.friction_alone + NEUTRAL[LIMITS] * options.limits
+                       + NEUTRAL[MAXWELL] * options.maxwell + NEUTRAL[RIG] * options.rig)
+    return SearchBox(coordinates, unit_weights=unit_weights, zeros=zeros, held=held, loop_start=loop, table_start=None)
+
+
+NEUTRAL = {
+    LIMITS: (("limit_gap_pos", 1.0), ("limit_gap_neg", 1.0), ("limit_k_pos", 0.0), ("limit_k_neg", 0.0),
+             ("limit_exponent_pos", 2.0), ("limit_exponent_neg", 2.0), ("limit_c_pos", 0.0), ("limit_c_neg", 0.0),
+             ("limit_depth_pos", 1.0), ("limit_depth_neg", 1.0), ("limit_width", 0.0)),
+    MAXWELL: (("maxwell_k", 0.0), ("maxwell_c", 1.0)),
+    RIG: (("rig_displacement_zero", 0.0), ("rig_force_zero", 0.0)),
+}
+"""Each option's values that leave the base's force as it is (a slow loop's friction alone)."""
 
 
 def derive(base: BushingModel, options: Options) -> BushingModel:
@@ -466,10 +286,13 @@ def derive(base: BushingModel, options: Options) -> BushingModel:
         k = len(switch_specs)
         switch_specs += (StateSpec("limit_upper", k, "m", "u - limit_gap_pos: the positive limit's corner"),
                          StateSpec("limit_lower", k + 1, "m", "u + limit_gap_neg: the negative limit's corner"))
-    words = {BACKBONE: "a measured backbone", LIMITS: "travel limits", RIG: "the rig's offsets"}
+    words = {BACKBONE: "a measured backbone", LIMITS: "travel limits", MAXWELL: "a Maxwell element",
+             RIG: "the rig's offsets"}
+    states = base.states + ((StateSpec("maxwell_f", len(base.states), "N", "the parallel Maxwell element's force"),)
+                            if options.maxwell else ())
     title = f"{base.title} with " + ", ".join(words[t.rstrip('0123456789')] for t in options.tokens)
     model = BushingModel(
-        name, derived_identifier(base, options), title, specs, base.states, base.default_file,
+        name, derived_identifier(base, options), title, specs, states, base.default_file,
         g["prepare"], g["initial_state"], g["jump"], g["integrate"], g["force"], g["derivatives"], g["switches"],
         constraints=constraints, switch_specs=switch_specs, update=g.get("update"), search=_search(base, options),
         description=f"{base.description or base.title}; with {', '.join(options.tokens)}",

@@ -165,11 +165,12 @@ def compare_models(models: Sequence[str | BushingModel], tests: Sequence[RigTest
                    scheduler=None, screening: int | None = None, starts: int | None = None, ensemble: bool = True,
                    table: KdynTable | None = None, multiaxis=(), couplings: Sequence[str] = (),
                    training_table: KdynTable | None = None, race: bool = True, every_ensemble: bool = False,
-                   progress: bool = True) -> dict:
+                   progress: bool = True, fixed=None) -> dict:
     """Fit every model on ``tests`` and the ``training_table`` (a data sheet, alone or with the
     tests, as ``fit(kdyn=...)``), assess it on the training data, on the ``validation_files``
     and on the held-out dynamic-stiffness ``table``, write the files (module docstring) and
-    recommend one. ``models``: names or ``BushingModel``s, each resolved once here and passed on.
+    recommend one. ``models``: names or ``BushingModel``s, each resolved once here and passed on;
+    ``fixed``: parameters every model holds (``fit(fixed=...)``).
 
     The models race (:func:`race_models`): each is screened, and only those that can still win
     run the least-squares stages (``race=False``: every model runs them). The ensemble (profiles
@@ -186,7 +187,7 @@ def compare_models(models: Sequence[str | BushingModel], tests: Sequence[RigTest
     out_dir.mkdir(parents=True, exist_ok=True)
     validation = [load_measurement(path) for path in validation_files]
     training_names = {Path(t.measurement.source).name for t in tests}
-    requests = [training_request(tests, bushing, preset, seed, screening, starts, training_table, False)
+    requests = [training_request(tests, bushing, preset, seed, screening, starts, training_table, False, fixed=fixed)
                 for bushing in bushings]
     data = [t.measurement.source for t in tests] + ([training_table.source] if training_table is not None else [])
     # one BLAS thread, as fit() runs its searches
@@ -320,16 +321,18 @@ def format_assessments(assessments: Sequence[Assessment], recommendation: Recomm
     """One row per model: parameters, training against the noise, BIC, held-out errors; a model
     stopped after its screening, its screened misfit and why (``race``)."""
     best_bic = min(a.information_criterion for a in assessments)
-    lines = [f"{'model':17s} {'params':>6s} {'worst NRMSE/floor':>17s} {'floor':>5s} {'chi2/n':>9s} {'dBIC':>9s} "
+    width = max([17] + [len(a.model) for a in assessments] + [len(s.model) for s in stopped])
+    lines = [f"{'model':{width}s} {'params':>6s} {'worst NRMSE/floor':>17s} {'floor':>5s} {'chi2/n':>9s} {'dBIC':>9s} "
              f"{'held-out NRMSE':>14s} {'table err/unc':>13s}"]
     for a in assessments:
         held = f"{a.validation_error:.2%}" if a.validation_error is not None else "-"
         table = f"{a.table_error:.2f}" if a.table_error is not None else "-"
         mark = "  <- recommended" if a.model == recommendation.model else ""
-        lines.append(f"{a.model:17s} {a.free_parameters:6d} {a.training_ratio:17.2f} {'yes' if a.at_floor else 'NO':>5s} "
-                     f"{a.misfit:9.3f} {a.information_criterion - best_bic:9.1f} {held:>14s} {table:>13s}{mark}")
+        lines.append(f"{a.model:{width}s} {a.free_parameters:6d} {a.training_ratio:17.2f} "
+                     f"{'yes' if a.at_floor else 'NO':>5s} {a.misfit:9.3f} {a.information_criterion - best_bic:9.1f} "
+                     f"{held:>14s} {table:>13s}{mark}")
     for s in stopped:
-        lines.append(f"{s.model:17s} {s.free_parameters:6d}  stopped after its screening: {s.reason}")
+        lines.append(f"{s.model:{width}s} {s.free_parameters:6d}  stopped after its screening: {s.reason}")
     lines.append(f"floor: every training test's NRMSE within {FLOOR_FACTOR}x its noise level or, for a sine whose "
                  "device repeats less than that from cycle to cycle, its repeatability (a training table's "
                  f"rms error within {FLOOR_FACTOR}x its uncertainty; the column is the worst of them); dBIC: BIC = chi^2 + "
@@ -342,9 +345,11 @@ def format_assessments(assessments: Sequence[Assessment], recommendation: Recomm
 def format_comparison(errors: dict, models: Sequence[str], files: Sequence[str], training: set[str] = frozenset()) -> str:
     """NRMSE per file (rows) and model (columns), the eq. 10 error in brackets."""
     width = max(len(name) for name in files) + 13
-    lines = [f"{'file':{width}s}" + "".join(f"{model:>22s}" for model in models)]
+    column = max([22] + [len(model) + 1 for model in models])
+    lines = [f"{'file':{width}s}" + "".join(f"{model:>{column}s}" for model in models)]
     for name in files:
-        cells = "".join(f"{errors[name, model][0]:>12.2%} ({errors[name, model][1]:+6.1%})" for model in models)
+        cells = "".join(f"{errors[name, model][0]:>{column - 10}.2%} ({errors[name, model][1]:+6.1%})"
+                        for model in models)
         lines.append(f"{name + (' (training)' if name in training else ''):{width}s}{cells}")
     lines.append("NRMSE = rms(F_pre - F_exp)/rms(F_exp); (eq. 10) = (rms F_exp - rms F_pre)/rms F_exp")
     return "\n".join(lines)

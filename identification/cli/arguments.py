@@ -16,7 +16,7 @@ from pathlib import Path
 
 from fmu_src import __version__
 from fmu_src.kernels import jit
-from fmu_src.model.registry import DEFAULT_MODEL, MODEL_CHOICES, MODEL_NAMES, MODELS
+from fmu_src.model.registry import DEFAULT_MODEL, MODEL_NAMES, MODELS, get_model
 from fmu_src.model.parameter_specs import ParameterError
 from identification.cli import commands
 from identification.forward.dynamic_stiffness import DEFAULT_AMPLITUDES_MM, DEFAULT_FREQUENCIES_HZ
@@ -61,6 +61,14 @@ def fraction(text: str) -> float:
     return value
 
 
+def model_name(text: str) -> str:
+    """A model's name or identifier, with its options where given (``berg+backbone9+rig``)."""
+    try:
+        return get_model(text).name
+    except ParameterError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
 def number_list(text: str) -> list[float]:
     """'0.1,0.5,1' -> [0.1, 0.5, 1.0]."""
     try:
@@ -92,11 +100,15 @@ def build_parser(program: str = "python -m identification") -> argparse.Argument
 def _add_fit(subcommands) -> None:
     """The ``fit`` command's arguments."""
     fit_parser = subcommands.add_parser("fit", help="fit a model's parameters to rig tests, with convergence evidence")
-    fit_parser.add_argument("--model", choices=MODEL_CHOICES, metavar="MODEL",
+    fit_parser.add_argument("--model", type=model_name, metavar="MODEL",
                             help=f"one of {', '.join(MODEL_NAMES)} ({_linear_models()} by linear least squares; "
-                                 f"`compare` recommends one); default: the manifest's, else {DEFAULT_MODEL}, the "
-                                 "paper's")
+                                 f"`compare` recommends one), with options where wanted (berg+backbone9+rig); "
+                                 f"default: the manifest's, else {DEFAULT_MODEL}, the paper's")
     _add_training_arguments(fit_parser)
+    _add_model_option_arguments(fit_parser)
+    fit_parser.add_argument("--rig-offsets-in-fmu", action="store_true",
+                            help="with the rig's offsets (rig): write them into the parameter file as its mounting's "
+                                 "offset and preload (default: only in its provenance, the model without them)")
     fit_parser.add_argument("--coupling", choices=tuple(COUPLED_AXES), metavar="COUPLING",
                             help="how the model runs on the --multiaxis tests (required with them): none (one "
                                  "model per axis), radial (coupled in x, y; z alone) or spherical (x, y, z)")
@@ -138,6 +150,7 @@ def _add_compare(subcommands) -> None:
         "compare", help="fit several models on training tests, weigh them on held-out files and a table, and "
                         "recommend one")
     _add_training_arguments(compare_parser)
+    _add_model_option_arguments(compare_parser)
     _add_search_arguments(compare_parser)
     compare_parser.add_argument("--validate", action="append", type=Path, default=[], metavar="FILE",
                                 help="validation test CSV, held out of the fits; repeatable (default: the training "
@@ -146,7 +159,8 @@ def _add_compare(subcommands) -> None:
                                 help="dynamic-stiffness table held out of the fits (CSV amplitude_mm,frequency_hz,"
                                      "kdyn_N_per_mm,loss_angle_deg[,preload_mm][,weight]): each model predicts it")
     compare_parser.add_argument("--models", default=",".join(MODEL_NAMES),
-                                help=f"comma-separated models (default: {','.join(MODEL_NAMES)})")
+                                help=f"comma-separated models, with options where wanted (default: "
+                                     f"{','.join(MODEL_NAMES)}; --options gives every one the same)")
     compare_parser.add_argument("--coupling", default=None, metavar="LIST",
                                 help="couplings to weigh on the held-out multi-axis files: none and radial (x, y) "
                                      "or spherical (x, y, z), comma-separated (e.g. none,radial)")
@@ -224,7 +238,7 @@ def _add_characterise(subcommands) -> None:
         "characterise", help="dynamic stiffness |K*| and loss angle over amplitudes and frequencies (data sheet)")
     characterise_parser.add_argument("--params", type=Path, required=True,
                                      help="parameter file (.json, .ssv) or ensemble file (then with min/max columns)")
-    characterise_parser.add_argument("--model", choices=MODEL_CHOICES, metavar="MODEL", help="check the file is for this model")
+    characterise_parser.add_argument("--model", type=model_name, metavar="MODEL", help="check the file is for this model")
     characterise_parser.add_argument("--amplitudes-mm", type=number_list, metavar="LIST",
                                      default=",".join(map(str, DEFAULT_AMPLITUDES_MM)),
                                      help="sine amplitudes [mm], comma-separated (default %(default)s)")
@@ -324,6 +338,24 @@ def _add_training_arguments(parser) -> None:
     group.add_argument("--multiaxis", action="append", type=Path, default=[], metavar="FILE",
                        help="multi-axis test (CSV time_s,dx_mm,dy_mm,Fx_N,Fy_N[,dz_mm,Fz_N][,vx_mm_s,...]), alone or "
                             "with the one-axis tests; repeatable")
+
+
+def _add_model_option_arguments(parser) -> None:
+    """``--options``, ``--static``, ``--backbone-knots``, ``--fix`` (``model_options``)."""
+    group = parser.add_argument_group("model options (a measured backbone, travel limits, the rig's offsets)")
+    group.add_argument("--options", metavar="LIST",
+                       help="options every model gets, comma-separated: backbone<K> (a static curve of K knots), "
+                            "limits (a travel limit each side), maxwell (a Maxwell element in parallel), rig (the "
+                            "rig's displacement and load-cell zeros, fitted and kept out of the FMU)")
+    group.add_argument("--backbone-knots", type=number_list, metavar="LIST",
+                       help="the backbone's knot positions [mm], increasing (held; their forces are fitted, or read "
+                            "off --static)")
+    group.add_argument("--static", type=str, metavar="FILE",
+                       help="a quasi-static test (a slow triangle or ramp): the backbone read off it (the mean of its "
+                            "loading and unloading branches) at --backbone-knots or 9 knots, and held; a training "
+                            "test too")
+    group.add_argument("--fix", action="append", default=[], metavar="NAME=VALUE",
+                       help="hold a parameter at a value (the model's units); repeatable")
 
 
 def _add_search_arguments(parser) -> None:

@@ -16,7 +16,9 @@ from pathlib import Path
 
 import numpy as np
 
-from fmu_src.model.registry import DEFAULT_MODEL, MODEL_CHOICES, MODEL_NAMES, get_model
+from fmu_src.model.parameter_specs import ParameterError
+from fmu_src.model.registry import DEFAULT_MODEL, MODEL_NAMES, get_model
+from identification.cli.model_options import model_options_of
 from fmu_src.parameter_files import read_parameter_set
 from identification.errors import FitNotConvergedWarning, UsageError
 from identification.measured.measurements import load_measurement, measurement_name
@@ -116,10 +118,17 @@ def fit_command(args) -> int:
         raise UsageError(f"--ensemble {args.ensemble} needs the ensemble that --no-ensemble skips: give one of them")
     tests, manifest_model = training_tests_of(args)
     model = args.model or manifest_model or DEFAULT_MODEL
-    if model not in MODEL_CHOICES:
-        raise UsageError(f"the manifest's model {model!r} is not one of {', '.join(MODEL_NAMES)}")
-    bushing = get_model(model)             # resolved once; an alias (bouc_wen) under its name
+    try:
+        get_model(model)
+    except ParameterError:
+        raise UsageError(f"the manifest's model {model!r} is not one of {', '.join(MODEL_NAMES)}") from None
+    options = model_options_of(args)
+    bushing = options.model(model)          # resolved once; an alias (bouc_wen) under its name
     model = bushing.name
+    tests = options.training(tests)
+    fixed = options.fixed_for(bushing)
+    if options.curve is not None:
+        print(options.describe(), file=sys.stderr)
     table = None
     if args.kdyn is not None:
         from identification.measured.kdyn_table import load_kdyn_table
@@ -135,7 +144,7 @@ def fit_command(args) -> int:
         result = fit(tests, model=bushing, preset=args.preset, seed=args.seed, workers=args.workers,
                      scheduler=args.scheduler, progress=not args.quiet, screening=args.screening,
                      starts=args.starts, kdyn=table, ensemble=not args.no_ensemble, multiaxis=multiaxis,
-                     coupling=args.coupling)
+                     coupling=args.coupling, fixed=fixed)
     written = _save_or_rescue(result, args, [t.measurement.source for t in tests] + [m.source for m in multiaxis]
                               + ([str(args.kdyn)] if args.kdyn else []))
     print(result.summary())
@@ -178,7 +187,7 @@ def _save_or_rescue(result, args, data) -> list[Path]:
     finished fit is never lost."""
     import time
     try:
-        return result.save(args.out, args.ssv, args.ensemble, data=data)
+        return result.save(args.out, args.ssv, args.ensemble, data=data, rig_into_fmu=args.rig_offsets_in_fmu)
     except OSError as exc:
         stamp = time.strftime("%Y%m%d-%H%M%S")
         for folder in (Path.cwd(), Path(tempfile.gettempdir())):
@@ -186,7 +195,8 @@ def _save_or_rescue(result, args, data) -> list[Path]:
                       "ssv": folder / f"rescued_fit_{stamp}.ssv" if args.ssv else None,
                       "ensemble": folder / f"rescued_fit_{stamp}_ensemble.json" if args.ensemble else None}
             try:
-                written = result.save(rescue["out"], rescue["ssv"], rescue["ensemble"], data=data)
+                written = result.save(rescue["out"], rescue["ssv"], rescue["ensemble"], data=data,
+                                      rig_into_fmu=args.rig_offsets_in_fmu)
             except OSError:
                 continue
             print_warning(f"could not write the fit's files ({exc}); wrote them instead to "
@@ -390,11 +400,24 @@ def compare_command(args) -> int:
                          "on is not held out; give another table to --validate-kdyn, or leave it out")
     training_table = load_kdyn_table(args.kdyn) if args.kdyn is not None else None
     tests, _ = training_tests_of(args)
+    options = model_options_of(args)
+    tests = options.training(tests)
     models = [name.strip() for name in args.models.split(",") if name.strip()]
-    unknown = [name for name in models if name not in MODEL_CHOICES]
+    unknown = []
+    for name in models:
+        try:
+            get_model(name)
+        except ParameterError:
+            unknown.append(name)
     if unknown:
-        raise UsageError(f"unknown models {unknown}; choose from {', '.join(MODEL_NAMES)}")
-    models = [get_model(name) for name in models]          # resolved once, passed on
+        raise UsageError(f"unknown models {unknown}; choose from {', '.join(MODEL_NAMES)}, with options where wanted "
+                         "(berg+limits)")
+    models = [options.model(name) for name in models]          # resolved once, passed on
+    fixed = {}
+    for bushing in models:
+        fixed = options.fixed_for(bushing)
+    if options.curve is not None:
+        print(options.describe(), file=sys.stderr)
     couplings = couplings_of(args.coupling, args.validate_multiaxis)
     from identification.measured.multiaxis import load_multiaxis
     multiaxis = [load_multiaxis(path) for path in args.validate_multiaxis]    # a bad file: refused before any fit
@@ -410,7 +433,7 @@ def compare_command(args) -> int:
                    scheduler=args.scheduler, screening=args.screening, starts=args.starts,
                    ensemble=not args.no_ensemble, table=table, multiaxis=multiaxis, couplings=couplings,
                    training_table=training_table, race=not args.no_race, every_ensemble=args.every_ensemble,
-                   progress=not args.quiet)
+                   progress=not args.quiet, fixed=fixed)
     return 0
 
 

@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING, Sequence
 
 import numpy as np
 
+from fmu_src.model.derived import derive
 from fmu_src.parameter_files import ParameterSet, save_ensemble, save_parameters
 from identification.errors import FitNotConvergedWarning, IdentificationError  # noqa: F401  (also imported from here)
 from identification.interrupt import deferred, writing
@@ -34,6 +35,10 @@ if TYPE_CHECKING:
     from identification.fitting.ensemble import Identifiability, SamplerReport
     from identification.fitting.multistart import StartRecord
     from identification.fitting.search_space import SearchSpace
+
+RIG_PARAMETERS = (("rig_displacement_zero", "offset", "mm"), ("rig_force_zero", "preload", "N"))
+"""The rig's offsets (``fmu_src.model.derived``'s ``rig`` option), what an FMU's mounting calls
+them where asked to take them, and their units."""
 
 FLOOR_FACTOR = 1.25
 """A test is at its floor when the fit's NRMSE on it is at most this times its floor (the larger
@@ -293,6 +298,9 @@ class FitResult:
                "tests": [t.as_dict() for t in self.tests] + ([self.table.as_dict()] if self.table else [])}
         if self.coupling is not None:
             out["multiaxis_coupling"] = self.coupling
+        if self.rig_offsets:
+            out["rig_offsets"] = {name: {"value": round_for_file(value), "uncertainty_95": round_for_file(spread),
+                                         "unit": unit} for name, (value, spread, unit) in self.rig_offsets.items()}
         if self.space is not None:
             out.update({"starts_agreeing": self.agreeing, "final_starts": self.final_starts,
                         "starts_added_for_agreement": self.added_starts,
@@ -352,6 +360,10 @@ class FitResult:
             if self.failed_starts:
                 lines.append(f"failed starts: {self.failed_starts} (their residuals or Jacobian were not finite: "
                              "skipped, each kept at its last finite point)")
+        if self.rig_offsets:
+            lines.append("rig offsets (nuisance parameters, kept out of the parameter file's model unless asked): "
+                         + ", ".join(f"{name.replace('rig_', '').replace('_', ' ')} {value:.4g} +- {spread:.2g} {unit}"
+                                     for name, (value, spread, unit) in self.rig_offsets.items()))
         if self.coupling is not None:
             lines.append(f"multi-axis tests: the model runs with the {self.coupling} coupling on them "
                          "(NRMSE of the force vector; noise: the rms of its axes')")
@@ -366,8 +378,45 @@ class FitResult:
         lines.append("converged: yes" if self.converged else f"converged: no ({self.warning})")
         return "\n".join(lines)
 
+    @property
+    def rig_offsets(self) -> dict[str, tuple[float, float, str]]:
+        """{rig parameter: (the fit's value, the ensemble's largest distance from it: the 95 %
+        region's half width, or nan where the ensemble was not sampled, unit)} of a model with the
+        ``rig`` option; empty otherwise."""
+        options = self.parameters.model.options
+        if options is None or not options.rig:
+            return {}
+        out = {}
+        for name, _, unit in RIG_PARAMETERS:
+            value = float(self.parameters.parameters[name])
+            members = [float(member[name]) for member in self.ensemble[1:]]
+            spread = max((abs(m - value) for m in members), default=math.nan) if self.ensemble_sampled else math.nan
+            out[name] = (value, spread, unit)
+        return out
+
+    def for_fmu(self, members, into_fmu: bool = False) -> tuple[object, list[dict[str, float]]]:
+        """(the model an FMU gets, ``members`` as its parameter sets): a model fitted with the rig's
+        offsets without them (they are the test rig's, not the bushing's), or with them as its
+        mounting's ``offset`` and ``preload`` where ``into_fmu``; any other model as it is."""
+        model = self.parameters.model
+        if not self.rig_offsets:
+            return model, [dict(member) for member in members]
+        bushing = derive(model.base, model.options.without_rig())
+        mounting = {spec.name for spec in bushing.mounting_specs}
+        sets = []
+        for member in members:
+            out = {name: value for name, value in member.items() if not name.startswith("rig_")}
+            if into_fmu:
+                for name, port, _ in RIG_PARAMETERS:
+                    if port in mounting:
+                        out[port] = member[name]
+                    else:      # the model's own parameter of that name (Kelvin-Voigt's preload): the same force
+                        out[port] = out[port] + member[name]
+            sets.append(out)
+        return bushing, sets
+
     def save(self, path: str | Path, ssv: str | Path | None = None, ensemble: str | Path | None = None,
-             data: Sequence[str] = ()) -> list[Path]:
+             data: Sequence[str] = (), rig_into_fmu: bool = False) -> list[Path]:
         """Write the fit's files: what ``build_fmu.py --params`` and ``predict`` read.
 
         Parameters
@@ -382,6 +431,9 @@ class FitResult:
             ``ensemble=False``.
         data : sequence of str
             The training files, recorded in the provenance.
+        rig_into_fmu : bool
+            A model fitted with the rig's offsets (``+rig``): write them as its mounting's ``offset``
+            and ``preload`` (default: only in the provenance, ``rig_offsets``, the model without them).
 
         Returns
         -------
@@ -400,16 +452,19 @@ class FitResult:
             raise IdentificationError(f"no ensemble to write to {ensemble}: this fit ran with ensemble=False "
                                       "(--no-ensemble); fit again without it for the ensemble")
         provenance = dict(self.provenance(), data=[str(d) for d in data])
+        if self.rig_offsets:
+            provenance["rig_offsets_in_fmu"] = bool(rig_into_fmu)
+        model, (best, *_) = self.for_fmu([self.parameters.parameters], rig_into_fmu)
         # each file whole or not at all, and a Ctrl-C or SIGTERM held until the set is written
         with deferred():
             with writing(path) as temporary:
-                save_parameters(temporary, self.parameters.parameters, self.model, provenance)
+                save_parameters(temporary, best, model.name, provenance)
             if ssv is not None:
                 with writing(ssv) as temporary:
-                    save_parameters(temporary, self.parameters.parameters, self.model)
+                    save_parameters(temporary, best, model.name)
             if ensemble is not None:
                 with writing(ensemble) as temporary:
-                    save_ensemble(temporary, self.ensemble, self.model, provenance)
+                    save_ensemble(temporary, self.for_fmu(self.ensemble, rig_into_fmu)[1], model.name, provenance)
         return [Path(file) for file in (path, ssv, ensemble) if file is not None]
 
 

@@ -6,6 +6,7 @@
   can be run with, the force-vector error);
 - ``kdyn_table``: the dynamic-stiffness and loss-angle table a supplier gives (its CSV file);
 - ``noise``: each test's force-noise level, from the data alone;
+- ``static_curve``: a quasi-static test's backbone (the mean of its loading and unloading branches);
 - ``repeatability``: what a sine test's device repeats from cycle to cycle (the floor beside the noise);
 - ``signals``: the paper's test signals (sine, step, random) as sampled displacement and velocity.
 

@@ -128,7 +128,8 @@ class ModelCode:
                 f"static void bw_{name}_{kernel}(const void *c, const double *s, double x, double v, double *{out}) {{\n"
                 f"    {self.translation.c_type(k[kernel].return_type)} r = {k[kernel].name}({constants}, "
                 f"{self.state_literal('s')}, x, v);\n"
-                + ("".join(f"    {out}[{i}] = r.f{i};\n" for i in range(count)) or
+                + ("".join(f"    {out}[{i}] = r.f{i};\n" for i in range(count))
+                   + ("    (void)s;\n" if not states else "") if count else
                    f"    (void)r;\n    (void){out};\n" + ("    (void)s;\n" if not states else "")) + "}\n")
         lines.append(self.tangent_wrappers())
         if self.coupled is not None:

@@ -1,0 +1,113 @@
+"""The command line's model options: ``--options``, ``--static``, ``--backbone-knots``, ``--fix``.
+
+They turn a model's name into the model a fit or ``compare`` runs (``fmu_src.model.derived``: the
+model with a backbone, travel limits or the rig's offsets) and the parameters it holds:
+
+- ``--options backbone9,limits,maxwell,rig``: the options every model gets (``fit --model berg+limits``
+  names them too);
+- ``--backbone-knots -4,-2,0,2,4`` [mm]: the backbone's knots, held (its forces fitted), which
+  gives the models a backbone of that many knots;
+- ``--static FILE``: a quasi-static test (a slow triangle or ramp); the backbone's forces are read
+  off it (``identification.measured.static_curve``) at ``--backbone-knots``, or at as many knots as
+  ``--options backbone<K>`` says (9 without) over its range, and held; it is a training test too. With the rig's offsets the backbone passes through
+  0 at its knot at 0 mm, the load-cell zero carries the force there, and the displacement zero is
+  the static test's (held at 0);
+- ``--fix NAME=VALUE``: a parameter held at a value (the model's units), repeatable.
+
+Every problem is a ``UsageError`` naming the argument and what is allowed.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+from fmu_src.model.derived import Options, derive
+from fmu_src.model.parameter_specs import ParameterError
+from fmu_src.model.registry import get_model
+from identification.errors import UsageError
+from identification.measured.measurements import load_measurement
+from identification.measured.rig_tests import RigTest
+from identification.measured.static_curve import DEFAULT_KNOTS, StaticCurve, read_static_curve
+
+
+@dataclass(frozen=True)
+class ModelOptions:
+    """What the model options ask for: the options every model gets, the parameters held, the
+    static curve read (or None) and the training test it adds (or None)."""
+    options: Options
+    fixed: dict
+    curve: StaticCurve | None = None
+    static_test: RigTest | None = None
+
+    def model(self, name):
+        """The model ``name`` (a name, an identifier, a model) with these options added."""
+        bushing = get_model(name)
+        base = bushing.base if bushing.base is not None else bushing
+        present = bushing.options or Options()
+        knots = self.options.knots or present.knots
+        if self.options.knots and present.knots and self.options.knots != present.knots:
+            raise UsageError(f"{bushing.name} has a backbone of {present.knots} knots, the options one of "
+                             f"{self.options.knots}: give one")
+        merged = Options(knots, present.limits or self.options.limits, present.rig or self.options.rig,
+                         present.maxwell or self.options.maxwell)
+        return derive(base, merged)
+
+    def fixed_for(self, bushing) -> dict[str, float]:
+        """The held parameters ``bushing`` has (a --fix the model does not have is refused)."""
+        unknown = sorted(set(self.fixed) - set(bushing.parameter_names))
+        if unknown:
+            raise UsageError(f"--fix {', '.join(unknown)}: not parameters of the {bushing.name} model; its parameters: "
+                             f"{', '.join(bushing.parameter_names)}")
+        return dict(self.fixed)
+
+    def training(self, tests: list) -> list:
+        """The training tests with the quasi-static test added (where it is not among them)."""
+        if self.static_test is None:
+            return list(tests)
+        names = {t.name for t in tests}
+        return list(tests) + ([self.static_test] if self.static_test.name not in names else [])
+
+    def describe(self) -> str:
+        return self.curve.describe() if self.curve is not None else ""
+
+
+def model_options_of(args) -> ModelOptions:
+    """The model options of the parsed ``args`` (module docstring)."""
+    try:
+        options = Options.parse(part for part in (args.options or "").split(",") if part.strip())
+    except ParameterError as exc:
+        raise UsageError(f"--options {args.options}: {exc}") from None
+    fixed = fixed_values(args.fix)
+    knots = args.backbone_knots
+    curve = static_test = None
+    if args.static is not None:
+        measurement = load_measurement(args.static)
+        curve = read_static_curve(measurement, knots, len(knots) if knots is not None else options.knots or DEFAULT_KNOTS)
+        knots = list(curve.knots_mm)
+        static_test = RigTest(measurement)
+    if knots is not None:
+        if len(knots) < 2 or any(b <= a for a, b in zip(knots, knots[1:])):
+            raise UsageError(f"--backbone-knots {','.join(f'{k:g}' for k in knots)}: give 2 or more knot positions "
+                             "[mm], increasing")
+        if options.knots and options.knots != len(knots):
+            raise UsageError(f"--options backbone{options.knots} and {len(knots)} backbone knots: give one count")
+        options = replace(options, knots=len(knots))
+        fixed.update({f"backbone_x{i + 1}": float(k) for i, k in enumerate(knots)})
+    if curve is not None:
+        forces = curve.parameters(pinned_at_zero=options.rig)
+        fixed.update({name: value for name, value in forces.items() if name.startswith("backbone_F")})
+        if options.rig:     # the static test's displacement is the backbone's: its zero is the model's
+            fixed.setdefault("rig_displacement_zero", 0.0)
+    return ModelOptions(options, fixed, curve, static_test)
+
+
+def fixed_values(texts) -> dict[str, float]:
+    """{name: value} of repeated ``--fix NAME=VALUE``."""
+    out = {}
+    for text in texts or ():
+        name, _, value = text.partition("=")
+        try:
+            out[name.strip()] = float(value)
+        except ValueError:
+            raise UsageError(f"--fix {text}: give NAME=VALUE with a number in the parameter's unit, e.g. "
+                             "--fix limit_exponent_pos=2") from None
+    return out
