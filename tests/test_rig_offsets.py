@@ -21,24 +21,27 @@ ZERO_MM, LOAD_CELL_N = 0.25, 35.0
 
 
 @pytest.fixture(scope="module")
-def fitted():
+def fitted(request):
+    """The fit (under the optimizer tests' rounding variant: a module's fixture applies it itself)."""
     from identification.fitting.fit import fit
-    truth = read_parameter_set(DATA / "params_berg_filled_rubber.json").parameters
-    tests = []
-    for amplitude, frequency, seed in ((2.0, 10.0, 1), (1.0, 3.0, 2)):
-        t = sample_times(0.6, 1000.0)
-        x, v = Sine(amplitude, frequency).signals(t)
-        # the bushing sits at its own zero where the rig reads 0.25 mm; the load cell reads 35 N at no force
-        force = simulate_python_core(truth, t, x - ZERO_MM, v, model="berg") + LOAD_CELL_N
-        force = force + np.random.default_rng(seed).normal(0.0, 3.0, t.size)
-        tests.append(RigTest(Measurement(t, x, force, v, source=f"sine_{amplitude}mm.csv"), kind="sine"))
+    from suite_options import rounding_variant
     import warnings
     from identification.errors import FitNotConvergedWarning
-    with warnings.catch_warnings():
+    truth = read_parameter_set(DATA / "params_berg_filled_rubber.json").parameters
+    with warnings.catch_warnings(), rounding_variant(request.config):
         warnings.simplefilter("ignore", FitNotConvergedWarning)     # 1.5x its noise: the budget is small
+        tests = []
+        for amplitude, frequency, seed in ((2.0, 10.0, 1), (1.0, 3.0, 2)):
+            t = sample_times(0.6, 1000.0)
+            x, v = Sine(amplitude, frequency).signals(t)
+            # the bushing sits at its own zero where the rig reads 0.25 mm; the load cell reads 35 N at no force
+            force = simulate_python_core(truth, t, x - ZERO_MM, v, model="berg") + LOAD_CELL_N
+            force = force + np.random.default_rng(seed).normal(0.0, 3.0, t.size)
+            tests.append(RigTest(Measurement(t, x, force, v, source=f"sine_{amplitude}mm.csv"), kind="sine"))
         return fit(tests, model="berg+rig", screening=1024, starts=32, workers=1, progress=False), truth
 
 
+@pytest.mark.optimizer
 def test_the_fit_recovers_the_rigs_offsets_within_their_uncertainty(fitted):
     result, _ = fitted
     offsets = result.rig_offsets

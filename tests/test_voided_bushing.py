@@ -42,6 +42,7 @@ def test_the_static_curve_read_off_the_triangle_is_the_truths():
 
 
 @pytest.mark.slow
+@pytest.mark.optimizer
 def test_compare_recommends_a_model_that_predicts_the_held_out_tests_within_two_percent(tmp_path):
     from fmu_src.model.derived import Options
     from identification.analysis.compare import compare_models

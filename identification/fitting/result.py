@@ -362,7 +362,8 @@ class FitResult:
                              "skipped, each kept at its last finite point)")
         if self.rig_offsets:
             lines.append("rig offsets (nuisance parameters, kept out of the parameter file's model unless asked): "
-                         + ", ".join(f"{name.replace('rig_', '').replace('_', ' ')} {value:.4g} +- {spread:.2g} {unit}"
+                         + ", ".join(f"{name.replace('rig_', '').replace('_', ' ')} {value:.4g} {unit}"
+                                     + (f" +- {spread:.2g}" if math.isfinite(spread) else " (no ensemble: no band)")
                                      for name, (value, spread, unit) in self.rig_offsets.items()))
         if self.coupling is not None:
             lines.append(f"multi-axis tests: the model runs with the {self.coupling} coupling on them "
@@ -382,12 +383,15 @@ class FitResult:
     def rig_offsets(self) -> dict[str, tuple[float, float, str]]:
         """{rig parameter: (the fit's value, the ensemble's largest distance from it: the 95 %
         region's half width, or nan where the ensemble was not sampled, unit)} of a model with the
-        ``rig`` option; empty otherwise."""
+        ``rig`` option, but those the fit held; empty otherwise."""
         options = self.parameters.model.options
         if options is None or not options.rig:
             return {}
+        held = {name for name, _ in self.space.fixed} if self.space is not None else set()
         out = {}
         for name, _, unit in RIG_PARAMETERS:
+            if name in held:        # held (fixed=...): not a result of the fit
+                continue
             value = float(self.parameters.parameters[name])
             members = [float(member[name]) for member in self.ensemble[1:]]
             spread = max((abs(m - value) for m in members), default=math.nan) if self.ensemble_sampled else math.nan
@@ -399,7 +403,7 @@ class FitResult:
         offsets without them (they are the test rig's, not the bushing's), or with them as its
         mounting's ``offset`` and ``preload`` where ``into_fmu``; any other model as it is."""
         model = self.parameters.model
-        if not self.rig_offsets:
+        if model.options is None or not model.options.rig:
             return model, [dict(member) for member in members]
         bushing = derive(model.base, model.options.without_rig())
         mounting = {spec.name for spec in bushing.mounting_specs}
@@ -452,7 +456,7 @@ class FitResult:
             raise IdentificationError(f"no ensemble to write to {ensemble}: this fit ran with ensemble=False "
                                       "(--no-ensemble); fit again without it for the ensemble")
         provenance = dict(self.provenance(), data=[str(d) for d in data])
-        if self.rig_offsets:
+        if self.parameters.model.options is not None and self.parameters.model.options.rig:
             provenance["rig_offsets_in_fmu"] = bool(rig_into_fmu)
         model, (best, *_) = self.for_fmu([self.parameters.parameters], rig_into_fmu)
         # each file whole or not at all, and a Ctrl-C or SIGTERM held until the set is written
