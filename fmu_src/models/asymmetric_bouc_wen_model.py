@@ -198,7 +198,7 @@ MODEL = BushingModel(
                   StateSpec("z", 1, "N", "the element's force"),
                   StateSpec("play_upper", 2, "m", "e - gap: the play's upper corner"),
                   StateSpec("play_lower", 3, "m", "e + gap: the play's lower corner")),
-    search=SEARCH, plot_style=("C5", "-."), rank=25,
+    search=SEARCH, plot_style=("C8", "-"), rank=25,
     description="A Bouc-Wen element whose yield differs by direction, with free play and breakaway, in "
                 "parallel with a spring and a dashpot (inputs x [m], v [m/s]; output F [N]).",
     static_spring=("k0",))
