@@ -172,7 +172,7 @@ def test_the_rig_offsets_shift_the_base_models_input_and_output(base):
     (dict(limit_gap_pos=-1.0), r"limit_gap_pos = -1.0 \[mm\] must be >= 0"),
     (dict(limit_exponent_neg=0.5), r"limit_exponent_neg = 0.5 \[1\] must be >= 1"),
     (dict(limit_width=-0.1), r"limit_width = -0.1 \[mm\] must be >= 0"),
-    (dict(limit_k_pos=-5.0), r"limit_k_pos = -5.0 \[N/mm\] must be >= 0"),
+    (dict(limit_k_pos=-5.0), r"limit_k_pos = -5.0 \[N/mm\^e\] must be >= 0"),
 ])
 def test_bad_backbones_and_limits_are_refused_with_value_unit_and_range(bad, message):
     model = get_model("kelvin_voigt+backbone4+limits")

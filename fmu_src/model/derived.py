@@ -154,8 +154,8 @@ def limit_specs() -> tuple[ParameterSpec, ...]:
         out += [
             ParameterSpec(f"limit_gap_{side}", "mm", f"the {word} travel limit's gap: free travel before it engages",
                           minimum=0.0, why="a gap is a magnitude"),
-            ParameterSpec(f"limit_k_{side}", "N/mm", f"the {word} limit's stiffness: force k*d^e at penetration d "
-                          "[mm] (N/mm^e)", minimum=0.0, why="a negative stiffness is unstable", bound_powers=None),
+            ParameterSpec(f"limit_k_{side}", "N/mm^e", f"the {word} limit's stiffness: force k*d^e at penetration d "
+                          "[mm], e its exponent", minimum=0.0, why="a negative stiffness is unstable", bound_powers=None),
             ParameterSpec(f"limit_exponent_{side}", "1", f"the {word} limit's exponent e (1: linear, 2: a "
                           "progressive bump stop)", minimum=1.0, why="below 1 its stiffness is infinite at contact"),
             ParameterSpec(f"limit_c_{side}", "N.s/mm", f"the {word} limit's damping, fully in at the depth",
