@@ -465,6 +465,26 @@ def test_a_builtin_given_as_a_kernel_is_refused_with_a_translation_error():
         Translation().function(round, (DOUBLE,))
 
 
+def equality_tests(a, n):
+    while n != 0:
+        n -= 1
+    if a == 0.0:
+        return 1.0
+    if a < 1.0 and n == 0:
+        return 2.0
+    return 3.0
+
+
+def test_an_if_or_while_on_one_comparison_has_one_pair_of_parentheses():
+    # clang refuses `if ((a == b))` under -Werror (-Wparentheses-equality): the test's own pair only
+    translation = Translation(prefix="bw")
+    translation.function(equality_tests, (DOUBLE, INT))
+    source = translation.source()
+    assert "while (n != 0) {" in source and "if (a == 0.0) {" in source
+    assert "if (((a < 1.0) && (n == 0))) {" in source      # a compound test keeps its grouping
+    assert "((n != 0))" not in source and "((a == 0.0))" not in source
+
+
 @pytest.mark.parametrize("name", list(MODELS))
 def test_every_registered_models_kernels_translate(name):
     code = ModelCode(Translation(prefix="bw"), MODELS[name])

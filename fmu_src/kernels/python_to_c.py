@@ -513,7 +513,7 @@ class _Function(kernel_language.KernelFunction):
         if isinstance(s, ast.Return):
             return [f"{pad}return {self.converted(s.value, self.return_type)};"]
         if isinstance(s, ast.If):
-            lines = [f"{pad}if ({self.expression(s.test)}) {{", *self.emit_block(s.body, depth + 1)]
+            lines = [f"{pad}if ({self.condition(s.test)}) {{", *self.emit_block(s.body, depth + 1)]
             if s.orelse:
                 lines += [f"{pad}}} else {{", *self.emit_block(s.orelse, depth + 1)]
             return lines + [f"{pad}}}"]
@@ -523,7 +523,7 @@ class _Function(kernel_language.KernelFunction):
             self.loops.append(None)
             body = self.emit_block(s.body, depth + 1)
             self.loops.pop()
-            return [f"{pad}while ({self.expression(s.test)}) {{", *body, f"{pad}}}"]
+            return [f"{pad}while ({self.condition(s.test)}) {{", *body, f"{pad}}}"]
         if isinstance(s, ast.For):
             start, stop = (self.expression(a) for a in self.range_arguments(s))
             flag = self.temporary() if s.orelse else None      # set by a break: the else is skipped
@@ -643,6 +643,15 @@ class _Function(kernel_language.KernelFunction):
         if isinstance(e, ast.Call):
             return self.call(e)
         raise self.error(e, f"expression {type(e).__name__}")
+
+    def condition(self, test) -> str:
+        """The C of an if/while test: a single comparison without the parentheses the expression
+        gives it, since clang warns of ``if ((a == b))`` as a possible mistyped assignment
+        (-Wparentheses-equality, an error under -Werror)."""
+        code = self.expression(test)
+        if isinstance(test, ast.Compare) and len(test.ops) == 1:
+            return code[1:-1]
+        return code
 
     def as_double(self, e, code: str) -> str:
         return f"(double){code}" if self.type_of(e) == INT else code

@@ -9,8 +9,11 @@ Layout of the FMU::
     binaries/linux64/<id>.so, binaries/win64/<id>.dll        (FMI 3: x86_64-linux, x86_64-windows)
     sources/<id>.c            the one translation unit: includes the files below
     sources/bushing_fmu.h, bushing_model.c (generated), bushing_instance.c, fmi2_functions.c
-            (or fmi3_functions.c), and the FMI headers (from fmpy's c-code)
+            (or fmi3_functions.c), and the FMI headers
     sources/buildDescription.xml                                (FMI 3)
+
+The FMI 2 headers are fmpy's copy; the FMI 3 ones are the standard's 3.0.1 headers, kept in ``c/``
+(fmpy's are 3.0's, whose two callbacks without prototypes clang refuses under -Werror).
 """
 from __future__ import annotations
 
@@ -55,8 +58,10 @@ class NativeBuild:
     skipped: dict[str, str] = field(default_factory=dict)    # platform -> why it was not built
 
 
-def fmi_header_directory() -> Path:
-    """fmpy's copy of the FMI 2 and 3 headers."""
+def fmi_header_directory(fmi_version: int = 2) -> Path:
+    """Where the FMI ``fmi_version`` headers are: fmpy's copy for FMI 2, ``c/`` for FMI 3."""
+    if fmi_version == 3:
+        return C_LAYER
     import fmpy
     folder = Path(fmpy.__file__).resolve().parent / "c-code"
     if not (folder / "fmi2Functions.h").is_file():
@@ -72,7 +77,7 @@ def write_sources(folder: Path, axis_models, identifier: str, fmi_version: int, 
     functions = f"fmi{fmi_version}_functions.c"
     for name in (*HAND_WRITTEN, functions):
         shutil.copy2(C_LAYER / name, folder / name)
-    headers = fmi_header_directory()
+    headers = fmi_header_directory(fmi_version)
     for name in FMI_HEADERS[fmi_version]:
         shutil.copy2(headers / name, folder / name)
     (folder / f"{identifier}.c").write_text(
