@@ -1,8 +1,9 @@
 """Build a bushing FMU: ``python build_fmu.py [--model NAME] [--params FILE] [--out DIR] [--native
-[--fmi-version 2|3]]``; or the release bundle: ``python build_fmu.py --release [--out DIR]
-[--allow-missing-platforms]`` (:func:`build_release`: every model's native FMU, FMI 2 and 3, linux64 and
-win64, with its default set; the sets as ``.ssv``, README.txt, SHA256SUMS), which a user without a
-compiler applies a parameter set to as start values.
+[--fmi-version 2|3] [--platforms all|P,Q]]``; or the release bundle: ``python build_fmu.py --release
+[--out DIR] [--allow-missing-platforms]`` (:func:`build_release`: every model's native FMU, FMI 2 and
+3, for Linux (x86_64, aarch64), Windows (x86_64) and macOS (x86_64, arm64), with its default set;
+the sets as ``.ssv``, README.txt, SHA256SUMS), which a user without a compiler applies a parameter
+set to as start values.
 
 Writes ``DIR/<identifier>.fmu`` (FMI 2.0 co-simulation, pythonfmu; with ``--native``: compiled C,
 FMI 2.0 or 3.0, co-simulation and model exchange, see ``fmu_src/fmi/native``) of the model NAME
@@ -154,8 +155,9 @@ def build_native_fmu(params_file: str | Path | None = None, out_dir: str | Path 
     fmi_version : int
         2 or 3.
     platforms : tuple of str, optional
-        Binaries to build (default: ``linux64``, and ``win64`` where mingw-w64 is installed);
-        the C sources are always included.
+        Binaries to build, names of ``fmu_src/fmi/native/platforms.py`` (default: ``linux64``, and
+        ``win64`` where mingw-w64 is installed; FMI 3: ``x86_64-linux``, ``x86_64-windows``); the
+        C sources are always included.
 
     Returns
     -------
@@ -330,8 +332,8 @@ def _missing_text(missing: dict[int, dict[str, str]]) -> str:
 def build_release(out_dir: str | Path = RELEASE_DIR, allow_missing_platforms: bool = False,
                   models: tuple[str, ...] | None = None,
                   fmi_versions: tuple[int, ...] = RELEASE_FMI_VERSIONS) -> ReleaseBundle:
-    """Build the release bundle: the native FMU of every model (FMI 2 and 3, linux64 and win64
-    binaries and the C sources in each, the model's default parameter set as start values), the
+    """Build the release bundle: the native FMU of every model (FMI 2 and 3, the binaries of every
+    platform of ``fmu_src/fmi/native/platforms.py`` and the C sources in each, the model's default parameter set as start values), the
     default sets as SSP 1.0 ``.ssv``, ``README.txt`` and ``SHA256SUMS`` (``sha256sum -c``).
 
     The FMUs' parameters are start values, so one binary per model serves every parameter set:
@@ -361,11 +363,11 @@ def build_release(out_dir: str | Path = RELEASE_DIR, allow_missing_platforms: bo
         A platform's compiler is missing (and not ``allow_missing_platforms``), or no platform
         can be built at all; an FMU fails fmpy's validation.
     """
-    from fmu_src.fmi.native.build import NO_COMPILER, missing_platforms, platform_compilers
+    from fmu_src.fmi.native.build import NO_COMPILER, missing_platforms, platform_names
     started = time.perf_counter()
     models = tuple(models or release_models())
     missing = {version: why for version in fmi_versions if (why := missing_platforms(version))}
-    if any(len(why) == len(platform_compilers(version)) for version, why in missing.items()):
+    if any(len(why) == len(platform_names(version)) for version, why in missing.items()):
         raise BuildError(f"no platform could be built: {_missing_text(missing)}; {NO_COMPILER}")
     if missing and not allow_missing_platforms:
         raise BuildError(f"a release bundle carries every platform, and {_missing_text(missing)}; install the "
@@ -376,13 +378,15 @@ def build_release(out_dir: str | Path = RELEASE_DIR, allow_missing_platforms: bo
     with tempfile.TemporaryDirectory(prefix="bushing_release_") as stage:
         stage = Path(stage)
         staged = {}
+
         for model in models:
             default = default_parameter_file(model)
             name = release_parameter_name(model)
             _write_default_ssv(default, model, stage / name)
             staged[name] = ("ssv", model, default)
             for version in fmi_versions:
-                build = build_native_fmu(default, stage / f"fmi{version}", model, version)
+                build = build_native_fmu(default, stage / f"fmi{version}", model, version,
+                                         tuple(p for p in platform_names(version) if p not in missing.get(version, {})))
                 fmu = release_fmu_name(model, version)
                 build.path.rename(stage / fmu)
                 staged[fmu] = ("fmu", model, version)
@@ -436,6 +440,17 @@ def _release_readme(staged: dict, bundle: ReleaseBundle) -> str:
         "and its C sources (sources/), from which an FMI tool builds it for another platform.",
         "Inputs x [m] and v [m/s] (rotational axes: rad, rad/s), output F [N] (moments: N.m).",
         "",
+        "linux64, x86_64-linux: Linux on x86_64; aarch64-linux: Linux on ARM 64 (both glibc);",
+        "win64, x86_64-windows: 64-bit Windows; darwin64: one universal macOS library for Intel",
+        "(macOS 10.15 or later) and Apple silicon (macOS 11 or later), as x86_64-darwin and",
+        "aarch64-darwin are in FMI 3.",
+        "",
+        "FMI 2 on ARM Linux: FMI 2.0 named no ARM platform and importers differ in where they look.",
+        "The bundle's FMI 2 FMUs carry binaries/aarch64-linux, FMI 2.0.4's name, but FMPy (0.3.32)",
+        "reads binaries/linux64 on any Linux CPU (and darwin64 on any Mac, which the universal library",
+        "serves). On ARM Linux, use the FMI 3 FMU (FMI 3 names aarch64-linux), or replace",
+        "binaries/linux64/ by binaries/aarch64-linux/ in your copy of the FMI 2 FMU.",
+        "",
     ]
     if bundle.missing:
         text += ["MISSING PLATFORMS: this bundle was made without",
@@ -480,6 +495,22 @@ def _release_readme(staged: dict, bundle: ReleaseBundle) -> str:
     return "\n".join(text)
 
 
+def chosen_platforms(text: str | None, fmi_version: int) -> tuple[str, ...] | None:
+    """The platforms ``--platforms`` names (``all``: every one; None: the default). A named platform
+    whose compiler is missing is refused, naming the package that provides it."""
+    from fmu_src.fmi.native.build import NativeBuildError, missing_platforms, platform_names
+    if not text:
+        return None
+    names = platform_names(fmi_version) if text.strip() == "all" else tuple(
+        name.strip() for name in text.split(",") if name.strip())
+    if not names:
+        raise NativeBuildError(f"--platforms {text!r} names no platform; give 'all' or some of "
+                               f"{', '.join(platform_names(fmi_version))}")
+    if text.strip() != "all" and (missing := missing_platforms(fmi_version, names)):
+        raise NativeBuildError("cannot build " + "; ".join(f"{name}: {why}" for name, why in missing.items()))
+    return names
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
         prog="bushing-build-fmu",
@@ -498,12 +529,18 @@ def main(argv: list[str] | None = None) -> int:
                                       f"with --release: {RELEASE_DIR}/)")
     parser.add_argument("--native", action="store_true",
                         help="build the native FMU: compiled C, co-simulation and model exchange, no Python in the "
-                             "host (linux64 with the system's C compiler, win64 where mingw-w64 is installed)")
+                             "host (linux64 with the system's C compiler, win64 where mingw-w64 is installed; "
+                             "more with --platforms)")
     parser.add_argument("--fmi-version", type=int, choices=(2, 3),
                         help="FMI version of the native FMU (default 2; the pythonfmu FMU is FMI 2 only)")
+    parser.add_argument("--platforms", metavar="all|P,Q",
+                        help="with --native: the binaries to build, 'all' or a comma list of FMI platform names "
+                             "(FMI 2: linux64, win64, darwin64, aarch64-linux; FMI 3: x86_64-linux, "
+                             "x86_64-windows, x86_64-darwin, aarch64-darwin, aarch64-linux); default linux64 "
+                             "and win64 (FMI 3: x86_64-linux, x86_64-windows), each where its compiler is here")
     parser.add_argument("--release", action="store_true",
-                        help="build the release bundle: the native FMU of every model, FMI 2 and 3, linux64 and "
-                             "win64 binaries and sources in each, each with its default parameter set; the "
+                        help="build the release bundle: the native FMU of every model, FMI 2 and 3, binaries for "
+                             "Linux (x86_64, aarch64), Windows and macOS (x86_64, arm64) and sources in each, each with its default parameter set; the "
                              f"default sets as .ssv, {README} and {CHECKSUMS}. Its parameters are start values: "
                              "one binary per model serves every parameter set, no compiler needed to apply one")
     parser.add_argument("--allow-missing-platforms", action="store_true",
@@ -516,6 +553,8 @@ def main(argv: list[str] | None = None) -> int:
                      "no --model, --params, --fmi-version or --native")
     if args.allow_missing_platforms and not args.release:
         parser.error("--allow-missing-platforms goes with --release")
+    if args.platforms and not args.native:
+        parser.error("--platforms goes with --native (--release builds every platform)")
     out = args.out or (RELEASE_DIR if args.release else "dist")
     try:
         if args.release:
@@ -528,7 +567,8 @@ def main(argv: list[str] | None = None) -> int:
         if args.model is None:
             args.model = model_of_file(args.params) if args.params else "proposed"
         if args.native:
-            build = build_native_fmu(args.params, out, args.model, args.fmi_version or 2)
+            version = args.fmi_version or 2
+            build = build_native_fmu(args.params, out, args.model, version, chosen_platforms(args.platforms, version))
             path = build.path
             for platform, why in build.skipped.items():
                 print(f"note: no {platform} binary: {why}", file=sys.stderr)

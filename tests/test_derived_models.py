@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 import shutil
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -221,13 +222,16 @@ def test_the_derived_kernels_tangents_are_their_complex_step_derivatives(base):
         assert derivative == pytest.approx(want, rel=1e-9, abs=1e-9 * max(1.0, abs(want)))
 
 
-@pytest.fixture(scope="module")
-def derived_parameter_file(tmp_path_factory):
+def write_derived_parameter_file(folder) -> Path:
+    """``folder/params.json``: single_bouc_wen with a backbone, travel limits and a Maxwell element."""
     params = {name: value for name, value in defaults("single_bouc_wen").items() if name != "k0"}
     params.update({k: v for k, v in BACKBONE.items()}, **LIMITS, maxwell_k=200.0, maxwell_c=2.0)
-    path = tmp_path_factory.mktemp("derived") / "params.json"
-    save_parameters(path, params, "single_bouc_wen+backbone4+limits+maxwell")
-    return path
+    return save_parameters(Path(folder) / "params.json", params, "single_bouc_wen+backbone4+limits+maxwell")
+
+
+@pytest.fixture(scope="module")
+def derived_parameter_file(tmp_path_factory):
+    return write_derived_parameter_file(tmp_path_factory.mktemp("derived"))
 
 
 @pytest.mark.parametrize("kind", ["pythonfmu", "native2", "native3"])

@@ -1,5 +1,5 @@
-"""The release bundle (``build_fmu.py --release``): the native FMU of every model, FMI 2 and 3, linux64
-and win64 binaries and sources in each, its default parameter set as start values; the default sets
+"""The release bundle (``build_fmu.py --release``): the native FMU of every model, FMI 2 and 3, the
+binaries of every platform (Linux x86_64 and aarch64, Windows, macOS) and sources in each, its default parameter set as start values; the default sets
 as ``.ssv``, README.txt and SHA256SUMS. A user without a compiler applies a fitted set to the bundle's
 FMU as start values: the same forces as an FMU built with that set as its defaults (one binary serves
 every parameter set).
@@ -21,13 +21,16 @@ import build_fmu
 from conftest import DATA
 from fmu_src import __version__
 from fmu_src.fmi.native import build as native_build
+from fmu_src.fmi.native import platforms
 from fmu_src.parameter_files import load_parameters, read_parameter_set, read_six_axis, save_parameters
 from identification.measured.signals import Random, sample_times
 from test_fmu_numerics import simulate_with_fmpy
 from test_six_axis_fmu import axis_signals, run_with_fmpy
 
-HAS_MINGW = shutil.which(native_build.MINGW) is not None
-NO_MINGW = f"mingw-w64 ({native_build.MINGW}) is not installed: the bundle has no win64 binaries"
+MISSING = {version: native_build.missing_platforms(version) for version in (2, 3)}
+"""The platforms whose compilers are not installed here, by FMI version: the bundle goes without them."""
+HAS_MINGW = shutil.which(platforms.MINGW) is not None
+NO_MINGW = f"mingw-w64 ({platforms.MINGW}) is not installed: the bundle has no win64 binaries"
 QUICK_MODELS = ("proposed", "berg")      # a Bouc-Wen model and a filled-rubber one
 LINUX = {2: "linux64", 3: "x86_64-linux"}
 WINDOWS = {2: "win64", 3: "x86_64-windows"}
@@ -36,13 +39,13 @@ MM = 1e-3
 
 @pytest.fixture(scope="module")
 def bundle(tmp_path_factory):
-    """A bundle of QUICK_MODELS, FMI 2 and 3 (win64 where mingw-w64 is installed)."""
-    return build_fmu.build_release(tmp_path_factory.mktemp("release"), allow_missing_platforms=not HAS_MINGW,
+    """A bundle of QUICK_MODELS, FMI 2 and 3 (every platform whose compiler is installed)."""
+    return build_fmu.build_release(tmp_path_factory.mktemp("release"), allow_missing_platforms=any(MISSING.values()),
                                    models=QUICK_MODELS)
 
 
 def expected_platforms(version: int) -> set[str]:
-    return {LINUX[version]} | ({WINDOWS[version]} if HAS_MINGW else set())
+    return set(native_build.platform_names(version)) - set(MISSING[version])
 
 
 def binary_platforms(fmu) -> set[str]:
@@ -103,15 +106,12 @@ def check_bundle(bundle, models, versions=(2, 3)):
     for name in [*names, build_fmu.CHECKSUMS]:
         assert name in readme
     assert "start values" in readme and "simulate_fmu" in readme and "start_values=" in readme
-    assert ("MISSING PLATFORMS" in readme) == (not HAS_MINGW)
+    assert ("MISSING PLATFORMS" in readme) == any(MISSING.values())
 
 
 def test_the_bundle_holds_valid_fmus_their_default_sets_a_readme_and_checksums(bundle):
     check_bundle(bundle, QUICK_MODELS)
-    if HAS_MINGW:
-        assert bundle.missing == {}
-    else:
-        assert {version: set(why) for version, why in bundle.missing.items()} == {2: {"win64"}, 3: {"x86_64-windows"}}
+    assert bundle.missing == {version: why for version, why in MISSING.items() if why}
 
 
 @pytest.mark.skipif(not HAS_MINGW, reason=NO_MINGW)
@@ -158,12 +158,13 @@ def test_a_fitted_set_from_an_ssv_as_start_values_equals_an_fmu_built_with_it(bu
 
 
 def test_a_release_without_mingw_is_refused_unless_allowed(monkeypatch, tmp_path, capsys):
-    monkeypatch.setattr(native_build, "MINGW", "x86_64-w64-mingw32-gcc-not-here")
+    monkeypatch.setattr(platforms, "MINGW", "x86_64-w64-mingw32-gcc-not-here")
     out = tmp_path / "refused"
     assert build_fmu.main(["--release", "--out", str(out)]) == 2
     error = capsys.readouterr().err
     assert error.startswith("error: a release bundle carries every platform")
-    assert "win64 (FMI 2): x86_64-w64-mingw32-gcc-not-here is not installed" in error
+    assert "win64 (FMI 2): x86_64-w64-mingw32-gcc-not-here is not installed (Debian: apt-get install " \
+           "gcc-mingw-w64-x86-64)" in error
     assert "x86_64-windows (FMI 3)" in error and "--allow-missing-platforms" in error
     assert not out.exists()     # refused before building anything
 
@@ -178,17 +179,19 @@ def test_a_release_without_mingw_is_refused_unless_allowed(monkeypatch, tmp_path
     assert "MISSING PLATFORMS" in readme and "win64 (FMI 2): x86_64-w64-mingw32-gcc-not-here is not installed" in readme
     for version in (2, 3):
         fmu = out / build_fmu.release_fmu_name("kelvin_voigt", version)
-        assert binary_platforms(fmu) == {LINUX[version]}
+        assert binary_platforms(fmu) == expected_platforms(version) - {WINDOWS[version]}
         assert validate_fmu(str(fmu)) == []
 
 
 def test_a_native_build_without_a_compiler_points_to_the_release_bundle(monkeypatch, tmp_path, capsys):
     monkeypatch.setenv("CC", "cc-not-here")
-    monkeypatch.setattr(native_build, "MINGW", "x86_64-w64-mingw32-gcc-not-here")
+    monkeypatch.setattr(platforms, "MINGW", "x86_64-w64-mingw32-gcc-not-here")
+    monkeypatch.setattr(platforms, "CROSS_GCC", {"x86_64": "x86_64-gcc-not-here", "aarch64": "aarch64-gcc-not-here"})
+    monkeypatch.setattr(platforms, "ZIG", ("zig-not-here", "cc"))
     assert build_fmu.main(["--native", "--out", str(tmp_path)]) == 2
     error = capsys.readouterr().err
-    assert error.startswith("error: no platform could be built: linux64: cc-not-here is not installed; "
-                            "win64: x86_64-w64-mingw32-gcc-not-here is not installed")
+    assert error.startswith("error: no platform could be built: linux64: cc-not-here is not installed (Debian: "
+                            "apt-get install gcc); win64: x86_64-w64-mingw32-gcc-not-here is not installed")
     assert error.rstrip().endswith(native_build.NO_COMPILER)
     assert "python build_fmu.py --release" in error and "start values" in error
     # a release bundle cannot be made here either, allowed or not
@@ -207,7 +210,7 @@ def test_release_takes_no_model_parameters_or_version(flags, capsys):
 @pytest.mark.slow
 def test_the_full_release_bundle(tmp_path, capsys):
     # The command a release runs: every model, FMI 2 and 3; every FMU runs with its .ssv as start values.
-    flags = [] if HAS_MINGW else ["--allow-missing-platforms"]
+    flags = ["--allow-missing-platforms"] if any(MISSING.values()) else []
     assert build_fmu.main(["--release", "--out", str(tmp_path), *flags]) == 0
     models = build_fmu.release_models()
     assert set(models) == {*build_fmu.MODEL_NAMES, "six_axis"} and len(models) == len(build_fmu.MODEL_NAMES) + 1

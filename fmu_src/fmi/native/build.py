@@ -1,12 +1,14 @@
-"""Build a native bushing FMU: C generated from the model definitions, compiled for linux64 (the
-system's C compiler) and win64 (mingw-w64, where it is installed), its sources inside so that
-any tool can compile it for another platform (FMI 2 ``<SourceFiles>``, FMI 3
-``buildDescription.xml``). No Python in the host: ``needsExecutionTool="false"``.
+"""Build a native bushing FMU: C generated from the model definitions, compiled for each platform
+of ``platforms.py`` whose toolchain is here (Linux x86_64 and aarch64, Windows x86_64, macOS x86_64
+and arm64), its sources inside so that any tool can compile it for another platform (FMI 2
+``<SourceFiles>``, FMI 3 ``buildDescription.xml``). No Python in the host:
+``needsExecutionTool="false"``.
 
 Layout of the FMU::
 
     modelDescription.xml
-    binaries/linux64/<id>.so, binaries/win64/<id>.dll        (FMI 3: x86_64-linux, x86_64-windows)
+    binaries/<platform>/<id>.so | .dll | .dylib     (platforms.PLATFORMS: linux64, win64, darwin64,
+                                                     aarch64-linux; FMI 3: x86_64-linux, ...)
     sources/<id>.c            the one translation unit: includes the files below
     sources/bushing_fmu.h, bushing_model.c (generated), bushing_instance.c, fmi2_functions.c
             (or fmi3_functions.c), and the FMI headers
@@ -17,7 +19,6 @@ The FMI 2 headers are fmpy's copy; the FMI 3 ones are the standard's 3.0.1 heade
 """
 from __future__ import annotations
 
-import os
 import shutil
 import subprocess
 import tempfile
@@ -27,6 +28,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .. import model_description
+from . import macho, platforms as toolchains
 from .generate import model_source
 
 C_LAYER = Path(__file__).resolve().parent / "c"
@@ -35,10 +37,8 @@ FMI_HEADERS = {2: ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.
                3: ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h")}
 WARNINGS = ("-std=c99", "-pedantic", "-Wall", "-Wextra", "-Werror")
 FLAGS = ("-O3", "-fPIC", "-ffp-contract=off", "-fvisibility=hidden")
-"""-ffp-contract=off: no fused multiply-add, so the C gives the Python kernels' floats;
--fvisibility=hidden: only the FMI functions are exported."""
-MINGW = "x86_64-w64-mingw32-gcc"
-PLATFORMS = {2: {"linux64": ".so", "win64": ".dll"}, 3: {"x86_64-linux": ".so", "x86_64-windows": ".dll"}}
+"""-ffp-contract=off: no fused multiply-add, so the C gives the Python kernels' floats on every CPU
+(gcc fuses by default on aarch64); -fvisibility=hidden: only the FMI functions are exported."""
 
 
 NO_COMPILER = ("without a compiler, use a release bundle's FMU (python build_fmu.py --release on a machine with gcc "
@@ -87,38 +87,54 @@ def write_sources(folder: Path, axis_models, identifier: str, fmi_version: int, 
     return generated
 
 
-def compile_binary(sources: Path, identifier: str, target: Path, compiler: str, extra=()) -> None:
+def compile_binary(sources: Path, identifier: str, target: Path, compiler: tuple[str, ...], extra=()) -> None:
     """Compile the unit ``sources/<identifier>.c`` into the shared library ``target``."""
     target.parent.mkdir(parents=True, exist_ok=True)
-    command = [compiler, *WARNINGS, *FLAGS, *extra, "-shared", "-I", str(sources), "-o", str(target),
+    command = [*compiler, *WARNINGS, *FLAGS, *extra, "-shared", "-I", str(sources), "-o", str(target),
                str(sources / f"{identifier}.c"), "-lm"]
     result = subprocess.run(command, capture_output=True, text=True)
     if result.returncode != 0:
-        raise NativeBuildError(f"{compiler} failed on {identifier}.c:\n{result.stderr[-4000:]}")
+        raise NativeBuildError(f"{' '.join(compiler)} failed on {identifier}.c:\n{result.stderr[-4000:]}")
 
 
-def platform_compilers(fmi_version: int) -> dict[str, str]:
-    """The compiler of each binary platform of an FMI ``fmi_version`` FMU: linux64 the system's
-    ``cc`` (or ``$CC``), win64 mingw-w64 (FMI 3: x86_64-linux, x86_64-windows)."""
-    if fmi_version not in (2, 3):
-        raise NativeBuildError(f"FMI version {fmi_version}: give 2 or 3")
-    native = os.environ.get("CC", "cc")
-    return dict(zip(PLATFORMS[fmi_version], (native, MINGW)))
+def compile_platform(sources: Path, identifier: str, platform: toolchains.Platform, binaries: Path) -> Path:
+    """Compile ``binaries/<platform>/<identifier><suffix>``: one library for each of the platform's
+    targets, the universal Mach-O of them where there are two."""
+    library = binaries / platform.name / f"{identifier}{platform.suffix}"
+    if len(platform.targets) == 1:
+        compile_targets = {platform.targets[0]: library}
+    else:
+        compile_targets = {target: binaries / f"{platform.name}.{target.name}" / library.name
+                           for target in platform.targets}
+    for target, path in compile_targets.items():
+        compile_binary(sources, identifier, path, toolchains.toolchain(target).command,
+                       toolchains.target_flags(target, identifier))
+    if len(platform.targets) > 1:
+        library.parent.mkdir(parents=True, exist_ok=True)
+        library.write_bytes(macho.universal([path.read_bytes() for path in compile_targets.values()]))
+        for path in compile_targets.values():
+            shutil.rmtree(path.parent)
+    return library
+
+
+def platform_names(fmi_version: int) -> tuple[str, ...]:
+    """Every binary platform of an FMI ``fmi_version`` native FMU (platforms.PLATFORMS)."""
+    try:
+        return tuple(toolchains.platforms_of(fmi_version))
+    except ValueError as exc:
+        raise NativeBuildError(str(exc)) from None
 
 
 def missing_platforms(fmi_version: int, platforms: tuple[str, ...] | None = None) -> dict[str, str]:
     """{platform: why it cannot be built here} of ``platforms`` (default: every platform) of an FMI
     ``fmi_version`` FMU; empty when every compiler is installed."""
-    compilers = platform_compilers(fmi_version)
+    known = platform_names(fmi_version)
     missing = {}
-    for platform in platforms or compilers:
-        if platform not in compilers:
-            raise NativeBuildError(f"unknown platform {platform!r} for FMI {fmi_version}; "
-                                   f"choose from {', '.join(compilers)}")
-        compiler = compilers[platform]
-        if shutil.which(compiler) is None:
-            missing[platform] = (f"{compiler} is not installed" + (
-                " (Debian: apt-get install gcc-mingw-w64-x86-64)" if compiler == MINGW else ""))
+    for name in platforms or known:
+        if name not in known:
+            raise NativeBuildError(f"unknown platform {name!r} for FMI {fmi_version}; choose from {', '.join(known)}")
+        if why := toolchains.missing(toolchains.platforms_of(fmi_version)[name]):
+            missing[name] = why
     return missing
 
 
@@ -127,10 +143,10 @@ def build_native(axis_models, identifier: str, out_dir: str | Path, fmi_version:
     """Write ``out_dir/<identifier>.fmu``, a native FMU (FMI ``fmi_version``, co-simulation and
     model exchange) of the axes ``axis_models`` [(axes.Axis, model on that axis, parameters)] with
     the coupled ``groups`` (tuples of positions among them).
-    ``platforms``: default every platform whose compiler is here (linux64 with the system's
-    ``cc``, win64 with mingw-w64); the result says which were skipped and why."""
-    compilers = platform_compilers(fmi_version)
-    wanted = list(platforms or compilers)
+    ``platforms``: names of platforms.PLATFORMS, default platforms.QUICK_PLATFORMS (x86_64 Linux
+    and Windows), each where its compiler is here; the result says which were skipped and why."""
+    platform_names(fmi_version)
+    wanted = list(platforms or toolchains.QUICK_PLATFORMS[fmi_version])
     out_dir = Path(out_dir)
     build = NativeBuild(out_dir / f"{identifier}.fmu")
     build.skipped = missing_platforms(fmi_version, tuple(wanted))
@@ -151,16 +167,11 @@ def build_native(axis_models, identifier: str, out_dir: str | Path, fmi_version:
             (sources / "buildDescription.xml").write_bytes(model_description.build_description(identifier))
         (stage / "modelDescription.xml").write_bytes(xml)
         build.platforms = [platform for platform in wanted if platform not in build.skipped]
-
-        def compile_platform(platform: str) -> None:
-            compiler = compilers[platform]
-            extra = ("-static-libgcc",) if compiler == MINGW else ()
-            binary = stage / "binaries" / platform / f"{identifier}{PLATFORMS[fmi_version][platform]}"
-            compile_binary(sources, identifier, binary, compiler, extra)
-
+        known = toolchains.platforms_of(fmi_version)
         # the platforms' compilers run side by side (each its own process)
         with ThreadPoolExecutor(max_workers=len(build.platforms)) as pool:
-            for done in [pool.submit(compile_platform, platform) for platform in build.platforms]:
+            for done in [pool.submit(compile_platform, sources, identifier, known[name], stage / "binaries")
+                         for name in build.platforms]:
                 done.result()
         with zipfile.ZipFile(build.path, "w", zipfile.ZIP_DEFLATED) as archive:
             for path in sorted(stage.rglob("*")):
