@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import build_fmu
+from fmu_src.fmi import fmu_inputs
 import test_fmu_directional_derivatives as derivatives
 from fmu_harness import BushingFmu
 from fmu_src.fmi.axes import SIX_AXES
@@ -180,8 +181,8 @@ def test_a_sanitizer_build_of_the_coupled_groups_survives_runs_refusals_and_stat
     from test_native_fmu import sanitizers_work
     if shutil.which("gcc") is None or not sanitizers_work(tmp_path):
         pytest.skip("gcc here cannot build and run with -fsanitize=address,undefined (libasan, libubsan)")
-    identifier, _, axes, document = build_fmu.fmu_axes(coupled["file"], "six_axis")
-    write_sources(tmp_path / "sources", axes, identifier, 2, build_fmu.groups_of(document))
+    identifier, _, axes, document = fmu_inputs.fmu_axes(coupled["file"], "six_axis")
+    write_sources(tmp_path / "sources", axes, identifier, 2, fmu_inputs.groups_of(document))
     sanitize = ["-fsanitize=address,undefined", "-fno-sanitize-recover=all", "-fno-omit-frame-pointer", "-g"]
     library = tmp_path / f"{identifier}.so"
     subprocess.run(["gcc", *WARNINGS, *[f for f in FLAGS if not f.startswith("-O")], "-O1", *sanitize, "-shared",

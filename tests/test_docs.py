@@ -72,7 +72,8 @@ API_OBJECTS = ("identification.fit", "identification.FitResult", "identification
                "identification.forward.simulate.simulate", "identification.analysis.predict.predict", "identification.characterise",
                "identification.measured.kdyn_table.KdynTable", "identification.load_measurement", "identification.training_tests",
                "fmu_src.parameter_files.read_parameter_set", "fmu_src.parameter_files.save_parameters",
-               "build_fmu.build_fmu", "build_fmu.build_native_fmu", "fmu_src.model.definition.BushingModel",
+               "fmu_src.fmi.pythonfmu_package.build_fmu", "fmu_src.fmi.native.build.build_native_fmu",
+               "fmu_src.model.definition.BushingModel",
                "fmu_src.model.registry.get_model")
 
 

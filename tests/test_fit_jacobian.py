@@ -12,7 +12,7 @@ import random
 import numpy as np
 import pytest
 
-import build_fmu
+from fmu_src.fmi.fmu_inputs import default_parameter_file
 from fmu_src.kernels import tangents
 from fmu_src.model.registry import MODELS, get_model
 from fmu_src.parameter_files import load_parameters
@@ -37,7 +37,7 @@ below 1e-6 there."""
 
 def default_values(name):
     model = get_model(name)
-    return model, np.array([model.values(load_parameters(build_fmu.default_parameter_file(name), name))])
+    return model, np.array([model.values(load_parameters(default_parameter_file(name), name))])
 
 
 def jumping_sine(samples=80):

@@ -6,7 +6,7 @@ import pytest
 from fmpy import read_model_description
 from fmpy.validation import validate_fmu
 
-import build_fmu
+from fmu_src.fmi.fmu_inputs import default_parameter_file
 from fmu_harness import BushingFmu
 from fmu_src.model.registry import MODELS
 from fmu_src.parameter_files import load_parameters
@@ -55,7 +55,7 @@ def test_baseline_fmu_validates_and_declares_its_own_identifier_and_units(baseli
     variables = {v.name: v for v in description.modelVariables}
     assert {"x", "v", "F"} <= set(variables)
     assert (variables["x"].unit, variables["v"].unit, variables["F"].unit) == ("m", "m/s", "N")
-    defaults = load_parameters(build_fmu.default_parameter_file(model), model)
+    defaults = load_parameters(default_parameter_file(model), model)
     assert {v.name for v in description.modelVariables if v.causality == "parameter"} == set(fmu_parameter_units(model))
     for name, unit in fmu_parameter_units(model).items():
         assert variables[name].unit == unit and float(variables[name].start) == defaults.get(name, 0.0), name
@@ -68,7 +68,7 @@ def test_baseline_fmu_equals_the_model_through_fmpy(baseline_fmus, model):
     # of the input table may give it either sign, so a friction model may rightly reverse in one
     # run and not in the other
     x, v = Sine(2.0, 10.0).signals(t + 3.7e-4)
-    params = load_parameters(build_fmu.default_parameter_file(model), model)
+    params = load_parameters(default_parameter_file(model), model)
     np.testing.assert_allclose(simulate_with_fmpy(baseline_fmus[model], t, x, v),
                                simulate_model_held(model, params, t, x, v), rtol=1e-9, atol=1e-9)
 
@@ -124,7 +124,7 @@ def test_every_model_runs_side_by_side_in_one_process(fmu_path, baseline_fmus):
             assert fmu.step(x[k] * MM, v[k] * MM, 1e-3) == "ok"
             forces[model].append(fmu.get("F"))
     for model in paths:
-        params = load_parameters(build_fmu.default_parameter_file(model), model)
+        params = load_parameters(default_parameter_file(model), model)
         np.testing.assert_allclose(forces[model], simulate_model_held(model, params, t, x, v)[1:], rtol=1e-9, atol=1e-9,
                                    err_msg=model)
         instances[model].free()

@@ -11,6 +11,7 @@ from fmpy import read_model_description
 from fmpy.validation import validate_fmu
 
 import build_fmu
+from fmu_src.fmi import fmu_inputs
 from conftest import paper_force, paper_parameters
 from fmu_src.model.registry import MODELS
 from identification.measured.signals import Random, Sine, Step, sample_times
@@ -301,7 +302,7 @@ def test_a_sanitizer_build_survives_bad_inputs_state_restores_and_1000_instances
     from test_c_host import HOST_SOURCE
     if not sanitizers_work(tmp_path):
         pytest.skip("gcc here cannot build and run with -fsanitize=address,undefined (libasan, libubsan)")
-    identifier, _, axes, _ = build_fmu.fmu_axes()
+    identifier, _, axes, _ = fmu_inputs.fmu_axes()
     generated = write_sources(tmp_path / "sources", axes, identifier, 2)
     sanitize = ["-fsanitize=address,undefined", "-fno-sanitize-recover=all", "-fno-omit-frame-pointer", "-g"]
     library = tmp_path / f"{identifier}.so"

@@ -128,12 +128,13 @@ def test_the_base_install_builds_runs_and_simulates_and_names_the_extra_it_lacks
               "import build_fmu\n"
               "from fmpy import simulate_fmu\n"
               "from identification import simulate\n"
+              "from fmu_src.fmi.fmu_inputs import default_parameter_file\n"
               "path = build_fmu.build_fmu(out_dir='dist')\n"
               "t = np.arange(0, 0.201, 1e-3)\n"
               "table = np.array(list(zip(t, 2e-3*np.sin(20*np.pi*t), 2e-3*20*np.pi*np.cos(20*np.pi*t))),\n"
               "                 dtype=[('time', float), ('x', float), ('v', float)])\n"
               "fmu = simulate_fmu(str(path), stop_time=0.2, step_size=1e-3, input=table, output=['F'])\n"
-              "force = simulate(build_fmu.default_parameter_file(), t, 2*np.sin(20*np.pi*t))\n"
+              "force = simulate(default_parameter_file(), t, 2*np.sin(20*np.pi*t))\n"
               "print(np.max(np.abs(fmu['F'])), np.max(np.abs(force)))\n")
     run = subprocess.run([str(python), "-c", script], capture_output=True, text=True, timeout=600, cwd=work)
     assert run.returncode == 0, run.stderr[-3000:]

@@ -19,6 +19,7 @@ from fmpy import read_model_description
 from fmpy.validation import validate_fmu
 
 import build_fmu
+from fmu_src.fmi import fmu_inputs
 from conftest import REPO
 from fmu_src.fmi.axes import ONE_AXIS, SIX_AXES
 from fmu_src.fmi.native import build as native_build, macho, platforms
@@ -257,9 +258,9 @@ def test_clang_takes_the_generated_c_with_the_projects_strict_flags(tmp_path, ve
 
 def check_clang(tmp_path, models, version):
     for model in models:
-        identifier, _, axes, document = build_fmu.fmu_axes(model=model)
+        identifier, _, axes, document = fmu_inputs.fmu_axes(model=model)
         sources = tmp_path / f"{model}-{version}"
-        native_build.write_sources(sources, axes, identifier, version, build_fmu.groups_of(document))
+        native_build.write_sources(sources, axes, identifier, version, fmu_inputs.groups_of(document))
         run = subprocess.run([*platforms.ZIG, "-target", "x86_64-linux-gnu", *native_build.WARNINGS,
                               "-Wstrict-prototypes", "-c", "-o", str(sources / "check.o"), "-I", str(sources),
                               str(sources / f"{identifier}.c")],

@@ -20,8 +20,11 @@ from fmpy.validation import validate_fmu
 import build_fmu
 from conftest import DATA
 from fmu_src import __version__
+from fmu_src.fmi import release
+from fmu_src.fmi.fmu_inputs import identifier_of
 from fmu_src.fmi.native import build as native_build
 from fmu_src.fmi.native import platforms
+from fmu_src.model.registry import MODEL_NAMES
 from fmu_src.parameter_files import load_parameters, read_parameter_set, read_six_axis, save_parameters
 from identification.measured.signals import Random, sample_times
 from test_fmu_numerics import simulate_with_fmpy
@@ -40,7 +43,7 @@ MM = 1e-3
 @pytest.fixture(scope="module")
 def bundle(tmp_path_factory):
     """A bundle of QUICK_MODELS, FMI 2 and 3 (every platform whose compiler is installed)."""
-    return build_fmu.build_release(tmp_path_factory.mktemp("release"), allow_missing_platforms=any(MISSING.values()),
+    return release.build_release(tmp_path_factory.mktemp("release"), allow_missing_platforms=any(MISSING.values()),
                                    models=QUICK_MODELS)
 
 
@@ -64,14 +67,14 @@ def check_bundle(bundle, models, versions=(2, 3)):
     """What every bundle must be: its files, their checksums, every FMU valid with its platforms and
     its default set's start values, the README naming every file and the version."""
     folder = bundle.folder
-    fmus = {build_fmu.release_fmu_name(model, version): (model, version) for model in models for version in versions}
-    sets = {build_fmu.release_parameter_name(model): model for model in models}
-    names = {*fmus, *sets, build_fmu.README}
-    assert {path.name for path in folder.iterdir()} == names | {build_fmu.CHECKSUMS}
-    assert set(bundle.files) == {folder / name for name in names | {build_fmu.CHECKSUMS}}
+    fmus = {release.release_fmu_name(model, version): (model, version) for model in models for version in versions}
+    sets = {release.release_parameter_name(model): model for model in models}
+    names = {*fmus, *sets, release.README}
+    assert {path.name for path in folder.iterdir()} == names | {release.CHECKSUMS}
+    assert set(bundle.files) == {folder / name for name in names | {release.CHECKSUMS}}
 
     # SHA256SUMS: `sha256sum -c` format ("<64 hex>  <name>"), every file but itself, right digests
-    lines = (folder / build_fmu.CHECKSUMS).read_text().splitlines()
+    lines = (folder / release.CHECKSUMS).read_text().splitlines()
     listed = {}
     for line in lines:
         match = re.fullmatch(r"([0-9a-f]{64})  (\S+)", line)
@@ -81,7 +84,7 @@ def check_bundle(bundle, models, versions=(2, 3)):
     for name, digest in listed.items():
         assert hashlib.sha256((folder / name).read_bytes()).hexdigest() == digest, name
     if shutil.which("sha256sum"):
-        done = subprocess.run(["sha256sum", "--strict", "-c", build_fmu.CHECKSUMS], cwd=folder, capture_output=True,
+        done = subprocess.run(["sha256sum", "--strict", "-c", release.CHECKSUMS], cwd=folder, capture_output=True,
                               text=True)
         assert done.returncode == 0, done.stdout + done.stderr
 
@@ -90,7 +93,7 @@ def check_bundle(bundle, models, versions=(2, 3)):
         assert validate_fmu(str(path)) == [], name
         description = read_model_description(str(path))
         assert description.fmiVersion == f"{version}.0"
-        identifier = build_fmu.fmu_axes(model=model)[0]
+        identifier = identifier_of(model)
         assert description.coSimulation.modelIdentifier == description.modelExchange.modelIdentifier == identifier
         assert name.startswith(identifier + "-")
         assert binary_platforms(path) == expected_platforms(version), name
@@ -99,11 +102,11 @@ def check_bundle(bundle, models, versions=(2, 3)):
             assert f"sources/{identifier}.c" in archive.namelist()
         # its start values are the bundle's .ssv of its model, bit for bit
         starts = {v.name: float(v.start) for v in description.modelVariables if v.causality == "parameter"}
-        assert starts == ssv_values(folder / build_fmu.release_parameter_name(model), model), name
+        assert starts == ssv_values(folder / release.release_parameter_name(model), model), name
 
-    readme = (folder / build_fmu.README).read_text()
+    readme = (folder / release.README).read_text()
     assert __version__ in readme.splitlines()[0]
-    for name in [*names, build_fmu.CHECKSUMS]:
+    for name in [*names, release.CHECKSUMS]:
         assert name in readme
     assert "start values" in readme and "simulate_fmu" in readme and "start_values=" in readme
     assert ("MISSING PLATFORMS" in readme) == any(MISSING.values())
@@ -117,7 +120,7 @@ def test_the_bundle_holds_valid_fmus_their_default_sets_a_readme_and_checksums(b
 @pytest.mark.skipif(not HAS_MINGW, reason=NO_MINGW)
 def test_the_win64_binaries_are_x86_64_windows_dlls_exporting_the_fmi_functions(bundle):
     for (model, version), path in bundle.fmus.items():
-        identifier = build_fmu.fmu_axes(model=model)[0]
+        identifier = identifier_of(model)
         with zipfile.ZipFile(path) as archive:
             dll = archive.read(f"binaries/{WINDOWS[version]}/{identifier}.dll")
         assert dll[:2] == b"MZ"
@@ -169,16 +172,16 @@ def test_a_release_without_mingw_is_refused_unless_allowed(monkeypatch, tmp_path
     assert not out.exists()     # refused before building anything
 
     # allowed: the bundle says what it lacks, on stderr and in its README (one model, to be quick)
-    monkeypatch.setattr(build_fmu, "release_models", lambda: ("kelvin_voigt",))
+    monkeypatch.setattr(release, "release_models", lambda: ("kelvin_voigt",))
     out = tmp_path / "allowed"
     assert build_fmu.main(["--release", "--allow-missing-platforms", "--out", str(out)]) == 0
     captured = capsys.readouterr()
     assert "warning: the bundle has no win64 (FMI 2)" in captured.err and "x86_64-windows (FMI 3)" in captured.err
     assert captured.out.startswith(f"wrote {out}: 2 FMUs, 1 parameter sets")
-    readme = (out / build_fmu.README).read_text()
+    readme = (out / release.README).read_text()
     assert "MISSING PLATFORMS" in readme and "win64 (FMI 2): x86_64-w64-mingw32-gcc-not-here is not installed" in readme
     for version in (2, 3):
-        fmu = out / build_fmu.release_fmu_name("kelvin_voigt", version)
+        fmu = out / release.release_fmu_name("kelvin_voigt", version)
         assert binary_platforms(fmu) == expected_platforms(version) - {WINDOWS[version]}
         assert validate_fmu(str(fmu)) == []
 
@@ -212,12 +215,12 @@ def test_the_full_release_bundle(tmp_path, capsys):
     # The command a release runs: every model, FMI 2 and 3; every FMU runs with its .ssv as start values.
     flags = ["--allow-missing-platforms"] if any(MISSING.values()) else []
     assert build_fmu.main(["--release", "--out", str(tmp_path), *flags]) == 0
-    models = build_fmu.release_models()
-    assert set(models) == {*build_fmu.MODEL_NAMES, "six_axis"} and len(models) == len(build_fmu.MODEL_NAMES) + 1
-    bundle = build_fmu.ReleaseBundle(tmp_path)
-    bundle.fmus = {(m, v): tmp_path / build_fmu.release_fmu_name(m, v) for m in models for v in (2, 3)}
-    bundle.parameter_files = {m: tmp_path / build_fmu.release_parameter_name(m) for m in models}
-    bundle.readme, bundle.checksums = tmp_path / build_fmu.README, tmp_path / build_fmu.CHECKSUMS
+    models = release.release_models()
+    assert set(models) == {*MODEL_NAMES, "six_axis"} and len(models) == len(MODEL_NAMES) + 1
+    bundle = release.ReleaseBundle(tmp_path)
+    bundle.fmus = {(m, v): tmp_path / release.release_fmu_name(m, v) for m in models for v in (2, 3)}
+    bundle.parameter_files = {m: tmp_path / release.release_parameter_name(m) for m in models}
+    bundle.readme, bundle.checksums = tmp_path / release.README, tmp_path / release.CHECKSUMS
     check_bundle(bundle, models)
     t = sample_times(0.05, 1000.0)
     x, v = Random(2.0, 1.0, seed=3).signals(t)

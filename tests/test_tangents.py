@@ -11,7 +11,7 @@ import types
 
 import pytest
 
-import build_fmu
+from fmu_src.fmi.fmu_inputs import default_parameter_file
 from fmu_src.model import integration
 from fmu_src.model.registry import MODELS, get_model
 from fmu_src.kernels.python_to_c import DOUBLE, INT, Translation
@@ -179,7 +179,7 @@ def central_difference(kernel, m, state, x, v, d_state, d_x, d_v, h):
 # ---------------------------------------------------------------------------- points
 def default_constants(name):
     model = get_model(name)
-    parameters = load_parameters(build_fmu.default_parameter_file(name), name)
+    parameters = load_parameters(default_parameter_file(name), name)
     return model, model.prepare(model.values(parameters))
 
 

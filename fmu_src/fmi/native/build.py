@@ -27,7 +27,9 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ...model.registry import DEFAULT_MODEL
 from .. import model_description
+from ..fmu_inputs import BuildError, fmu_axes, groups_of
 from . import macho, platforms as toolchains
 from .generate import model_source
 
@@ -178,3 +180,57 @@ def build_native(axis_models, identifier: str, out_dir: str | Path, fmi_version:
                 if path.is_file():
                     archive.write(path, path.relative_to(stage).as_posix())
     return build
+
+
+def build_native_fmu(params_file: str | Path | None = None, out_dir: str | Path = "dist", model: str = DEFAULT_MODEL,
+                     fmi_version: int = 2, platforms: tuple[str, ...] | None = None):
+    """Build the native FMU: C generated from the model's definition, compiled, no Python needed
+    in the host; co-simulation and model exchange in one FMU.
+
+    Parameters
+    ----------
+    params_file : str or Path, optional
+        Parameter file whose values become the start values (default: the model's shipped set).
+    out_dir : str or Path
+        Directory for ``<Identifier>.fmu`` (created if missing).
+    model : str
+        A model of ``fmu_src/model/registry.py`` or ``six_axis`` (default: the paper's, ``proposed``).
+    fmi_version : int
+        2 or 3.
+    platforms : tuple of str, optional
+        Binaries to build, names of ``fmu_src/fmi/native/platforms.py`` (default: ``linux64``, and
+        ``win64`` where mingw-w64 is installed; FMI 3: ``x86_64-linux``, ``x86_64-windows``); the
+        C sources are always included.
+
+    Returns
+    -------
+    NativeBuild
+        Its ``path``, the platforms built and those skipped (with why).
+
+    Raises
+    ------
+    BuildError
+        The FMU fails fmpy's validation; ``ParameterError`` for an invalid parameter file.
+    """
+    from fmpy.validation import validate_fmu
+    identifier, _, axes, document = fmu_axes(params_file, model)
+    build = build_native(axes, identifier, out_dir, fmi_version, platforms, groups_of(document))
+    problems = validate_fmu(str(build.path))
+    if problems:
+        raise BuildError(f"{build.path} fails validation:\n  " + "\n  ".join(problems))
+    return build
+
+
+def chosen_platforms(text: str | None, fmi_version: int) -> tuple[str, ...] | None:
+    """The platforms ``--platforms`` names (``all``: every one; None: the default). A named platform
+    whose compiler is missing is refused, naming the package that provides it."""
+    if not text:
+        return None
+    names = platform_names(fmi_version) if text.strip() == "all" else tuple(
+        name.strip() for name in text.split(",") if name.strip())
+    if not names:
+        raise NativeBuildError(f"--platforms {text!r} names no platform; give 'all' or some of "
+                               f"{', '.join(platform_names(fmi_version))}")
+    if text.strip() != "all" and (missing := missing_platforms(fmi_version, names)):
+        raise NativeBuildError("cannot build " + "; ".join(f"{name}: {why}" for name, why in missing.items()))
+    return names
