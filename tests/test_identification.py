@@ -15,6 +15,7 @@ from identification.forward.input_path import prepare_input
 from identification.measured.measurements import Measurement, MeasurementError, MeasurementWarning, load_measurement
 from identification.measured.noise import NoiseEstimate
 from identification.fitting.objectives import Objective, nrmse, rms_level_error
+from identification.fitting.result import MIN_AGREEING
 from identification.measured.rig_tests import RigTest
 from identification.forward.simulate import simulate
 from identification.measured.signals import Sine, Step, sample_times
@@ -325,10 +326,10 @@ def test_paper_ga_preset_runs_the_ga_then_the_least_squares_stages(monkeypatch):
     fourth = min(result.records, key=lambda r: len(r.history))
     assert all(len(r.history) >= 3 and r.stage == 2 for r in result.records if r is not fourth)
     if result.added_starts:
-        assert result.added_starts == 1 and result.agreed_before_added < fitting.MIN_AGREEING
+        assert result.added_starts == 1 and result.agreed_before_added < MIN_AGREEING
         assert fourth.stage == 2 and len(fourth.history) >= 2
     else:
-        assert result.agreed_before_added >= fitting.MIN_AGREEING
+        assert result.agreed_before_added >= MIN_AGREEING
         assert fourth.stage == 0 and len(fourth.history) == 1
     # never silent: the warning is given exactly when the fit is not converged
     warned = [w for w in caught if issubclass(w.category, fitting.FitNotConvergedWarning)]

@@ -669,9 +669,3 @@ def tangent(function: Callable, inactive: tuple = ("m",)) -> Callable:
 def tangent_source(function: Callable, inactive: tuple = ("m",)) -> str:
     """The Python source of ``function``'s tangent and of every tangent it calls."""
     return "\n\n".join(tangent(function, inactive).generator.sources.values())
-
-
-def model_tangents(model) -> dict:
-    """{"force": ..., "derivatives": ..., "switches": ...}: the tangents of ``model``'s kernels
-    (a ``BushingModel``), each f_tangent(m, state, x, v, d_state, d_x, d_v)."""
-    return {name: tangent(getattr(model, name)) for name in ("force", "derivatives", "switches")}

@@ -62,7 +62,6 @@ MOUNTING_SPECS = (
 """How an axis mounts its model: every model on every axis takes them (0 and 0: the model as it
 is, bit for bit). A model with a parameter of the same name (Kelvin-Voigt's preload, the same
 constant force) keeps its own; on a rotational axis they are in rad and N.mm."""
-MOUNTING_NAMES = tuple(spec.name for spec in MOUNTING_SPECS)
 
 
 class ModelContractError(ValueError):

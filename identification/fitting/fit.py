@@ -38,11 +38,11 @@ from identification.forward.population import parameter_matrix
 from identification.fitting.engine import make_engine
 from identification.errors import IdentificationError
 from identification.extras import require
-from identification.fitting.result import FLOOR_FACTOR, MIN_AGREEING, FitNotConvergedWarning, FitResult  # noqa: F401
+from identification.fitting.result import FitNotConvergedWarning, FitResult
 from identification.measured.kdyn_table import KdynTable, load_kdyn_table
 from identification.measured.measurements import Measurement
 from identification.measured.multiaxis import COUPLED_AXES, MultiAxisMeasurement, coupled_axes, load_multiaxis
-from identification.fitting.multistart import JACOBIANS, jacobian
+from identification.fitting.multistart import JACOBIANS
 from identification.measured.noise import NoiseEstimate, estimate_noise
 from identification.fitting.objectives import Objective
 from identification.fitting.presets import PRESETS, SearchSettings

@@ -24,7 +24,6 @@ import numpy as np
 from fmu_src.kernels import numba_binding as _kernels
 from fmu_src.model import integration
 from fmu_src.model.registry import BushingModel, DEFAULT_MODEL, resolve_model
-from fmu_src.models.proposed_model import PARAMETER_NAMES  # noqa: F401  (the proposed model's order, for callers)
 from identification.forward import steady_state
 
 _MAX_SUBSTEPS = integration.DEFAULT_MAX_SUBSTEPS
