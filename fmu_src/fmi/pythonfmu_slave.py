@@ -29,10 +29,13 @@ siblings live in the package ``<that name>_lib``, so several FMUs of this projec
 with different code or defaults) can share one Python interpreter without running each
 other's modules.
 """
+import atexit
 import ctypes
 import importlib
 import math
+import os
 import sys
+import threading
 from functools import partial
 
 from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Real
@@ -70,6 +73,37 @@ _JUMP_MASK = (1 << JUMP_WINDOW) - 1
 
 class InitializationError(RuntimeError):
     """Start values with which the simulation cannot start (fmi2Fatal at the first doStep)."""
+
+
+_EXIT_ORDERED = set()   # the export libraries (paths) whose exit order_library_exit has put right
+
+
+def order_library_exit(resources: str | None, identifier: str) -> None:
+    """Empty the export library's interpreter guard at the Python host's exit, before the process
+    exit destroys it (Linux; the library is the FMU's ``binaries/linux64/<identifier>.so``).
+
+    pythonfmu 0.7's export library keeps a ``std::shared_ptr<PyState>`` that two exit paths
+    release: the C++ static destructor, then the library's ``__attribute__((destructor))``
+    (``finalizePythonInterpreter``), which assigns nullptr to the already destroyed pointer and
+    so decrements a counter in freed memory (valgrind: an invalid access in
+    finalizePythonInterpreter, 8 bytes into a block freed at exit). That write corrupts malloc's
+    free lists, and the host aborts at exit ("corrupted double-linked list", in a later free).
+    Called first, from Python's atexit, ``finalizePythonInterpreter`` leaves the pointer empty
+    and both exit paths find nothing to release. Only where the host started Python on the
+    process's main thread: pythonfmu starts it on a thread of its own otherwise, and its guard
+    must then finish it."""
+    if not sys.platform.startswith("linux") or not resources or threading.main_thread().native_id != os.getpid():
+        return
+    library = os.path.join(os.path.dirname(os.path.abspath(resources)), "binaries", "linux64", identifier + ".so")
+    if library in _EXIT_ORDERED:
+        return
+    try:
+        loaded = ctypes.CDLL(library, mode=os.RTLD_NOLOAD)   # the host's copy, kept loaded by this handle
+        finalize = loaded.finalizePythonInterpreter
+    except (OSError, AttributeError):      # not loaded from there, or another export library
+        return
+    _EXIT_ORDERED.add(library)
+    atexit.register(finalize)
 
 
 class _AxisState:
@@ -143,6 +177,7 @@ class BushingSlave(Fmi2Slave):
         super().__init__(**kwargs)
         if AXES is None:
             raise RuntimeError("the bushing slave runs inside an FMU built by build_fmu.py")
+        order_library_exit(self.resources, type(self).__name__)
         self._axes = [_AxisState(axis, model, defaults) for axis, model, defaults in AXES]
         # coupled groups whose model has a coupled form (Kelvin-Voigt's is its axes as they are)
         self._groups = []
@@ -175,7 +210,11 @@ class BushingSlave(Fmi2Slave):
         self._jump_warned = False           # the jumping-inputs warning is given once per instance
         for variable in variables.fmu_variables(AXES, GROUPS):
             self._register(variable)
-        self.log(STEP, Fmi2Status.ok, "logAll")
+        # Which step runs is logged at the exit of initialization mode, not here: pythonfmu 0.7
+        # passes an instance's queued messages on after each call, and when an instance is freed
+        # with messages still queued its destructor hands them to a logger it has already
+        # destroyed (Fmi2Component's members die in reverse order), which crashes the host.
+        self._step_logged = False
 
     def _register(self, variable):
         """Register one variable of the FMU's table (``variables``), with its getter and setter."""
@@ -338,6 +377,9 @@ class BushingSlave(Fmi2Slave):
     def exit_initialization_mode(self):
         # Never raise here: libcosim aborts the whole process on a failed exitInitializationMode,
         # while it reports a failed step. Invalid start values are logged now and fail the first step.
+        if not self._step_logged:
+            self.log(STEP, Fmi2Status.ok, "logAll")
+            self._step_logged = True
         usable = [self._refresh_parameters(a) for a in self._single] + [self._refresh_group(g) for g in self._groups]
         if all(usable) and all(math.isfinite(a.x_now) for a in self._axes):
             self._set_initial_state()
