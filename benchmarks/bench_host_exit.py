@@ -8,7 +8,9 @@ installed; the plain-Python step, so that valgrind has no JIT to follow), a host
 and frees it at once, three times, then exits: prints valgrind's error contexts that name the
 export library's ``clearLogBuffer`` (a freed instance's queued messages handed to a destroyed
 logger) and ``finalizePythonInterpreter`` (the interpreter guard released a second time at exit).
-Then ``--processes`` hosts (default 20) with the compiled step, and their exit codes.
+Then ``--processes`` hosts (default 20) with the compiled step, and their exit codes; and, where
+gcc and a shared libpython are here, as many runs of the C host of ``tests/c_host/fmi2_host.c``
+(libpython loaded by the host, 200 steps of the proposed model) with ``BUSHING_FMU_STEP=compiled``.
 """
 from __future__ import annotations
 
@@ -19,6 +21,7 @@ import re
 import shutil
 import subprocess
 import sys
+import sysconfig
 import tempfile
 from pathlib import Path
 
@@ -65,9 +68,36 @@ def exit_codes(fmu: Path, processes: int) -> collections.Counter:
     return codes
 
 
+def c_host_exit_codes(fmu: Path, processes: int, work: Path) -> collections.Counter | str:
+    """Exit codes of the C host (tests/c_host/fmi2_host.c) running the proposed model's FMU
+    ``fmu`` with the compiled step, or why it cannot run here."""
+    from fmpy import extract, read_model_description
+    libpython = Path(sysconfig.get_config_var("LIBDIR") or "") / (sysconfig.get_config_var("LDLIBRARY") or "")
+    if shutil.which("gcc") is None or not sysconfig.get_config_var("Py_ENABLE_SHARED") or not libpython.is_file():
+        return "needs gcc and a shared libpython"
+    host = work / "fmi2_host"
+    subprocess.run(["gcc", "-O1", "-o", str(host), str(REPO / "tests" / "c_host" / "fmi2_host.c"), "-ldl", "-lm"],
+                   check=True)
+    description = read_model_description(str(fmu))
+    refs = {v.name: v.valueReference for v in description.modelVariables}
+    folder = Path(extract(str(fmu)))
+    library = folder / "binaries" / "linux64" / f"{description.coSimulation.modelIdentifier}.so"
+    environment = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p), PYTHONHOME=sys.base_prefix,
+                       BUSHING_FMU_STEP="compiled")
+    codes = collections.Counter()
+    for _ in range(processes):
+        codes[subprocess.run([str(host), str(libpython), str(library), description.guid,
+                              (folder / "resources").as_uri(), str(refs["x"]), str(refs["v"]), str(refs["F"]), "200",
+                              "1e-3"], capture_output=True, env=environment, timeout=600).returncode] += 1
+    shutil.rmtree(folder, ignore_errors=True)
+    return codes
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--fmu", type=Path, help="a pythonfmu FMU (default: the Kelvin-Voigt one, built now)")
+    parser.add_argument("--proposed", type=Path, help="the proposed model's pythonfmu FMU for the C host "
+                                                       "(default: built now)")
     parser.add_argument("--processes", type=int, default=20)
     args = parser.parse_args()
     with tempfile.TemporaryDirectory(prefix="bench_host_exit_") as work:
@@ -80,7 +110,14 @@ def main() -> int:
             print(f"under valgrind, {fmu.name}: {under_valgrind(fmu)}", flush=True)
         else:
             print("valgrind is not installed: no memory check")
-        print(f"{args.processes} hosts, compiled step, exit codes: {dict(exit_codes(fmu, args.processes))}")
+        print(f"{args.processes} hosts, compiled step, exit codes: {dict(exit_codes(fmu, args.processes))}", flush=True)
+        proposed = args.proposed
+        if proposed is None:
+            subprocess.run([sys.executable, str(REPO / "build_fmu.py"), "--out", work], check=True,
+                           stdout=subprocess.DEVNULL)
+            proposed = Path(work) / "BoucWenBushing.fmu"
+        codes = c_host_exit_codes(proposed, args.processes, Path(work))
+        print(f"C host, {proposed.name}, compiled step: {codes if isinstance(codes, str) else dict(codes)}")
     return 0
 
 
