@@ -23,7 +23,6 @@ import argparse
 import importlib.util
 import math
 import platform
-import sys
 import tempfile
 import time
 from datetime import date
@@ -32,7 +31,6 @@ from pathlib import Path
 import numpy as np
 
 REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO))
 
 import build_fmu  # noqa: E402
 from fmu_src.fmi.axes import SIX_AXES  # noqa: E402

@@ -21,13 +21,11 @@ import os
 import platform
 import statistics
 import subprocess
-import sys
 import tempfile
 from datetime import date
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO))
 
 import build_fmu  # noqa: E402
 from bench_fmu_step import _c_master  # noqa: E402

@@ -28,14 +28,12 @@ import os
 import platform
 import resource
 import subprocess
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
 REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO))
 
 REFERENCE_STEPS = 10.0 ** -np.arange(4.0, 8.5, 0.5)
 ACCURATE = 1e-4

@@ -38,7 +38,6 @@ from pathlib import Path
 import numpy as np
 
 REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO))
 
 from fmu_src.models.proposed_model import PARAMETER_NAMES  # noqa: E402
 from fmu_src.parameter_files import load_parameters  # noqa: E402

@@ -40,7 +40,6 @@ import time
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO))
 
 FILLED_RUBBER = ("berg", "fractional")
 """The filled-rubber models, timed on the same sine with their default sets (data/params_*_filled_rubber.json)."""

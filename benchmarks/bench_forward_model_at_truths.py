@@ -19,14 +19,11 @@ sees it as worse than any candidate that runs).
 from __future__ import annotations
 
 import argparse
-import sys
 from pathlib import Path
 
 import numpy as np
 
 REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO))
-sys.path.insert(0, str(REPO / "benchmarks"))
 
 from bench_fit_reliability import NOISE, TRAINING, load_or_draw_truths, truth_forces  # noqa: E402
 from identification.forward.population import parameter_matrix  # noqa: E402

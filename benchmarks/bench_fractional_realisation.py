@@ -13,14 +13,12 @@ from __future__ import annotations
 
 import math
 import platform
-import sys
 from datetime import date
 from pathlib import Path
 
 import numpy as np
 
 REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO))
 
 from fmu_src.models.fractional_model import ELEMENTS, MODEL  # noqa: E402
 

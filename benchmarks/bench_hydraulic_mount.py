@@ -35,8 +35,6 @@ from pathlib import Path
 import numpy as np
 
 REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO))
-sys.path.insert(0, str(REPO / "benchmarks"))
 
 from fmu_src.parameter_files import load_parameters  # noqa: E402
 from identification.forward.dynamic_stiffness import characterise  # noqa: E402

@@ -20,7 +20,6 @@ finds the compiled kernels' caches warm, so the ratio leans, slightly, against t
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 import warnings
 from pathlib import Path
@@ -28,7 +27,6 @@ from pathlib import Path
 import numpy as np
 
 REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO))
 
 from fmu_src.parameter_files import load_parameters  # noqa: E402
 from identification.forward.dynamic_stiffness import characterise  # noqa: E402

@@ -42,7 +42,6 @@ from pathlib import Path
 import numpy as np
 
 REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO))
 
 from fmu_src.model.registry import MODEL_NAMES  # noqa: E402
 from identification.analysis.compare import compare_models  # noqa: E402

@@ -52,7 +52,6 @@ from fmpy.fmi2 import FMU2Model
 from scipy.integrate import BDF, Radau
 
 REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO))
 
 import build_fmu  # noqa: E402
 from identification.measured.signals import Sine  # noqa: E402

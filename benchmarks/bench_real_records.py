@@ -21,7 +21,6 @@ from pathlib import Path
 import numpy as np
 
 REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO))
 
 from fmu_src.model.registry import MODEL_NAMES  # noqa: E402
 from identification.errors import FitNotConvergedWarning  # noqa: E402

@@ -11,14 +11,12 @@ ranked first. tests/test_identification.py asserts rho > 0.7 and the first ranks
 from __future__ import annotations
 
 import platform
-import sys
 import time
 from pathlib import Path
 
 from scipy.stats import spearmanr
 
 REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO))
 
 from fmu_src.parameter_files import load_parameters  # noqa: E402
 from fmu_src.models.proposed_model import PARAMETER_NAMES  # noqa: E402
