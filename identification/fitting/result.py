@@ -28,6 +28,7 @@ from identification.interrupt import deferred, writing
 from identification.measured.kdyn_table import FIT_CYCLES, KDYN_UNCERTAINTY, LOSS_ANGLE_UNCERTAINTY_DEG
 from identification.measured.noise import NoiseEstimate
 from identification.measured.repeatability import Repeatability
+from identification.forward.parameter_sets import FittedParameters
 from identification.fitting.objectives import MIN_NOISE_FRACTION
 from identification.fitting.presets import describe
 
@@ -160,7 +161,7 @@ def information_criterion(misfit: float, free_parameters: int, residuals: int) -
 
 
 @dataclass
-class FitResult:
+class FitResult(FittedParameters):
     """What ``fit`` returns: the best parameter set, the evidence that it is the optimum, and
     how sure it is.
 

@@ -16,6 +16,15 @@ from fmu_src.parameter_files import ParameterEnsemble, ParameterSet, read_ensemb
 from identification.errors import IdentificationError
 
 
+class FittedParameters:
+    """What a fit returns, as the front door reads it: ``parameters``, the best fit (a
+    ``ParameterSet``), and ``ensemble``, the sets best first. ``identification.fitting.result.
+    FitResult`` derives from it, so that this layer recognises a fit without naming the fitting
+    layer above it."""
+    parameters: ParameterSet
+    ensemble: list[dict[str, float]]
+
+
 def parameter_sets(parameters, model: str | BushingModel | None = None) -> tuple[BushingModel, list[dict[str, float]]]:
     """The model and the validated parameter sets (best first) of any accepted ``parameters``.
 
@@ -26,7 +35,7 @@ def parameter_sets(parameters, model: str | BushingModel | None = None) -> tuple
     ``TypeError`` for anything else.
     """
     expected = resolve_model(model) if model is not None else None
-    if hasattr(parameters, "ensemble") and hasattr(parameters, "parameters") and hasattr(parameters, "misfit"):
+    if isinstance(parameters, FittedParameters):
         bushing, sets = parameters.parameters.model, parameters.ensemble          # a FitResult
     elif isinstance(parameters, (str, Path)):
         ensemble = read_ensemble(parameters)
