@@ -30,10 +30,9 @@ import time
 import zipfile
 from pathlib import Path
 
+from fmu_src.fmi.native.build import FLAGS, WARNINGS
+
 REPO = Path(__file__).resolve().parents[1]
-# the build's warning and optimisation flags (fmu_src/fmi/native/build.py: WARNINGS, FLAGS)
-FLAGS = ("-std=c99", "-pedantic", "-Wall", "-Wextra", "-Werror", "-O3", "-fPIC", "-ffp-contract=off",
-         "-fvisibility=hidden")
 TOKEN = re.compile(rb'(?:guid|instantiationToken)="(\{[^"]+\})"')
 
 
@@ -67,7 +66,7 @@ def object_dump(fmu: Path, compiler: str, folder: Path) -> str:
                 path = folder / name
                 path.parent.mkdir(parents=True, exist_ok=True)
                 path.write_bytes(archive.read(name).replace(token, b"{" + b"0" * (len(token) - 2) + b"}"))
-    subprocess.run([compiler, *FLAGS, "-c", "-I", str(folder / "sources"), "-o", str(folder / "unit.o"),
+    subprocess.run([compiler, *WARNINGS, *FLAGS, "-c", "-I", str(folder / "sources"), "-o", str(folder / "unit.o"),
                     str(folder / "sources" / f"{identifier}.c")], check=True)
     dump = compiler.replace("gcc", "objdump") if "mingw" in compiler else "objdump"
     text = subprocess.run([dump, "-d", "-r", "-s", str(folder / "unit.o")], capture_output=True, text=True,

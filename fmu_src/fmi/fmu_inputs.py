@@ -26,6 +26,15 @@ class BuildError(RuntimeError):
     """An FMU that cannot be built as asked (a missing default set, an FMU that fails validation)."""
 
 
+def check_valid(fmu: Path) -> Path:
+    """``fmu`` if fmpy's validation finds no problem in it, else BuildError naming each problem."""
+    from fmpy.validation import validate_fmu
+    problems = validate_fmu(str(fmu))
+    if problems:
+        raise BuildError(f"{fmu} fails validation:\n  " + "\n  ".join(problems))
+    return fmu
+
+
 def is_six_axis(model: str) -> bool:
     """Whether ``model`` names the six-axis FMU (by its name or its identifier)."""
     return model in (SIX_AXIS, SIX_AXIS_IDENTIFIER)

@@ -29,7 +29,7 @@ from xml.etree import ElementTree as ET
 from .. import __version__
 from ..model.registry import DEFAULT_MODEL
 from . import model_description
-from .fmu_inputs import BuildError, fmu_axes, groups_of
+from .fmu_inputs import BuildError, check_valid, fmu_axes, groups_of
 
 SOURCE_DIR = Path(__file__).resolve().parents[1]
 SLAVE_MODULE = "fmi/pythonfmu_slave.py"
@@ -86,7 +86,6 @@ def build_fmu(params_file: str | Path | None = None, out_dir: str | Path = "dist
     BuildError
         The FMU fails fmpy's validation; ``ParameterError`` for an invalid parameter file.
     """
-    from fmpy.validation import validate_fmu
     from pythonfmu import builder
     from pythonfmu.builder import FmuBuilder
     pythonfmu_folder = Path(builder.__file__).parent
@@ -134,10 +133,7 @@ def build_fmu(params_file: str | Path | None = None, out_dir: str | Path = "dist
                 del sys.modules[loaded]
 
     _write_model_description(fmu_path, identifier, axes, groups_of(defaults_json))
-    problems = validate_fmu(str(fmu_path))
-    if problems:
-        raise BuildError(f"{fmu_path} fails validation:\n  " + "\n  ".join(problems))
-    return fmu_path
+    return check_valid(fmu_path)
 
 
 def _write_model_description(fmu_path: Path, identifier: str, axes: list, groups=()) -> None:

@@ -29,7 +29,7 @@ from pathlib import Path
 
 from ...model.registry import DEFAULT_MODEL
 from .. import model_description
-from ..fmu_inputs import BuildError, fmu_axes, groups_of
+from ..fmu_inputs import check_valid, fmu_axes, groups_of
 from . import macho, platforms as toolchains
 from .generate import model_source
 
@@ -131,11 +131,12 @@ def missing_platforms(fmi_version: int, platforms: tuple[str, ...] | None = None
     """{platform: why it cannot be built here} of ``platforms`` (default: every platform) of an FMI
     ``fmi_version`` FMU; empty when every compiler is installed."""
     known = platform_names(fmi_version)
+    table = toolchains.platforms_of(fmi_version)
     missing = {}
     for name in platforms or known:
         if name not in known:
             raise NativeBuildError(f"unknown platform {name!r} for FMI {fmi_version}; choose from {', '.join(known)}")
-        if why := toolchains.missing(toolchains.platforms_of(fmi_version)[name]):
+        if why := toolchains.missing(table[name]):
             missing[name] = why
     return missing
 
@@ -212,12 +213,9 @@ def build_native_fmu(params_file: str | Path | None = None, out_dir: str | Path 
     BuildError
         The FMU fails fmpy's validation; ``ParameterError`` for an invalid parameter file.
     """
-    from fmpy.validation import validate_fmu
     identifier, _, axes, document = fmu_axes(params_file, model)
     build = build_native(axes, identifier, out_dir, fmi_version, platforms, groups_of(document))
-    problems = validate_fmu(str(build.path))
-    if problems:
-        raise BuildError(f"{build.path} fails validation:\n  " + "\n  ".join(problems))
+    check_valid(build.path)
     return build
 
 
