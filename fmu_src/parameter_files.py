@@ -28,6 +28,7 @@ from pathlib import Path
 from typing import Mapping
 from xml.etree import ElementTree as ET
 
+from .fmi.runtime_messages import MESSAGES
 from .fmi.axes import ONE_AXIS, SIX_AXES, SIX_AXIS_IDENTIFIER, SIX_AXIS_NAMES, Coupling, model_on_axis
 from .model.registry import BushingModel, DEFAULT_MODEL, MODELS, get_model
 from .model.parameter_specs import UNIT_SYSTEM, ParameterError
@@ -405,9 +406,8 @@ def check_groups(coupling: Coupling, axes: Mapping[str, ParameterSet], where: st
         for name in (model.coupled.zero_parameters if model.coupled is not None else ()):
             value = sets[group[0]].parameters[name]
             if value != 0.0:
-                raise ParameterError(f"{label}: {name} = {value!r} [{model.units[name]}] must be 0 in a coupled "
-                                     "group (it has no direction in the plane); give the axes an offset and a "
-                                     "preload instead")
+                raise ParameterError(MESSAGES["GROUP_PARAMETER_NOT_ZERO"].text(
+                    label=f"{label}: ", name=name, value=repr(value), unit=model.units[name]))
 
 
 def _check_axis_names(path: Path, names: set[str]) -> None:

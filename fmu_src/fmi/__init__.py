@@ -4,7 +4,9 @@
 - ``variables``: the FMU's variables, declared once;
 - ``dependencies``: each output's dependencies, from the activity analysis of the kernels;
 - ``model_description``: modelDescription.xml, one writer for both FMUs (FMI 2 and 3);
-- ``pythonfmu_slave``: the pythonfmu adapter and its error policy;
+- ``runtime_messages``: the runtime policy's words, every message both FMUs log, defined once
+  (the C's ``bushing_messages.h`` is generated from it);
+- ``pythonfmu_slave``: the pythonfmu adapter;
 - ``fmu_inputs``: a model and a parameter file read into what the builders take;
 - ``pythonfmu_package``: the pythonfmu FMU (the slave and ``fmu_src`` packed by pythonfmu);
 - ``release``: the release bundle (its README from ``release_readme.txt``);

@@ -37,7 +37,7 @@ PACKED_LIBRARY_INIT = '''"""Packed library of the bushing FMU (written by build_
 from pathlib import Path
 
 from . import parameter_files
-from .fmi import axes, variables
+from .fmi import axes, runtime_messages, variables
 from .kernels import numba_binding
 from .model import integration
 

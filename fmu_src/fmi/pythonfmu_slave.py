@@ -47,7 +47,7 @@ from pythonfmu.enums import Fmi2Status
 # (fmpy's simulate_fmu does). So module-level code here must touch no files: the packed
 # library, imported once and then cached, reads the default parameters.
 if __package__:
-    from . import axes, variables
+    from . import axes, runtime_messages, variables
     from ..model import integration
     AXES = None   # only an FMU built by build_fmu.py has axes, models and defaults
     GROUPS = ()
@@ -57,6 +57,7 @@ else:
     _library = importlib.import_module(__name__ + "_lib")
     axes = _library.axes
     integration = _library.integration
+    runtime_messages = _library.runtime_messages
     variables = _library.variables
     AXES = _library.AXES   # [(axes.Axis, BushingModel on that axis, default parameters)]
     GROUPS = _library.GROUPS   # coupled groups: tuples of positions in AXES
@@ -66,9 +67,19 @@ else:
 np = importlib.import_module("numpy") if STEP_AXES else None
 
 
+MESSAGES = runtime_messages.MESSAGES   # the runtime policy's words, shared with the native FMU
+TEXTS = runtime_messages.TEXTS
+
 # Jumping inputs (integration.JUMP_*, which say why; logging only, the force is the same)
 JUMP_WINDOW, JUMP_COUNT = integration.JUMP_WINDOW, integration.JUMP_COUNT
 _JUMP_MASK = (1 << JUMP_WINDOW) - 1
+
+
+def _inputs_text(*members) -> str:
+    """The inputs of ``members`` (``_AxisState``) in a message, port units (``runtime_messages.INPUTS``)."""
+    return ", ".join(runtime_messages.INPUTS.format(
+        displacement=a.axis.displacement, x=a.x, x_unit=a.axis.displacement_unit, velocity=a.axis.velocity, v=a.v,
+        v_unit=a.axis.velocity_unit) for a in members)
 
 
 class InitializationError(RuntimeError):
@@ -257,8 +268,8 @@ class BushingSlave(Fmi2Slave):
             a.parameters_changed = self._parameters_changed = True
             self._outputs_stale(a)
             if not math.isfinite(value):
-                self._error(f"{a.axis.label}parameter {name} = {value} [{a.units[name]}] is not "
-                            "a finite number; the next doStep will be refused until it is")
+                self._say("PARAMETER_SET_NOT_FINITE", label=a.axis.label, name=name, value=value,
+                          unit=a.units[name])
             elif name == "offset":
                 # the model's displacement moves with the offset (a displacement jump if it
                 # changes during the run, which the dashpots carry)
@@ -272,25 +283,17 @@ class BushingSlave(Fmi2Slave):
         a.x_now = value * a.to_kernel - a.offset
         self._outputs_stale(a)
         if not math.isfinite(value):
-            self._error(f"input {axis.displacement} = {value} {axis.displacement_unit} is not a finite number; "
-                        "the next doStep will be refused")
+            self._say("INPUT_SET_NOT_FINITE", port=axis.displacement, value=value, unit=axis.displacement_unit)
         elif abs(value) > a.travel_limit and not a.travel_warned:
             a.travel_warned = True
-            if axis.rotational:
-                message = (f"input {axis.displacement} = {value} rad exceeds {axis.plausible_travel} rad: the "
-                           "bushing takes rotations as small angles (each component of the rotation vector about "
-                           "its own axis), which is approximate beyond about 20 degrees")
-            else:
-                message = (f"input {axis.displacement} = {value} m exceeds {axis.plausible_travel} m, far beyond a "
-                           f"bushing's travel; the FMU takes metres (2 mm is {axis.displacement} = 0.002)")
-            self.log(message, Fmi2Status.warning, "logStatusWarning")
+            self._say("ROTATION_BEYOND_SMALL_ANGLES" if axis.rotational else "DISPLACEMENT_BEYOND_TRAVEL",
+                      port=axis.displacement, value=value, limit=axis.plausible_travel)
 
     def _set_velocity(self, a, value):
         a.v = value
         self._outputs_stale(a)
         if not math.isfinite(value):
-            self._error(f"input {a.axis.velocity} = {value} {a.axis.velocity_unit} is not a finite number; "
-                        "the next doStep will be refused")
+            self._say("INPUT_SET_NOT_FINITE", port=a.axis.velocity, value=value, unit=a.axis.velocity_unit)
 
     def _output(self, a):
         """The axis's output at the current time and displacement. If the displacement was set
@@ -313,21 +316,25 @@ class BushingSlave(Fmi2Slave):
                 a.output_is_current = True
                 a.stale_output_logged = False
                 return output
-            reason = (f"it is not finite ({output}) at {a.axis.displacement} = {a.x} {a.axis.displacement_unit}, "
-                      f"{a.axis.velocity} = {a.v} {a.axis.velocity_unit}")
+            reason = TEXTS["NOT_FINITE_AT_INPUTS"]
         else:
-            reason = f"the parameters{' of axis ' + a.axis.name if a.axis.name else ''} are invalid (see the errors above)"
-        if not a.stale_output_logged:   # once until a current output can be computed again
+            reason = TEXTS["PARAMETERS_INVALID"]
+        return self._stale_output(a, reason)
+
+    def _stale_output(self, a, reason):
+        """The axis's last finite output, after saying once (until a current one can be computed
+        again) why it cannot be computed now."""
+        if not a.stale_output_logged:
             a.stale_output_logged = True
-            self._error(f"{a.axis.output} cannot be computed: {reason}; {a.axis.output} keeps its last finite "
-                        f"value {a.last_output} {a.axis.output_unit}")
+            self._say("OUTPUT_NOT_COMPUTABLE", output=a.axis.output, reason=reason, value=a.last_output,
+                      unit=a.axis.output_unit)
         return a.last_output
 
     def _group_output(self, a):
         """A coupled group member's output (``_output``): the group's force vector at the members'
         current inputs, through the displacement jump from the committed state."""
         group = a.group
-        reason = f"the parameters of {group.label[:-2]} are invalid (see the errors above)"
+        reason = TEXTS["PARAMETERS_INVALID"]
         if self._refresh_group(group):
             kernels = group.kernels
             x, v = group.inputs()
@@ -345,12 +352,8 @@ class BushingSlave(Fmi2Slave):
                     member.output_is_current = True
                     member.stale_output_logged = False
                 return a.last_output
-            reason = "it is not finite at the inputs set (check their units: the FMU takes metres and m/s)"
-        if not a.stale_output_logged:
-            a.stale_output_logged = True
-            self._error(f"{a.axis.output} cannot be computed: {reason}; {a.axis.output} keeps its last finite "
-                        f"value {a.last_output} {a.axis.output_unit}")
-        return a.last_output
+            reason = TEXTS["NOT_FINITE_AT_INPUTS"]
+        return self._stale_output(a, reason)
 
     def _refresh_group(self, group) -> bool:
         """Its members' parameters refreshed (``_refresh_parameters``) and equal: a group carries one
@@ -364,10 +367,9 @@ class BushingSlave(Fmi2Slave):
                          if any(a.values[name] != first.values[name] for a in group.members[1:])]
             group.errors = []
             if usable and differing:
-                group.errors = [group.label + "; ".join(
-                    ", ".join(f"{a.axis.name}.{name} = {a.values[name]}" for a in group.members)
-                    + f" [{first.units[name]}]" for name in differing)
-                    + " differ: the axes of a coupled group carry one parameter set (set them alike)"]
+                values = "; ".join(", ".join(f"{a.axis.name}.{name} = {a.values[name]}" for a in group.members)
+                                   + f" [{first.units[name]}]" for name in differing)
+                group.errors = [MESSAGES["GROUP_PARAMETERS_DIFFER"].text(label=group.label, values=values)]
                 self._error(group.errors[0])
             group.usable = usable and not differing
             group.constants = first.constants if group.usable else None
@@ -391,10 +393,10 @@ class BushingSlave(Fmi2Slave):
         step). fmi2Discard would not do: fmpy ends the run silently on it. pythonfmu passes log
         messages to the host only with debug logging on, so the reasons also go to stderr."""
         reasons = [a.axis.label + error for a in self._axes for error in a.last_errors] \
-            + [error for group in self._groups for error in group.errors] or ["the parameters are invalid"]
+            + [error for group in self._groups for error in group.errors] or [TEXTS["PARAMETERS_INVALID"]]
         for message in reasons:
             print(f"{self.instance_name}: {message}", file=sys.stderr)
-        self._error("the simulation cannot start: " + "; ".join(reasons))
+        self._say("CANNOT_START", reasons="; ".join(reasons))
         # pythonfmu 0.7 releases the instance, its class and its log queue once when an
         # exception is raised and once more when the instance is freed (PySlaveInstance's
         # cleanPyObject, twice): freeing a failed instance then corrupts memory and crashes the
@@ -421,7 +423,7 @@ class BushingSlave(Fmi2Slave):
 
     def do_step(self, current_time, step_size):
         if not 0.0 < step_size < math.inf:
-            return self._refuse(f"communication step size {step_size} s must be a finite number > 0")
+            return self._say("STEP_SIZE_INVALID", value=step_size)
         if self._parameters_changed or not self._parameters_usable:
             self._parameters_changed = False
             self._parameters_usable = all([self._refresh_parameters(a) for a in self._single]
@@ -429,7 +431,7 @@ class BushingSlave(Fmi2Slave):
         if not self._parameters_usable:
             if self._initial_state_pending:   # never started: nothing a master can do in the run
                 self._fail_to_start()
-            return self._refuse("doStep refused: the parameters are invalid (see the errors above)")
+            return self._say("STEP_PARAMETERS_INVALID", reason=TEXTS["PARAMETERS_INVALID"])
         # one sum is finite if every input is (and a huge but finite sum just takes the long way)
         if not math.isfinite(sum([a.x for a in self._axes] + [a.v for a in self._axes])):
             for a in self._axes:
@@ -437,7 +439,7 @@ class BushingSlave(Fmi2Slave):
                 if not (math.isfinite(a.x) and math.isfinite(a.v)):
                     name, value, unit = ((axis.displacement, a.x, axis.displacement_unit) if not math.isfinite(a.x)
                                          else (axis.velocity, a.v, axis.velocity_unit))
-                    return self._refuse(f"doStep refused: input {name} = {value} {unit} is not a finite number")
+                    return self._say("STEP_INPUT_NOT_FINITE", port=name, value=value, unit=unit)
         if self._initial_state_pending:  # the values at initialization could not be used
             self._set_initial_state()
         # every axis first, then commit all: a refusal leaves every axis as it was
@@ -482,52 +484,59 @@ class BushingSlave(Fmi2Slave):
         ``_step_axis`` gives it, its state None]) of one coupled group's step, or None after logging
         why it cannot be taken."""
         x, v = group.inputs()
-        label = group.label
+        label, outputs = group.label, ()
         try:
             state, _, status = group.kernels.step(group.constants, group.state, group.state_x, x, v, step_size,
                                                   integration.DEFAULT_MAX_SUBSTEPS)
             x_end = tuple(x[i] + v[i] * step_size for i in range(3))
-            forces = group.kernels.force(group.constants, state, x_end, v) if status == integration.OK else None
+            if status == integration.OK:
+                forces = group.kernels.force(group.constants, state, x_end, v)
+                outputs = [forces[c] * a.from_kernel + a.preload_port for c, a in enumerate(group.members)]
         except (ArithmeticError, ValueError) as exc:
-            status, forces, x_end = integration.NOT_FINITE, None, x
-            label += f"the step overflowed ({exc}); "
-        inputs = ", ".join(f"{a.axis.displacement} = {a.x} {a.axis.displacement_unit}, {a.axis.velocity} = {a.v} "
-                           f"{a.axis.velocity_unit}" for a in group.members)
-        if status == integration.TOO_MANY_SUBSTEPS:
-            return self._refuse(f"doStep at t = {current_time} s refused: {label}the step of {step_size:g} s would "
-                                f"need more than {integration.DEFAULT_MAX_SUBSTEPS} substeps ({inputs}); check the "
-                                "units of the inputs (the FMU takes metres and m/s) or shorten the communication "
-                                "step") or None
-        if status != integration.OK or not all(math.isfinite(f) for f in forces):
-            return self._refuse(f"doStep at t = {current_time} s refused: {label}the step gave a non-finite state or "
-                                f"force ({inputs}); check the units of the inputs (the FMU takes metres and m/s) "
-                                "and the parameters") or None
-        members = [(a, None, x_end[c], forces[c] * a.from_kernel + a.preload_port, False)
-                   for c, a in enumerate(group.members)]
+            status, label = integration.NOT_FINITE, label + f"the step overflowed ({exc}); "
+        if self._step_refused(status, outputs, label, group.members, current_time, step_size):
+            return None
+        members = [(a, None, x_end[c], outputs[c], False) for c, a in enumerate(group.members)]
         return (state, x_end), members
 
     def _step_axis(self, a, current_time, step_size):
         """(axis, new state, displacement at the end, output, False: its jumps not yet counted) of
         one axis's step, or None after logging why it cannot be taken."""
-        axis = a.axis
         x, v = a.x_now, a.v * a.to_kernel
-        if a.step_one is not None:   # compiled: one call (the same kernels as advance and force)
+        if a.step_one is not None:   # compiled: one call (the same kernels as model.step and force)
             state, output, x_end, status = a.step_one(a.params_row, a.state, a.state_x, x, v, step_size,
                                                       integration.DEFAULT_MAX_SUBSTEPS)
             output = output * a.from_kernel + a.preload_port
             if status == integration.OK and math.isfinite(output):
                 return a, state, x_end, output, False
+        label, output, x_end = a.axis.label, math.nan, x + v * step_size
         try:
-            state, _ = integration.advance(a.model, a.constants, a.state, a.state_x, x, v, step_size)
-        except integration.StepError as exc:
-            return self._refuse(f"doStep at t = {current_time} s refused: {axis.label}{exc}") or None
-        x_end = x + v * step_size
-        output = a.model.force(a.constants, state, x_end, v) * a.from_kernel + a.preload_port
-        if not math.isfinite(output):
-            return self._refuse(f"doStep at t = {current_time} s refused: {axis.output} would be {output} "
-                                f"{axis.output_unit} ({axis.displacement} = {a.x} {axis.displacement_unit}, "
-                                f"{axis.velocity} = {a.v} {axis.velocity_unit}); check the units of the inputs") or None
+            state, _, status = a.model.step(a.constants, a.state, a.state_x, x, v, step_size,
+                                            integration.DEFAULT_MAX_SUBSTEPS)
+            if status == integration.OK:
+                output = a.model.force(a.constants, state, x_end, v) * a.from_kernel + a.preload_port
+        except (ArithmeticError, ValueError) as exc:
+            status, label = integration.NOT_FINITE, label + f"the step overflowed ({exc}); "
+        if self._step_refused(status, (output,), label, (a,), current_time, step_size):
+            return None
         return a, state, x_end, output, False
+
+    def _step_refused(self, status, outputs, label, members, current_time, step_size) -> bool:
+        """Whether the step of ``members`` (one axis, or a coupled group's) failed (``status``, a
+        kernel's, or an output not finite); if so, why is logged, naming the inputs."""
+        if status == integration.OK and all(math.isfinite(output) for output in outputs):
+            return False
+        inputs = _inputs_text(*members)
+        if status == integration.TOO_MANY_SUBSTEPS:
+            self._say("STEP_TOO_MANY_SUBSTEPS", time=current_time, label=label, h=step_size,
+                      max_substeps=integration.DEFAULT_MAX_SUBSTEPS, inputs=inputs)
+        elif status != integration.OK:
+            self._say("STEP_NOT_FINITE", time=current_time, label=label, inputs=inputs)
+        else:
+            a, output = next((a, output) for a, output in zip(members, outputs) if not math.isfinite(output))
+            self._say("STEP_OUTPUT_NOT_FINITE", time=current_time, label=label, output=a.axis.output, value=output,
+                      unit=a.axis.output_unit, inputs=inputs)
+        return True
 
     def _step_compiled(self, step_size):
         """(steps, [(batch, the first axis whose jumps crossed JUMP_COUNT or -1)]): every axis's
@@ -558,27 +567,18 @@ class BushingSlave(Fmi2Slave):
         count = history.bit_count()
         self._jump_warned = True
         axis = a.axis
-        unit = axis.displacement_unit
-        self.log(f"{axis.label}the displacement input {axis.displacement} jumps in {count} of the last "
-                 f"{JUMP_WINDOW} steps (at t = {current_time:.6g} s by {mismatch / a.to_kernel:.3g} {unit} per "
-                 f"step against |{axis.velocity}|*h = {travel / a.to_kernel:.3g} {unit}): {axis.velocity} is "
-                 f"probably not the time derivative of the sampled {axis.displacement}, and the dashpots carry "
-                 f"every jump; build the input with identification.fmu_input (a continuous path, "
-                 f"{axis.velocity} = the secant velocity of {axis.displacement}) or set {axis.velocity} = "
-                 f"({axis.displacement}(t + h) - {axis.displacement}(t))/h",
-                 Fmi2Status.warning, "logStatusWarning")
+        self._say("DISPLACEMENT_JUMPS", label=axis.label, port=axis.displacement, count=count, window=JUMP_WINDOW,
+                  time=current_time, mismatch=mismatch / a.to_kernel, unit=axis.displacement_unit,
+                  velocity=axis.velocity, travel=travel / a.to_kernel)
 
     def _warn_implausible(self, a, output, time):
         """Warn, once per axis, of an output above the plausible bound (units most likely wrong)."""
         a.output_warned = True
         axis = a.axis
-        speed = ("rotation and angular velocity" if axis.rotational else "travel and speed")
-        self.log(f"{axis.output} = {output:.4g} {axis.output_unit} at t = {time} s exceeds "
-                 f"{a.output_bound:.3g} {axis.output_unit}, the {'moment' if axis.rotational else 'force'} of "
-                 f"all the bushing's springs and dashpots at the largest plausible {speed}: check the units of "
-                 f"the inputs ({axis.displacement} = {a.x} {axis.displacement_unit}, {axis.velocity} = {a.v} "
-                 f"{axis.velocity_unit}; the FMU takes {'radians' if axis.rotational else 'metres'})",
-                 Fmi2Status.warning, "logStatusWarning")
+        kind = "ROTATIONAL" if axis.rotational else "TRANSLATIONAL"
+        self._say("OUTPUT_IMPLAUSIBLE", output=axis.output, value=output, unit=axis.output_unit, time=time,
+                  bound=a.output_bound, quantity=TEXTS["QUANTITY_" + kind], motion=TEXTS["MOTION_" + kind],
+                  inputs=_inputs_text(a), units=TEXTS["UNITS_" + kind])
 
     def _refresh_parameters(self, a) -> bool:
         """Validate and prepare an axis's parameters once after they change, logging errors and
@@ -610,8 +610,14 @@ class BushingSlave(Fmi2Slave):
     def _error(self, message):
         self.log(message, Fmi2Status.error, "logStatusError")
 
-    def _refuse(self, message) -> bool:
-        self._error(message)
+    def _say(self, key, /, **fields) -> bool:
+        """Log the runtime policy's message ``key`` (``runtime_messages.MESSAGES``) with ``fields``
+        filled in, at its level; False, a refused step's answer."""
+        message = MESSAGES[key]
+        if message.level == "warning":
+            self.log(message.text(**fields), Fmi2Status.warning, "logStatusWarning")
+        else:
+            self._error(message.text(**fields))
         return False
 
     # ---------------------------------------------------------------- FMU state

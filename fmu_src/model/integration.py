@@ -662,16 +662,13 @@ def advance(model, constants, state, state_x: float, x: float, v: float, h: floa
         new, used, status = model.step(constants, state, state_x, x, v, h, max_substeps)
     except (OverflowError, ZeroDivisionError, ValueError) as exc:
         raise StepError(f"the step overflowed ({exc}) at x = {x:g} mm, v = {v:g} mm/s, "
-                        f"state = {tuple(state)}; check the units of the inputs "
-                        "(the FMU takes metres and m/s) and the parameters") from None
+                        f"state = {tuple(state)}: are x [mm], v [mm/s] and the parameters in their units?") from None
     if status == TOO_MANY_SUBSTEPS:
-        raise StepError(f"the step of {h:g} s would need more than {max_substeps} substeps "
-                        f"(x = {x:g} mm, v = {v:g} mm/s); check the units of the inputs "
-                        "(the FMU takes metres and m/s) or shorten the communication step")
+        raise StepError(f"more than {max_substeps} substeps needed for a step of {h:g} s at x = {x:g} mm, "
+                        f"v = {v:g} mm/s: are x and v in mm and mm/s, or is the step too long?")
     if status == NOT_FINITE:
-        raise StepError(f"the step gave a non-finite state {tuple(new)} at x = {x:g} mm, "
-                        f"v = {v:g} mm/s; check the units of the inputs (the FMU takes metres "
-                        "and m/s) and the parameters")
+        raise StepError(f"the state {tuple(new)} at x = {x:g} mm, v = {v:g} mm/s is not finite: are x [mm], "
+                        "v [mm/s] and the parameters in their units?")
     return new, used
 
 
@@ -685,6 +682,5 @@ def apply_displacement_jump(model, constants, state, jump_mm: float) -> tuple:
         return tuple(state)
     new, status = model.jump(constants, state, jump_mm)
     if status != OK:
-        raise StepError(f"a displacement jump of {jump_mm:g} mm needs too many substeps; "
-                        "check the units of the inputs (the FMU takes metres)")
+        raise StepError(f"a displacement jump of {jump_mm:g} mm needs too many substeps: is it in mm?")
     return new

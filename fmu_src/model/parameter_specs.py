@@ -21,6 +21,15 @@ from .units import UnitError, si_form
 UNIT_SYSTEM = "N-mm-s"
 
 
+# The rules' words (``str.format`` templates), which the FMUs' runtimes log too (``fmi.runtime_messages``).
+NOT_FINITE = "{name} = {value} [{unit}] must be a finite number"
+OUT_OF_RANGE = "{name} = {value} [{unit}] must be {allowed}{why}"
+"""``why``: the spec's reason in parentheses after a space, or nothing."""
+CONSTRAINT_BROKEN = "{expression} = {value}{unit} must be {condition} ({why})"
+"""``unit``: a space and the constraint's unit, or nothing; ``condition``: '> 0', '>= 1' …"""
+CONSTRAINT_DOUBTFUL = "{expression} = {value}{unit} violates {why} {expression} {condition}"
+
+
 @dataclass(frozen=True)
 class ParameterSpec:
     """A parameter's name, unit, meaning and allowed range: ``minimum`` and ``maximum`` (None: no
@@ -62,7 +71,8 @@ class ParameterSpec:
         below = self.maximum is None or (value < self.maximum if self.exclusive else value <= self.maximum)
         if above and below:
             return None
-        return f"{self.name} = {value} [{self.unit}] must be {self.allowed}" + (f" ({self.why})" if self.why else "")
+        return OUT_OF_RANGE.format(name=self.name, value=value, unit=self.unit, allowed=self.allowed,
+                                   why=f" ({self.why})" if self.why else "")
 
 
 @dataclass(frozen=True)
@@ -100,11 +110,9 @@ class Constraint:
         value = self.value(p)
         if value > self.bound if self.strict else value >= self.bound:
             return None
-        condition = f"{'>' if self.strict else '>='} {self.bound:g}"
-        unit = f" {self.unit}" if self.unit else ""
-        if self.error:
-            return f"{self.expression} = {value}{unit} must be {condition} ({self.why})"
-        return f"{self.expression} = {value}{unit} violates {self.why} {self.expression} {condition}"
+        fields = dict(expression=self.expression, value=value, unit=f" {self.unit}" if self.unit else "",
+                      condition=f"{'>' if self.strict else '>='} {self.bound:g}", why=self.why)
+        return (CONSTRAINT_BROKEN if self.error else CONSTRAINT_DOUBTFUL).format(**fields)
 
 
 SPRING = dict(minimum=0.0, why="a negative spring is unstable")
@@ -130,7 +138,7 @@ def number_errors(params: Mapping[str, float], units: Mapping[str, str], model_l
         if not isinstance(value, (int, float)) or isinstance(value, bool):
             errors.append(f"{name} = {value!r} is not a number (unit {unit})")
         elif not math.isfinite(value):
-            errors.append(f"{name} = {value} [{unit}] must be a finite number")
+            errors.append(NOT_FINITE.format(name=name, value=value, unit=unit))
     return errors
 
 

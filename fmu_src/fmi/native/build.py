@@ -10,8 +10,8 @@ Layout of the FMU::
     binaries/<platform>/<id>.so | .dll | .dylib     (platforms.PLATFORMS: linux64, win64, darwin64,
                                                      aarch64-linux; FMI 3: x86_64-linux, ...)
     sources/<id>.c            the one translation unit: includes the files below
-    sources/bushing_fmu.h, bushing_model.c (generated), bushing_instance.c, fmi2_functions.c
-            (or fmi3_functions.c), and the FMI headers
+    sources/bushing_fmu.h, bushing_model.c and bushing_messages.h (generated), bushing_instance.c,
+            fmi2_functions.c (or fmi3_functions.c), and the FMI headers
     sources/buildDescription.xml                                (FMI 3)
 
 The FMI 2 headers are fmpy's copy; the FMI 3 ones are the standard's 3.0.1 headers, kept in ``c/``
@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ...model.registry import DEFAULT_MODEL
-from .. import model_description
+from .. import model_description, runtime_messages
 from ..fmu_inputs import check_valid, fmu_axes, groups_of
 from . import macho, platforms as toolchains
 from .generate import model_source
@@ -76,6 +76,7 @@ def write_sources(folder: Path, axis_models, identifier: str, fmi_version: int, 
     folder.mkdir(parents=True, exist_ok=True)
     generated = model_source(axis_models, identifier, groups)
     (folder / "bushing_model.c").write_text(generated.source)
+    (folder / "bushing_messages.h").write_text(runtime_messages.c_header())
     functions = f"fmi{fmi_version}_functions.c"
     for name in (*HAND_WRITTEN, functions):
         shutil.copy2(C_LAYER / name, folder / name)
@@ -84,7 +85,8 @@ def write_sources(folder: Path, axis_models, identifier: str, fmi_version: int, 
         shutil.copy2(headers / name, folder / name)
     (folder / f"{identifier}.c").write_text(
         f"/* The native FMU {identifier}: one translation unit (see bushing_fmu.h). */\n"
-        '#include "bushing_fmu.h"\n#include "bushing_model.c"\n#include "bushing_instance.c"\n'
+        '#include "bushing_fmu.h"\n#include "bushing_model.c"\n#include "bushing_messages.h"\n'
+        '#include "bushing_instance.c"\n'
         f'#include "{functions}"\n')
     return generated
 

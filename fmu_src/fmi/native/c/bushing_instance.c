@@ -164,7 +164,7 @@ static int bw_check_group(bw_instance *inst, int g) {
     const bw_group_spec *spec = &bw_group_specs[g];
     const bw_model *model = bw_axis_specs[spec->axis[0]].model;
     const bw_axis *first = &inst->data.axes[spec->axis[0]];
-    char a[40], b[40];
+    char a[40], b[40], values[256];
     int i, c, equal = 1;
     for (i = 0; i < model->parameters; i++) {
         for (c = 1; c < spec->members; c++) {
@@ -172,10 +172,10 @@ static int bw_check_group(bw_instance *inst, int g) {
             if (other->parameters[i] == first->parameters[i]) continue;
             bw_format_double(a, sizeof a, first->parameters[i]);
             bw_format_double(b, sizeof b, other->parameters[i]);
-            bw_log(inst, BW_ERROR, "logStatusError", "%s%s.%s = %s, %s.%s = %s [%s] differ: the axes of a coupled "
-                   "group carry one parameter set (set them alike)", spec->label, bw_axis_specs[spec->axis[0]].name,
-                   model->specs[i].name, a, bw_axis_specs[spec->axis[c]].name, model->specs[i].name, b,
-                   model->specs[i].unit);
+            snprintf(values, sizeof values, "%s.%s = %s, %s.%s = %s [%s]", bw_axis_specs[spec->axis[0]].name,
+                     model->specs[i].name, a, bw_axis_specs[spec->axis[c]].name, model->specs[i].name, b,
+                     model->specs[i].unit);
+            BW_MESSAGE_GROUP_PARAMETERS_DIFFER(inst, spec->label, values);
             equal = 0;
         }
     }
@@ -183,9 +183,7 @@ static int bw_check_group(bw_instance *inst, int g) {
         int k = model->coupled->zero_parameter[i];
         if (first->parameters[k] == 0.0) continue;
         bw_format_double(a, sizeof a, first->parameters[k]);
-        bw_log(inst, BW_ERROR, "logStatusError", "%s%s = %s [%s] must be 0 in a coupled group (it has no direction "
-               "in the plane); give the axes an offset and a preload instead", spec->label, model->specs[k].name, a,
-               model->specs[k].unit);
+        BW_MESSAGE_GROUP_PARAMETER_NOT_ZERO(inst, spec->label, model->specs[k].name, a, model->specs[k].unit);
         equal = 0;
     }
     return equal;
@@ -204,8 +202,7 @@ static int bw_check_axis(bw_instance *inst, int a) {
         double x = axis->parameters[i];
         if (!isfinite(x)) {
             bw_format_double(value, sizeof value, x);
-            bw_log(inst, BW_ERROR, "logStatusError", "%s%s = %s [%s] must be a finite number", spec->label, p->name,
-                   value, p->unit);
+            BW_MESSAGE_PARAMETER_NOT_FINITE(inst, spec->label, p->name, value, p->unit);
             errors++;
         }
     }
@@ -216,23 +213,24 @@ static int bw_check_axis(bw_instance *inst, int a) {
             int above = !p->has_minimum || (p->exclusive ? x > p->minimum : x >= p->minimum);
             int below = !p->has_maximum || (p->exclusive ? x < p->maximum : x <= p->maximum);
             if (!(above && below)) {
+                char why[160] = "";
+                if (p->why[0]) snprintf(why, sizeof why, " (%s)", p->why);
                 bw_format_double(value, sizeof value, x);
-                bw_log(inst, BW_ERROR, "logStatusError", "%s%s = %s [%s] must be %s%s%s%s", spec->label, p->name,
-                       value, p->unit, p->allowed, p->why[0] ? " (" : "", p->why, p->why[0] ? ")" : "");
+                BW_MESSAGE_PARAMETER_OUT_OF_RANGE(inst, spec->label, p->name, value, p->unit, p->allowed, why);
                 errors++;
             }
         }
         for (i = 0; i < model->constraints; i++) {
             const bw_constraint *c = &model->constraint[i];
             double sum = 0.0;
-            char bound[40];
+            char bound[40], unit[40];
             for (t = 0; t < c->terms; t++) sum += c->coefficient[t] * axis->parameters[c->parameter[t]];
             if (c->strict ? sum > c->bound : sum >= c->bound) continue;
             bw_format_double(value, sizeof value, sum);
             snprintf(bound, sizeof bound, "%s %g", c->strict ? ">" : ">=", c->bound);
+            snprintf(unit, sizeof unit, "%s%s", c->unit[0] ? " " : "", c->unit);
             if (c->error) {
-                bw_log(inst, BW_ERROR, "logStatusError", "%s%s = %s%s%s must be %s (%s)", spec->label, c->expression,
-                       value, c->unit[0] ? " " : "", c->unit, bound, c->why);
+                BW_MESSAGE_CONSTRAINT_BROKEN(inst, spec->label, c->expression, value, unit, bound, c->why);
                 errors++;
             }
         }
@@ -242,13 +240,13 @@ static int bw_check_axis(bw_instance *inst, int a) {
     for (i = 0; i < model->constraints; i++) {
         const bw_constraint *c = &model->constraint[i];
         double sum = 0.0;
-        char bound[40];
+        char bound[40], unit[40];
         for (t = 0; t < c->terms; t++) sum += c->coefficient[t] * axis->parameters[c->parameter[t]];
         if (c->error || (c->strict ? sum > c->bound : sum >= c->bound)) continue;
         bw_format_double(value, sizeof value, sum);
         snprintf(bound, sizeof bound, "%s %g", c->strict ? ">" : ">=", c->bound);
-        bw_log(inst, BW_WARNING, "logStatusWarning", "%saccepted, but %s = %s%s%s violates %s %s %s", spec->label,
-               c->expression, value, c->unit[0] ? " " : "", c->unit, c->why, c->expression, bound);
+        snprintf(unit, sizeof unit, "%s%s", c->unit[0] ? " " : "", c->unit);
+        BW_MESSAGE_CONSTRAINT_DOUBTFUL(inst, spec->label, c->expression, value, unit, c->why, bound);
     }
     model->prepare(axis->parameters, &axis->constants);
     {   /* the plausible bound (BushingModel.plausible_force_bound), in port units */
@@ -377,15 +375,13 @@ static bw_status bw_exit_initialization(bw_instance *inst) {
             char value[40];
             int x_bad = !isfinite(axis->x);
             bw_format_double(value, sizeof value, x_bad ? axis->x : axis->v);
-            bw_log(inst, BW_ERROR, "logStatusError", "input %s = %s %s is not a finite number",
-                   x_bad ? spec->displacement : spec->velocity, value,
-                   x_bad ? (spec->rotational ? "rad" : "m") : (spec->rotational ? "rad/s" : "m/s"));
+            BW_MESSAGE_INPUT_SET_NOT_FINITE(inst, x_bad ? spec->displacement : spec->velocity, value,
+                                            x_bad ? (spec->rotational ? "rad" : "m") : (spec->rotational ? "rad/s" : "m/s"));
             usable = 0;
         }
     }
     if (!usable) {
-        bw_log(inst, BW_ERROR, "logStatusError", "the simulation cannot start: fix the values above and "
-               "instantiate again");
+        BW_MESSAGE_CANNOT_START(inst, BW_TEXT_FIX_AND_INSTANTIATE);
         return BW_ERROR;
     }
     bw_set_initial_state(inst);
@@ -412,9 +408,8 @@ static bw_status bw_set_parameter(bw_instance *inst, const bw_variable *var, dou
     if (!isfinite(value)) {
         char text[40];
         bw_format_double(text, sizeof text, value);
-        bw_log(inst, BW_ERROR, "logStatusError", "%sparameter %s = %s [%s] is not a finite number; the next doStep "
-               "will be refused until it is", spec->label, spec->model->specs[var->index].name, text,
-               spec->model->specs[var->index].unit);
+        BW_MESSAGE_PARAMETER_SET_NOT_FINITE(inst, spec->label, spec->model->specs[var->index].name, text,
+                                            spec->model->specs[var->index].unit);
     }
     return BW_OK;
 }
@@ -438,19 +433,14 @@ static bw_status bw_set_displacement(bw_instance *inst, int a, double value) {
     bw_inputs_changed(inst, a);
     if (!isfinite(value)) {
         bw_format_double(text, sizeof text, value);
-        bw_log(inst, BW_ERROR, "logStatusError", "input %s = %s %s is not a finite number; the next doStep will "
-               "be refused", spec->displacement, text, spec->rotational ? "rad" : "m");
+        BW_MESSAGE_INPUT_SET_NOT_FINITE(inst, spec->displacement, text, spec->rotational ? "rad" : "m");
     } else if (fabs(value) > spec->travel_limit && !axis->travel_warned) {
         axis->travel_warned = 1;
         bw_format_double(text, sizeof text, value);
         if (spec->rotational) {
-            bw_log(inst, BW_WARNING, "logStatusWarning", "input %s = %s rad exceeds %g rad: the bushing takes "
-                   "rotations as small angles (each component of the rotation vector about its own axis), which "
-                   "is approximate beyond about 20 degrees", spec->displacement, text, spec->travel_limit);
+            BW_MESSAGE_ROTATION_BEYOND_SMALL_ANGLES(inst, spec->displacement, text, spec->travel_limit);
         } else {
-            bw_log(inst, BW_WARNING, "logStatusWarning", "input %s = %s m exceeds %g m, far beyond a bushing's "
-                   "travel; the FMU takes metres (2 mm is %s = 0.002)", spec->displacement, text,
-                   spec->travel_limit, spec->displacement);
+            BW_MESSAGE_DISPLACEMENT_BEYOND_TRAVEL(inst, spec->displacement, text, spec->travel_limit);
         }
     }
     return BW_OK;
@@ -464,8 +454,7 @@ static bw_status bw_set_velocity(bw_instance *inst, int a, double value) {
     if (!isfinite(value)) {
         char text[40];
         bw_format_double(text, sizeof text, value);
-        bw_log(inst, BW_ERROR, "logStatusError", "input %s = %s %s is not a finite number; the next doStep will "
-               "be refused", spec->velocity, text, spec->rotational ? "rad/s" : "m/s");
+        BW_MESSAGE_INPUT_SET_NOT_FINITE(inst, spec->velocity, text, spec->rotational ? "rad/s" : "m/s");
     }
     return BW_OK;
 }
@@ -504,7 +493,7 @@ static int bw_group_outputs(bw_instance *inst, int g, double *outputs) {
 static double bw_output(bw_instance *inst, int a) {
     bw_axis *axis = &inst->data.axes[a];
     const bw_axis_spec *spec = &bw_axis_specs[a];
-    const char *reason = "the parameters are invalid (see the errors above)";
+    const char *reason = BW_TEXT_PARAMETERS_INVALID;
     int g = bw_axis_group[a];
     if (axis->output_is_current) return axis->last_output;
     if (g >= 0) {
@@ -520,7 +509,7 @@ static double bw_output(bw_instance *inst, int a) {
                 }
                 return axis->last_output;
             }
-            reason = "it is not finite at the inputs set (check their units: the FMU takes metres and m/s)";
+            reason = BW_TEXT_NOT_FINITE_AT_INPUTS;
         }
     } else if (bw_check_parameters(inst) || axis->usable) {
         double state[BW_MAX_STATES], output;
@@ -537,14 +526,13 @@ static double bw_output(bw_instance *inst, int a) {
             axis->stale_output_logged = 0;
             return output;
         }
-        reason = "it is not finite at the inputs set (check their units: the FMU takes metres and m/s)";
+        reason = BW_TEXT_NOT_FINITE_AT_INPUTS;
     }
     if (!axis->stale_output_logged) {
         char text[40];
         axis->stale_output_logged = 1;
         bw_format_double(text, sizeof text, axis->last_output);
-        bw_log(inst, BW_ERROR, "logStatusError", "%s cannot be computed: %s; %s keeps its last finite value %s %s",
-               spec->output, reason, spec->output, text, spec->rotational ? "N.m" : "N");
+        BW_MESSAGE_OUTPUT_NOT_COMPUTABLE(inst, spec->output, reason, text, spec->rotational ? "N.m" : "N");
     }
     return axis->last_output;
 }
@@ -609,6 +597,27 @@ static bw_status bw_refuse(bw_instance *inst, const char *format, ...) {
     return BW_DISCARD;
 }
 
+/* Axis a's inputs in port units (BW_TEXT_INPUTS) appended to text, after ", " if it holds some. */
+static void bw_append_inputs(const bw_instance *inst, int a, char *text, size_t size) {
+    const bw_axis_spec *spec = &bw_axis_specs[a];
+    const bw_axis *axis = &inst->data.axes[a];
+    size_t used = strlen(text);
+    char x[40], v[40];
+    bw_format_double(x, sizeof x, axis->x);
+    bw_format_double(v, sizeof v, axis->v);
+    if (used) snprintf(text + used, size - used, ", ");
+    used = strlen(text);
+    snprintf(text + used, size - used, BW_TEXT_INPUTS, spec->displacement, x, spec->rotational ? "rad" : "m",
+             spec->velocity, v, spec->rotational ? "rad/s" : "m/s");
+}
+
+/* Every member's inputs of group g, as bw_append_inputs writes them. */
+static void bw_group_inputs_text(const bw_instance *inst, int g, char *text, size_t size) {
+    int c;
+    text[0] = '\0';
+    for (c = 0; c < bw_group_specs[g].members; c++) bw_append_inputs(inst, bw_group_specs[g].axis[c], text, size);
+}
+
 /* Record whether axis a's step starts with a displacement jump (BW_DISPLACEMENT_JUMPED: the test
    integration.displacement_jumped, translated; before the step is committed) and warn, once per
    instance, when more than BW_JUMP_COUNT of its last BW_JUMP_WINDOW steps do (as pythonfmu_slave.py does). */
@@ -627,14 +636,8 @@ static void bw_count_jump(bw_instance *inst, int a, double current_time, double 
     if (count > BW_JUMP_COUNT) {
         const char *unit = spec->rotational ? "rad" : "m";
         inst->jump_warned = 1;
-        bw_log(inst, BW_WARNING, "logStatusWarning", "%sthe displacement input %s jumps in %d of the last %d steps "
-               "(at t = %.6g s by %.3g %s per step against |%s|*h = %.3g %s): %s is probably not the time derivative "
-               "of the sampled %s, and the dashpots carry every jump; build the input with "
-               "identification.fmu_input (a continuous path, %s = the secant velocity of %s) or set %s = "
-               "(%s(t + h) - %s(t))/h", spec->label, spec->displacement, count, BW_JUMP_WINDOW, current_time,
-               mismatch / spec->to_kernel, unit, spec->velocity, travel / spec->to_kernel, unit, spec->velocity,
-               spec->displacement, spec->velocity, spec->displacement, spec->velocity, spec->displacement,
-               spec->displacement);
+        BW_MESSAGE_DISPLACEMENT_JUMPS(inst, spec->label, spec->displacement, count, BW_JUMP_WINDOW, current_time,
+                                      mismatch / spec->to_kernel, unit, spec->velocity, travel / spec->to_kernel);
     }
 }
 
@@ -643,18 +646,18 @@ static void bw_count_jump(bw_instance *inst, int a, double current_time, double 
 static bw_status bw_do_step(bw_instance *inst, double current_time, double h) {
     double states[BW_AXES][BW_MAX_STATES], x_end[BW_AXES], outputs[BW_AXES];
     double group_states[BW_GROUP_SLOTS][BW_MAX_GROUP_STATES], group_x_end[BW_GROUP_SLOTS][3];
-    char t_text[40], h_text[40];      /* formatted only for a message: the step's hot path does no text */
+    char t_text[40], h_text[40], inputs[BW_MESSAGE];   /* formatted only for a message: the step's hot path does no text */
     int a, g;
     if (!(h > 0.0 && h < HUGE_VAL)) {
         bw_format_double(h_text, sizeof h_text, h);
-        return bw_refuse(inst, "communication step size %s s must be a finite number > 0", h_text);
+        return BW_MESSAGE_STEP_SIZE_INVALID(inst, h_text);
     }
     if (!bw_check_parameters(inst)) {
         if (inst->data.initial_state_pending) {
-            bw_error(inst, "%s", "the simulation cannot start: the parameters are invalid (see the errors above)");
+            BW_MESSAGE_CANNOT_START(inst, BW_TEXT_PARAMETERS_INVALID);
             return BW_ERROR;
         }
-        return bw_refuse(inst, "doStep refused: the parameters are invalid (see the errors above)");
+        return BW_MESSAGE_STEP_PARAMETERS_INVALID(inst, BW_TEXT_PARAMETERS_INVALID);
     }
     for (a = 0; a < BW_AXES; a++) {
         const bw_axis_spec *spec = &bw_axis_specs[a];
@@ -662,13 +665,11 @@ static bw_status bw_do_step(bw_instance *inst, double current_time, double h) {
         char value[40];
         if (!isfinite(axis->x)) {
             bw_format_double(value, sizeof value, axis->x);
-            return bw_refuse(inst, "doStep refused: input %s = %s %s is not a finite number", spec->displacement, value,
-                             spec->rotational ? "rad" : "m");
+            return BW_MESSAGE_STEP_INPUT_NOT_FINITE(inst, spec->displacement, value, spec->rotational ? "rad" : "m");
         }
         if (!isfinite(axis->v)) {
             bw_format_double(value, sizeof value, axis->v);
-            return bw_refuse(inst, "doStep refused: input %s = %s %s is not a finite number", spec->velocity, value,
-                             spec->rotational ? "rad/s" : "m/s");
+            return BW_MESSAGE_STEP_INPUT_NOT_FINITE(inst, spec->velocity, value, spec->rotational ? "rad/s" : "m/s");
         }
     }
     if (inst->data.initial_state_pending) bw_set_initial_state(inst);
@@ -680,29 +681,24 @@ static bw_status bw_do_step(bw_instance *inst, double current_time, double h) {
         if (bw_axis_group[a] >= 0) continue;     /* stepped with its group below */
         memcpy(states[a], axis->state, sizeof states[a]);
         status = spec->model->step(&axis->constants, states[a], axis->state_x, x, v, h, BW_MAX_SUBSTEPS);
-        if (status != BW_KERNEL_OK) bw_format_double(t_text, sizeof t_text, current_time);
-        if (status == BW_KERNEL_TOO_MANY_SUBSTEPS) {
-            return bw_refuse(inst, "doStep at t = %s s refused: %sthe step of %g s would need more than %d substeps "
-                             "(x = %g mm, v = %g mm/s); check the units of the inputs (the FMU takes metres and m/s) "
-                             "or shorten the communication step", t_text, spec->label, h, BW_MAX_SUBSTEPS, x, v);
-        }
         if (status != BW_KERNEL_OK) {
-            return bw_refuse(inst, "doStep at t = %s s refused: %sthe step gave a non-finite state at x = %g mm, "
-                             "v = %g mm/s; check the units of the inputs (the FMU takes metres and m/s) and the "
-                             "parameters", t_text, spec->label, x, v);
+            bw_format_double(t_text, sizeof t_text, current_time);
+            inputs[0] = '\0';
+            bw_append_inputs(inst, a, inputs, sizeof inputs);
         }
+        if (status == BW_KERNEL_TOO_MANY_SUBSTEPS) {
+            return BW_MESSAGE_STEP_TOO_MANY_SUBSTEPS(inst, t_text, spec->label, h, BW_MAX_SUBSTEPS, inputs);
+        }
+        if (status != BW_KERNEL_OK) return BW_MESSAGE_STEP_NOT_FINITE(inst, t_text, spec->label, inputs);
         x_end[a] = x + v * h;
         outputs[a] = spec->model->force(&axis->constants, states[a], x_end[a], v) * spec->from_kernel
                      + bw_preload(axis, spec->model) * spec->from_kernel;
         if (!isfinite(outputs[a])) {
-            char x_port[40], v_port[40];
             bw_format_double(t_text, sizeof t_text, current_time);
-            bw_format_double(x_port, sizeof x_port, axis->x);
-            bw_format_double(v_port, sizeof v_port, axis->v);
-            return bw_refuse(inst, "doStep at t = %s s refused: %s would be %g %s (%s = %s %s, %s = %s %s); check the "
-                             "units of the inputs", t_text, spec->output, outputs[a], spec->rotational ? "N.m" : "N",
-                             spec->displacement, x_port, spec->rotational ? "rad" : "m", spec->velocity, v_port,
-                             spec->rotational ? "rad/s" : "m/s");
+            inputs[0] = '\0';
+            bw_append_inputs(inst, a, inputs, sizeof inputs);
+            return BW_MESSAGE_STEP_OUTPUT_NOT_FINITE(inst, t_text, spec->label, spec->output, outputs[a],
+                                                     spec->rotational ? "N.m" : "N", inputs);
         }
     }
     for (g = 0; g < BW_GROUPS; g++) {
@@ -714,18 +710,14 @@ static bw_status bw_do_step(bw_instance *inst, double current_time, double h) {
         bw_group_inputs(inst, g, x, v);
         memcpy(group_states[g], inst->data.groups[g].state, sizeof group_states[g]);
         status = kernels->step(constants, group_states[g], inst->data.groups[g].state_x, x, v, h, BW_MAX_SUBSTEPS);
-        if (status != BW_KERNEL_OK) bw_format_double(t_text, sizeof t_text, current_time);
-        if (status == BW_KERNEL_TOO_MANY_SUBSTEPS) {
-            return bw_refuse(inst, "doStep at t = %s s refused: %sthe step of %g s would need more than %d substeps "
-                             "(x = (%g, %g, %g) mm, v = (%g, %g, %g) mm/s); check the units of the inputs (the FMU "
-                             "takes metres and m/s) or shorten the communication step", t_text, group->label, h,
-                             BW_MAX_SUBSTEPS, x[0], x[1], x[2], v[0], v[1], v[2]);
-        }
         if (status != BW_KERNEL_OK) {
-            return bw_refuse(inst, "doStep at t = %s s refused: %sthe step gave a non-finite state at x = (%g, %g, %g) "
-                             "mm, v = (%g, %g, %g) mm/s; check the units of the inputs (the FMU takes metres and m/s) "
-                             "and the parameters", t_text, group->label, x[0], x[1], x[2], v[0], v[1], v[2]);
+            bw_format_double(t_text, sizeof t_text, current_time);
+            bw_group_inputs_text(inst, g, inputs, sizeof inputs);
         }
+        if (status == BW_KERNEL_TOO_MANY_SUBSTEPS) {
+            return BW_MESSAGE_STEP_TOO_MANY_SUBSTEPS(inst, t_text, group->label, h, BW_MAX_SUBSTEPS, inputs);
+        }
+        if (status != BW_KERNEL_OK) return BW_MESSAGE_STEP_NOT_FINITE(inst, t_text, group->label, inputs);
         for (c = 0; c < 3; c++) group_x_end[g][c] = x[c] + v[c] * h;
         kernels->force(constants, group_states[g], group_x_end[g], v, force);
         for (c = 0; c < group->members; c++) {
@@ -735,8 +727,9 @@ static bw_status bw_do_step(bw_instance *inst, double current_time, double h) {
             outputs[a] = force[c] * spec->from_kernel + bw_preload(&inst->data.axes[a], spec->model) * spec->from_kernel;
             if (!isfinite(outputs[a])) {
                 bw_format_double(t_text, sizeof t_text, current_time);
-                return bw_refuse(inst, "doStep at t = %s s refused: %s%s would be %g %s; check the units of the inputs",
-                                 t_text, group->label, spec->output, outputs[a], spec->rotational ? "N.m" : "N");
+                bw_group_inputs_text(inst, g, inputs, sizeof inputs);
+                return BW_MESSAGE_STEP_OUTPUT_NOT_FINITE(inst, t_text, group->label, spec->output, outputs[a],
+                                                         spec->rotational ? "N.m" : "N", inputs);
             }
         }
     }
@@ -744,18 +737,15 @@ static bw_status bw_do_step(bw_instance *inst, double current_time, double h) {
         const bw_axis_spec *spec = &bw_axis_specs[a];
         bw_axis *axis = &inst->data.axes[a];
         if (fabs(outputs[a]) > axis->output_bound && !axis->output_warned) {
-            char x_port[40], v_port[40];
             axis->output_warned = 1;
-            bw_format_double(x_port, sizeof x_port, axis->x);
-            bw_format_double(v_port, sizeof v_port, axis->v);
-            bw_log(inst, BW_WARNING, "logStatusWarning", "%s = %.4g %s at t = %.17g s exceeds %.3g %s, the %s of all "
-                   "the bushing's springs and dashpots at the largest plausible %s: check the units of the inputs "
-                   "(%s = %s %s, %s = %s %s; the FMU takes %s)", spec->output, outputs[a],
-                   spec->rotational ? "N.m" : "N", current_time + h, axis->output_bound, spec->rotational ? "N.m" : "N",
-                   spec->rotational ? "moment" : "force",
-                   spec->rotational ? "rotation and angular velocity" : "travel and speed", spec->displacement,
-                   x_port, spec->rotational ? "rad" : "m", spec->velocity, v_port, spec->rotational ? "rad/s" : "m/s",
-                   spec->rotational ? "radians" : "metres");
+            bw_format_double(t_text, sizeof t_text, current_time + h);
+            inputs[0] = '\0';
+            bw_append_inputs(inst, a, inputs, sizeof inputs);
+            BW_MESSAGE_OUTPUT_IMPLAUSIBLE(inst, spec->output, outputs[a], spec->rotational ? "N.m" : "N", t_text,
+                                          axis->output_bound,
+                                          spec->rotational ? BW_TEXT_QUANTITY_ROTATIONAL : BW_TEXT_QUANTITY_TRANSLATIONAL,
+                                          spec->rotational ? BW_TEXT_MOTION_ROTATIONAL : BW_TEXT_MOTION_TRANSLATIONAL,
+                                          inputs, spec->rotational ? BW_TEXT_UNITS_ROTATIONAL : BW_TEXT_UNITS_TRANSLATIONAL);
         }
         if (!inst->jump_warned) bw_count_jump(inst, a, current_time, h);
         if (bw_axis_group[a] < 0) memcpy(axis->state, states[a], sizeof axis->state);
@@ -891,7 +881,7 @@ static bw_status bw_derivatives(bw_instance *inst, double *values, size_t count)
     int i;
     if (count != BW_CONTINUOUS_STATES) return bw_wrong_count(inst, "derivatives: asked for", count, BW_CONTINUOUS_STATES);
     if (!bw_check_parameters(inst)) {
-        bw_error(inst, "%s", "the derivatives cannot be computed: the parameters are invalid (see the errors above)");
+        BW_MESSAGE_NOT_COMPUTABLE(inst, "", "derivatives", BW_TEXT_PARAMETERS_INVALID);
         return BW_ERROR;
     }
     for (i = 0; i < BW_VARIABLES && k < count; i++) {
@@ -899,8 +889,7 @@ static bw_status bw_derivatives(bw_instance *inst, double *values, size_t count)
         if (var->kind != BW_STATE) continue;
         values[k] = bw_rate(inst, var->axis, var->index) * var->scale;
         if (!isfinite(values[k])) {
-            bw_log(inst, BW_ERROR, "logStatusError", "the derivative of %s is not finite (%g): check the units of the "
-                   "inputs and the states set", var->name, values[k]);
+            BW_MESSAGE_DERIVATIVE_NOT_FINITE(inst, "", var->name, values[k]);
             return BW_ERROR;
         }
         k++;
@@ -913,7 +902,7 @@ static bw_status bw_event_indicators(bw_instance *inst, double *values, size_t c
     int i;
     if (count != BW_EVENT_INDICATORS) return bw_wrong_count(inst, "event indicators: asked for", count, BW_EVENT_INDICATORS);
     if (!bw_check_parameters(inst)) {
-        bw_error(inst, "%s", "the event indicators cannot be computed: the parameters are invalid");
+        BW_MESSAGE_NOT_COMPUTABLE(inst, "", "event indicators", BW_TEXT_PARAMETERS_INVALID);
         return BW_ERROR;
     }
     for (i = 0; i < BW_VARIABLES && k < count; i++) {
@@ -994,8 +983,9 @@ static bw_status bw_check_derivative_variables(bw_instance *inst, const char *fu
         }
     }
     if (!bw_check_parameters(inst)) {
-        bw_log(inst, BW_ERROR, "logStatusError", "%s: the derivatives cannot be computed: the parameters are invalid "
-               "(see the errors above)", function);
+        char where[80];
+        snprintf(where, sizeof where, "%s: ", function);
+        BW_MESSAGE_NOT_COMPUTABLE(inst, where, "derivatives", BW_TEXT_PARAMETERS_INVALID);
         return BW_ERROR;
     }
     return BW_OK;
@@ -1033,9 +1023,9 @@ static bw_status bw_axis_tangent(bw_instance *inst, const char *function, int a,
         double d_jump[BW_MAX_STATES], jump = axis->x_now - axis->state_x;
         if (fabs(jump) <= BW_ROUNDING_JUMP && v != 0.0) jump = copysign(2.0 * BW_ROUNDING_JUMP, v);
         if (model->jump_tangent(&axis->constants, state, jump, d_jump) != BW_KERNEL_OK) {
-            bw_log(inst, BW_ERROR, "logStatusError", "%s: %sthe output cannot be differentiated: the displacement jump "
-                   "of %g mm from the committed state cannot be taken (check the units of %s: metres)", function,
-                   spec->label, axis->x_now - axis->state_x, spec->displacement);
+            char where[80];
+            snprintf(where, sizeof where, "%s: ", function);
+            BW_MESSAGE_JUMP_NOT_DIFFERENTIABLE(inst, where, spec->label, spec->output, spec->displacement);
             return BW_ERROR;
         }
         for (i = 0; i < model->states; i++) d_state[i] = d_jump[i] * direction->dx;
@@ -1043,8 +1033,9 @@ static bw_status bw_axis_tangent(bw_instance *inst, const char *function, int a,
     *d_output = model->force_tangent(&axis->constants, state, axis->x_now, v, d_state, direction->dx, direction->dv)
                 * spec->from_kernel;
     if (!isfinite(*d_output)) {
-        bw_log(inst, BW_ERROR, "logStatusError", "%s: the derivative of %s is not finite (%g): check the units of the "
-               "inputs and the states set", function, spec->output, *d_output);
+        char where[80];
+        snprintf(where, sizeof where, "%s: ", function);
+        BW_MESSAGE_DERIVATIVE_NOT_FINITE(inst, where, spec->output, *d_output);
         return BW_ERROR;
     }
     if (d_rates) {
@@ -1052,8 +1043,9 @@ static bw_status bw_axis_tangent(bw_instance *inst, const char *function, int a,
                                    d_rates);
         for (i = 0; i < model->states; i++) {
             if (!isfinite(d_rates[i])) {
-                bw_log(inst, BW_ERROR, "logStatusError", "%s: %sthe derivative of the rate of state %d is not finite "
-                       "(%g): check the units of the inputs and the states set", function, spec->label, i, d_rates[i]);
+                char where[80];
+                snprintf(where, sizeof where, "%s: ", function);
+                BW_MESSAGE_RATE_DERIVATIVE_NOT_FINITE(inst, where, spec->label, i, d_rates[i]);
                 return BW_ERROR;
             }
         }
@@ -1099,9 +1091,9 @@ static bw_status bw_group_tangent(bw_instance *inst, const char *function, int g
             for (c = 0; c < 3; c++) jump[c] = 2.0 * BW_ROUNDING_JUMP * v[c] / sqrt(speed);
         }
         if (kernels->jump_tangent(constants, state, jump, direction->dx, d_state) != BW_KERNEL_OK) {
-            bw_log(inst, BW_ERROR, "logStatusError", "%s: %sthe outputs cannot be differentiated: the displacement "
-                   "jump from the committed state cannot be taken (check the units of the inputs: metres)", function,
-                   spec->label);
+            char where[80];
+            snprintf(where, sizeof where, "%s: ", function);
+            BW_MESSAGE_JUMP_NOT_DIFFERENTIABLE(inst, where, spec->label, "the outputs", "the inputs");
             return BW_ERROR;
         }
     }
@@ -1110,8 +1102,9 @@ static bw_status bw_group_tangent(bw_instance *inst, const char *function, int g
         const bw_axis_spec *member = &bw_axis_specs[spec->axis[c]];
         d_output[c] = d_force[c] * member->from_kernel;
         if (!isfinite(d_output[c])) {
-            bw_log(inst, BW_ERROR, "logStatusError", "%s: the derivative of %s is not finite (%g): check the units of "
-                   "the inputs and the states set", function, member->output, d_output[c]);
+            char where[80];
+            snprintf(where, sizeof where, "%s: ", function);
+            BW_MESSAGE_DERIVATIVE_NOT_FINITE(inst, where, member->output, d_output[c]);
             return BW_ERROR;
         }
     }
@@ -1119,8 +1112,9 @@ static bw_status bw_group_tangent(bw_instance *inst, const char *function, int g
         kernels->derivatives_tangent(constants, state, x, v, d_state, direction->dx, direction->dv, d_rates);
         for (i = 0; i < kernels->states; i++) {
             if (!isfinite(d_rates[i])) {
-                bw_log(inst, BW_ERROR, "logStatusError", "%s: %sthe derivative of the rate of state %d is not finite "
-                       "(%g): check the units of the inputs and the states set", function, spec->label, i, d_rates[i]);
+                char where[80];
+                snprintf(where, sizeof where, "%s: ", function);
+                BW_MESSAGE_RATE_DERIVATIVE_NOT_FINITE(inst, where, spec->label, i, d_rates[i]);
                 return BW_ERROR;
             }
         }
