@@ -67,7 +67,7 @@ def test_the_installed_build_makes_a_native_fmu_outside_the_checkout(installed_w
     assert result.returncode == 0, result.stderr[-3000:]
     fmu = tmp_path / "dist" / "BoucWenBushing.fmu"
     with zipfile.ZipFile(fmu) as archive:
-        assert {"sources/bushing_instance.c", "sources/fmi2_functions.c", "binaries/linux64/BoucWenBushing.so"} \
+        assert {"sources/instance_cosimulation.c", "sources/bushing_messages.h", "sources/fmi2_functions.c", "binaries/linux64/BoucWenBushing.so"} \
             <= set(archive.namelist())
 
 

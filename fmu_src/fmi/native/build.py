@@ -10,8 +10,9 @@ Layout of the FMU::
     binaries/<platform>/<id>.so | .dll | .dylib     (platforms.PLATFORMS: linux64, win64, darwin64,
                                                      aarch64-linux; FMI 3: x86_64-linux, ...)
     sources/<id>.c            the one translation unit: includes the files below
-    sources/bushing_fmu.h, bushing_model.c and bushing_messages.h (generated), bushing_instance.c,
-            fmi2_functions.c (or fmi3_functions.c), and the FMI headers
+    sources/bushing_fmu.h, bushing_model.c and bushing_messages.h (generated), bushing_instance.h
+            and instance_*.c (the instance by concern), fmi2_functions.c (or fmi3_functions.c),
+            and the FMI headers
     sources/buildDescription.xml                                (FMI 3)
 
 The FMI 2 headers are fmpy's copy; the FMI 3 ones are the standard's 3.0.1 headers, kept in ``c/``
@@ -34,7 +35,10 @@ from . import macho, platforms as toolchains
 from .generate import model_source
 
 C_LAYER = Path(__file__).resolve().parent / "c"
-HAND_WRITTEN = ("bushing_fmu.h", "bushing_instance.c")
+INSTANCE = ("log", "parameters", "life_cycle", "variables", "cosimulation", "model_exchange", "derivatives",
+            "fmu_state")
+"""The instance's parts (``c/instance_<part>.c``), by concern, in the order the translation unit includes them."""
+HAND_WRITTEN = ("bushing_fmu.h", "bushing_instance.h", *(f"instance_{part}.c" for part in INSTANCE))
 FMI_HEADERS = {2: ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h"),
                3: ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h")}
 WARNINGS = ("-std=c99", "-pedantic", "-Wall", "-Wextra", "-Werror")
@@ -86,8 +90,8 @@ def write_sources(folder: Path, axis_models, identifier: str, fmi_version: int, 
     (folder / f"{identifier}.c").write_text(
         f"/* The native FMU {identifier}: one translation unit (see bushing_fmu.h). */\n"
         '#include "bushing_fmu.h"\n#include "bushing_model.c"\n#include "bushing_messages.h"\n'
-        '#include "bushing_instance.c"\n'
-        f'#include "{functions}"\n')
+        '#include "bushing_instance.h"\n' + "".join(f'#include "instance_{part}.c"\n' for part in INSTANCE)
+        + f'#include "{functions}"\n')
     return generated
 
 

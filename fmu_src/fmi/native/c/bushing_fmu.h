@@ -2,8 +2,10 @@
  *
  * One translation unit per FMU (<modelIdentifier>.c, written by the build) includes, in order,
  * this header, the generated bushing_model.c (the models' kernels translated from their Python
- * source, the FMU's axes, variables and parameter rules), bushing_instance.c (the instance:
- * life cycle, variables, validation, steps, model exchange, FMU state; no FMI types) and one of
+ * source, the FMU's axes, variables and parameter rules), the generated bushing_messages.h (the
+ * runtime policy's messages), bushing_instance.h and the instance's parts by concern
+ * (instance_log.c, _parameters.c, _life_cycle.c, _variables.c, _cosimulation.c,
+ * _model_exchange.c, _derivatives.c, _fmu_state.c; no FMI types) and one of
  * fmi2_functions.c or fmi3_functions.c (the FMI API on top of the instance). Everything but the
  * FMI functions is static: many FMUs of this project load into one process side by side, and
  * an instance keeps all its data in itself (no global state).

@@ -1,5 +1,5 @@
 /* The FMI 2.0 API of the native bushing FMU (co-simulation and model exchange), on top of
- * bushing_instance.c. Compiled after it (see bushing_fmu.h). */
+ * the instance (bushing_instance.h, instance_*.c). Compiled after it (see bushing_fmu.h). */
 #include <stdlib.h>
 #include <string.h>
 

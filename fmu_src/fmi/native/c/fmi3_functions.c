@@ -1,5 +1,6 @@
 /* The FMI 3.0 API of the native bushing FMU (co-simulation and model exchange), on top of
- * bushing_instance.c, as fmi2_functions.c is for FMI 2.0. Compiled after it (see bushing_fmu.h).
+ * the instance (bushing_instance.h, instance_*.c), as fmi2_functions.c is for FMI 2.0. Compiled
+ * after it (see bushing_fmu.h).
  * Every function of the standard is here; the ones this FMU has no use for (other variable
  * types, clocks, scheduled execution, directional derivatives) return fmi3Error and say so. */
 #include <stdlib.h>
@@ -377,7 +378,7 @@ static int bw3_derivative_arguments(fmi3Instance instance, const char *function,
     return 1;
 }
 
-/* fmi3GetAdjointDerivative (FMI 3 only, so here rather than in bushing_instance.c):
+/* fmi3GetAdjointDerivative (FMI 3 only, so here rather than in instance_derivatives.c):
    sensitivity = J^T * seed, one directional derivative per known (the column of J that the
    known's entry of J^T * seed needs; an axis's tangent, or a coupled group's), so it equals the
    transposed Jacobian of bw_directional_derivative to rounding. */
