@@ -36,6 +36,7 @@ import math
 import os
 import sys
 import threading
+from dataclasses import dataclass
 from functools import partial
 
 from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Real
@@ -152,6 +153,16 @@ class _AxisState:
         self.group = None              # the coupled group it belongs to, if any
 
 
+@dataclass(slots=True)
+class _Batch:
+    """The axes of one model stepped in one compiled call (``numba_binding._step_axes``)."""
+    step: object                  # the compiled step of all the batch's axes
+    axes: list                    # their _AxisState
+    params: object                # their parameter rows in force (an array), None: rebuilt at the next step
+    histories: object             # each axis's jumping-input history (JUMP_*; an int64 array)
+    next_histories: object        # the next step's, written by the compiled step (swapped when committed)
+
+
 class _GroupState:
     """A coupled group of axes (``axes.Coupling``): one model's coupled form
     (``definition.CoupledKernels``) on the vector of its members' displacements, padded with 0
@@ -206,13 +217,12 @@ class BushingSlave(Fmi2Slave):
         for a in self._axes:
             if a.group is None:
                 groups.setdefault(a.model.name, []).append(a)
-        # [step, axes, parameter rows, jump histories, the next step's jump histories]
-        self._batches = [[STEP_AXES[name][0], group, None, np.zeros(len(group), dtype=np.int64),
-                          np.zeros(len(group), dtype=np.int64)]
+        self._batches = [_Batch(STEP_AXES[name][0], group, None, np.zeros(len(group), dtype=np.int64),
+                                np.zeros(len(group), dtype=np.int64))
                          for name, group in groups.items() if name in STEP_AXES and len(group) > 1]
         for a in self._axes:
             a.step_one = STEP_AXES[a.model.name][1] if a.model.name in STEP_AXES else None
-        batched = {id(a) for batch in self._batches for a in batch[1]}
+        batched = {id(a) for batch in self._batches for a in batch.axes}
         self._unbatched = [a for a in self._axes if id(a) not in batched and a.group is None]
         self._single = [a for a in self._axes if a.group is None]
         self._initial_state_pending = True  # set at exit of initialization, or first valid step
@@ -459,9 +469,9 @@ class BushingSlave(Fmi2Slave):
             group_states.append(step[0])
             steps += step[1]
         for batch, crossed in crossings:   # the compiled step counted its axes' jumps: keep them
-            batch[3], batch[4] = batch[4], batch[3]
+            batch.histories, batch.next_histories = batch.next_histories, batch.histories
             if crossed >= 0 and not self._jump_warned:
-                self._warn_jumping(batch[1][crossed], current_time, step_size, int(batch[3][crossed]))
+                self._warn_jumping(batch.axes[crossed], current_time, step_size, int(batch.histories[crossed]))
         for a, state, x_end, output, jumps_counted in steps:
             if abs(output) > a.output_bound and not a.output_warned:
                 self._warn_implausible(a, output, current_time + step_size)
@@ -545,12 +555,12 @@ class BushingSlave(Fmi2Slave):
         any axis's step fails, so that the axis-by-axis step redoes it and words the refusal."""
         steps, crossings = [], []
         for batch in self._batches:
-            step_axes, group, params, histories, next_histories = batch
-            if params is None:
-                params = batch[2] = np.array([a.model.values(a.values) for a in group])
+            group = batch.axes
+            if batch.params is None:
+                batch.params = np.array([a.model.values(a.values) for a in group])
             rows = np.array([(a.x_now, a.v * a.to_kernel, a.state_x, *a.state) for a in group])
-            out, failures, crossed = step_axes(params, rows, step_size, integration.DEFAULT_MAX_SUBSTEPS,
-                                               histories, next_histories)
+            out, failures, crossed = batch.step(batch.params, rows, step_size, integration.DEFAULT_MAX_SUBSTEPS,
+                                                batch.histories, batch.next_histories)
             if failures:
                 return None
             crossings.append((batch, crossed))
@@ -604,7 +614,7 @@ class BushingSlave(Fmi2Slave):
                 if np is not None:
                     a.params_row = np.array(a.model.values(a.values))
             for batch in self._batches:
-                batch[2] = None
+                batch.params = None
         return a.constants is not None
 
     def _error(self, message):
