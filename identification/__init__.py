@@ -54,13 +54,14 @@ from identification.forward.dynamic_stiffness import characterise  # noqa: E402
 from identification.errors import FitNotConvergedWarning, IdentificationError, MeasurementError, MissingExtraError  # noqa: E402
 from identification.fitting.result import FitResult  # noqa: E402
 from identification.fitting.fit import fit  # noqa: E402
+from identification.fitting.presets import FitOptions  # noqa: E402
 from identification.analysis.fmu_input import fmu_input, simulate_measurement  # noqa: E402
 from identification.measured.measurements import load_measurement  # noqa: E402
 from identification.analysis.predict import predict  # noqa: E402
 from identification.measured.rig_tests import RigTest, load_manifest, training_tests  # noqa: E402
 from identification.forward.simulate import simulate  # noqa: E402
 
-__all__ = ["fit", "FitResult", "FitNotConvergedWarning", "simulate", "predict", "characterise", "load_measurement",
+__all__ = ["fit", "FitOptions", "FitResult", "FitNotConvergedWarning", "simulate", "predict", "characterise", "load_measurement",
            "fmu_input", "simulate_measurement",
            "RigTest", "training_tests", "load_manifest",
            "read_parameter_set", "save_parameters", "read_ensemble", "save_ensemble", "ParameterSet", "ParameterEnsemble",

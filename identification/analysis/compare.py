@@ -40,7 +40,7 @@ import sys
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Sequence
+from typing import Any, Mapping, Sequence
 
 import numpy as np
 
@@ -49,6 +49,7 @@ from identification.fitting.engine import make_engine
 from identification.errors import FitNotConvergedWarning
 from identification.fitting.result import FLOOR_FACTOR, FitResult, TableFit, information_criterion
 from identification.fitting.fit import training_request
+from identification.fitting.presets import FitOptions
 from identification.analysis.race import Stopped, race_models
 from identification.fitting.search import table_fit
 from identification.interrupt import writing
@@ -160,17 +161,45 @@ def _predicting_best(pool: list[Assessment], tolerance: float, why: list[str]) -
     return pool
 
 
+@dataclass(frozen=True)
+class CompareOptions:
+    """``compare_models``' settings (its keywords). The fits': ``preset``, ``seed``,
+    ``screening``, ``starts``, ``fixed`` (parameters every model holds), ``training_table`` (a
+    data sheet fitted with the tests, as ``fit(kdyn=...)``), ``workers``, ``scheduler``,
+    ``progress`` (as ``fit``'s). The comparison's: ``ensemble`` (sample the recommended model's),
+    ``every_ensemble`` (every finished model's), ``race`` (stop the models that cannot win after
+    their screening), ``table`` (a held-out dynamic-stiffness table), ``multiaxis`` and
+    ``couplings`` (held-out multi-axis tests and the couplings weighed on them)."""
+    preset: str = "default"
+    seed: int = 0
+    screening: int | None = None
+    starts: int | None = None
+    fixed: Mapping[str, float] | None = None
+    training_table: KdynTable | None = None
+    workers: int | None = None
+    scheduler: Any = None
+    progress: bool = True
+    ensemble: bool = True
+    every_ensemble: bool = False
+    race: bool = True
+    table: KdynTable | None = None
+    multiaxis: Any = ()
+    couplings: Sequence[str] = ()
+
+    def training(self) -> FitOptions:
+        """Each model's fit (its ensemble, if any, sampled later for the recommended one)."""
+        return FitOptions(preset=self.preset, seed=self.seed, screening=self.screening, starts=self.starts,
+                          fixed=self.fixed, kdyn=self.training_table, ensemble=False, workers=self.workers,
+                          scheduler=self.scheduler, progress=self.progress)
+
+
 def compare_models(models: Sequence[str | BushingModel], tests: Sequence[RigTest], validation_files: Sequence[Path],
-                   out_dir: Path, preset: str = "default", seed: int = 0, workers: int | None = None,
-                   scheduler=None, screening: int | None = None, starts: int | None = None, ensemble: bool = True,
-                   table: KdynTable | None = None, multiaxis=(), couplings: Sequence[str] = (),
-                   training_table: KdynTable | None = None, race: bool = True, every_ensemble: bool = False,
-                   progress: bool = True, fixed=None) -> dict:
+                   out_dir: Path, **keywords) -> dict:
     """Fit every model on ``tests`` and the ``training_table`` (a data sheet, alone or with the
     tests, as ``fit(kdyn=...)``), assess it on the training data, on the ``validation_files``
     and on the held-out dynamic-stiffness ``table``, write the files (module docstring) and
-    recommend one. ``models``: names or ``BushingModel``s, each resolved once here and passed on;
-    ``fixed``: parameters every model holds (``fit(fixed=...)``).
+    recommend one. ``models``: names or ``BushingModel``s, each resolved once here and passed on.
+    The keywords are ``CompareOptions``' (``preset``, ``seed``, ``fixed`` … as ``fit``'s).
 
     The models race (:func:`race_models`): each is screened, and only those that can still win
     run the least-squares stages (``race=False``: every model runs them). The ensemble (profiles
@@ -182,27 +211,31 @@ def compare_models(models: Sequence[str | BushingModel], tests: Sequence[RigTest
     (keyed by model name; a model stopped after its screening has no parameters, errors or
     assessment, only its row in ``stopped``)."""
     from threadpoolctl import threadpool_limits
+    options = CompareOptions(**keywords)
     bushings = [resolve_model(model) for model in models]
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     validation = [load_measurement(path) for path in validation_files]
     training_names = {Path(t.measurement.source).name for t in tests}
-    requests = [training_request(tests, bushing, preset, seed, screening, starts, training_table, False, fixed=fixed)
-                for bushing in bushings]
+    training = options.training()
+    requests = [training_request(tests, bushing, training) for bushing in bushings]
+    table, training_table = options.table, options.training_table
     data = [t.measurement.source for t in tests] + ([training_table.source] if training_table is not None else [])
     # one BLAS thread, as fit() runs its searches
-    with make_engine(workers, scheduler) as engine, warnings.catch_warnings(), threadpool_limits(limits=1):
+    with make_engine(options.workers, options.scheduler) as engine, warnings.catch_warnings(), \
+            threadpool_limits(limits=1):
         warnings.simplefilter("ignore", FitNotConvergedWarning)   # reported below, per model
-        results, stopped, searches = race_models(requests, engine, race, progress)
+        results, stopped, searches = race_models(requests, engine, options.race, options.progress)
         bushings = [b for b in bushings if b.name in results]
         models = [b.name for b in bushings]
         parameters = {model: results[model].parameters.parameters for model in models}
         assessments = [_assessed(results[model], table) for model in models]
         errors, predictions = _validation_errors(validation, bushings, parameters, assessments, training_names)
         recommendation = recommend(assessments)
-        if ensemble:
+        if options.ensemble:
             # the ensemble keeps the best fit: the assessments and the recommendation stand
-            for model in [m for m in models if m in searches and (every_ensemble or m == recommendation.model)]:
+            for model in [m for m in models if m in searches and (options.every_ensemble
+                                                                  or m == recommendation.model)]:
                 print(f"sampling the ensemble of {model} (profiles, posterior) ...", file=sys.stderr)
                 results[model] = searches[model].with_ensemble()
         for model in models:
@@ -211,7 +244,8 @@ def compare_models(models: Sequence[str | BushingModel], tests: Sequence[RigTest
         plot_comparison(m, predictions[Path(m.source).name], out_dir / f"compare_{measurement_name(m.source)}.png")
     if table is not None:
         plot_table_comparison(table, {a.model: a.table for a in assessments}, out_dir / f"compare_{table.name}.png")
-    coupling = weigh_couplings(parameters, bushings, multiaxis, couplings, recommendation.model) if couplings else None
+    coupling = (weigh_couplings(parameters, bushings, options.multiaxis, options.couplings, recommendation.model)
+                if options.couplings else None)
 
     print(format_assessments(assessments, recommendation, stopped))
     if validation:

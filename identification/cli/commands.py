@@ -141,10 +141,8 @@ def fit_command(args) -> int:
           file=sys.stderr)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", FitNotConvergedWarning)   # printed below as WARNING
-        result = fit(tests, model=bushing, preset=args.preset, seed=args.seed, workers=args.workers,
-                     scheduler=args.scheduler, progress=not args.quiet, screening=args.screening,
-                     starts=args.starts, kdyn=table, ensemble=not args.no_ensemble, multiaxis=multiaxis,
-                     coupling=args.coupling, fixed=fixed)
+        result = fit(tests, bushing, kdyn=table, multiaxis=multiaxis, coupling=args.coupling, fixed=fixed,
+                     **search_settings(args))
     written = _save_or_rescue(result, args, [t.measurement.source for t in tests] + [m.source for m in multiaxis]
                               + ([str(args.kdyn)] if args.kdyn else []))
     print(result.summary())
@@ -370,12 +368,17 @@ def coupling_of(text: str | None):
     return Coupling(**chosen)
 
 
+def search_settings(args) -> dict:
+    """The search's settings every fitting command takes (``arguments._add_search_arguments``),
+    as the keywords of ``fit``, ``fit_many`` and ``compare_models``."""
+    return dict(preset=args.preset, seed=args.seed, workers=args.workers, scheduler=args.scheduler,
+                screening=args.screening, starts=args.starts, progress=not args.quiet, ensemble=not args.no_ensemble)
+
+
 def fit_many_command(args) -> int:
     from identification.fitting.fleet import fit_many
     prepare_directory(args.out, "--out")
-    rows = fit_many(args.folder, args.out, workers=args.workers, scheduler=args.scheduler, preset=args.preset,
-                    seed=args.seed, screening=args.screening, starts=args.starts, progress=not args.quiet,
-                    ensemble=not args.no_ensemble)
+    rows = fit_many(args.folder, args.out, **search_settings(args))
     for row in rows:
         state = f"error: {row.error}" if row.error else (f"misfit {row.misfit:.4f}, "
                                                           + ("converged" if row.converged else "NOT converged"))
@@ -429,11 +432,9 @@ def compare_command(args) -> int:
         raise UsageError("--every-ensemble samples the ensembles that --no-ensemble skips: give one of them")
     prepare_directory(args.out, "--out")
     validation = args.validate or [Path(t.measurement.source) for t in tests]
-    compare_models(models, tests, validation, args.out, preset=args.preset, seed=args.seed, workers=args.workers,
-                   scheduler=args.scheduler, screening=args.screening, starts=args.starts,
-                   ensemble=not args.no_ensemble, table=table, multiaxis=multiaxis, couplings=couplings,
+    compare_models(models, tests, validation, args.out, table=table, multiaxis=multiaxis, couplings=couplings,
                    training_table=training_table, race=not args.no_race, every_ensemble=args.every_ensemble,
-                   progress=not args.quiet, fixed=fixed)
+                   fixed=fixed, **search_settings(args))
     return 0
 
 

@@ -4,7 +4,8 @@
   squares, any other searched;
 - ``search``: the search, step by step (the box, the starts, the stages, the ensemble, the result);
 - ``result``: ``FitResult``, what a fit returns (its summary, its parameter and ensemble files);
-- ``presets``: how much of each search phase a fit runs, defined once;
+- ``presets``: how much of each search phase a fit runs, defined once; ``FitOptions``, a fit's
+  settings as one value (the front doors' keywords);
 - ``search_space``: the box of dimensionless coordinates the fit searches, scaled by the data;
 - ``loop_start``, ``table_start``: starts read off the data (a slow loop; a data sheet);
 - ``objectives``: the misfit, every sample of every test in its noise units;

@@ -1,6 +1,6 @@
 """Fit a model's parameters to training tests, and say how sure the fit is.
 
-``fit(tests, model=DEFAULT_MODEL, preset="default", seed=0, workers=None, scheduler=None)``:
+``fit(tests, model=DEFAULT_MODEL, preset="default", seed=0, workers=None, scheduler=None, ...)``:
 
 1. the noise level of every test from its own data (``identification.measured.noise``);
 2. the search (``identification.fitting.multistart``): screened Sobol starts (for a model with a
@@ -45,6 +45,7 @@ from identification.measured.multiaxis import COUPLED_AXES, MultiAxisMeasurement
 from identification.fitting.multistart import JACOBIANS
 from identification.measured.noise import NoiseEstimate, estimate_noise
 from identification.fitting.objectives import Objective
+from identification.fitting.presets import FitOptions
 from identification.fitting.presets import PRESETS, SearchSettings
 from identification.measured.rig_tests import Manifest, RigTest
 from identification.fitting.search_space import SearchSpace
@@ -83,10 +84,8 @@ def as_multiaxis(multiaxis) -> list[MultiAxisMeasurement]:
     return [m if isinstance(m, MultiAxisMeasurement) else load_multiaxis(m) for m in multiaxis or ()]
 
 
-def fit(measurements, model: str | BushingModel = DEFAULT_MODEL, preset: str = "default", seed: int = 0,
-        workers: int | None = None, scheduler=None, engine=None, progress: bool = True, screening: int | None = None,
-        starts: int | None = None, kdyn=None, ensemble: bool = True, jacobian: str = "exact", multiaxis=(),
-        coupling: str | None = None, fixed=None) -> FitResult:
+def fit(measurements, model: str | BushingModel = DEFAULT_MODEL, options: FitOptions | None = None,
+        **keywords) -> FitResult:
     """Identify a model's parameters from rig tests, and say how sure the fit is.
 
     Parameters
@@ -99,6 +98,11 @@ def fit(measurements, model: str | BushingModel = DEFAULT_MODEL, preset: str = "
         paper's), or the model itself; resolved once and passed on. A model whose force is linear
         in its parameters (``BushingModel.linear``: Kelvin-Voigt) is fitted by linear least
         squares, every other by the search.
+    options : FitOptions, optional
+        The settings below as one value; keywords (``fit(tests, seed=1)``) are put into it.
+
+    Other Parameters
+    ----------------
     preset : str
         ``default`` (Sobol screening) or ``paper`` (the paper's GA); see ``presets``.
     seed : int
@@ -121,10 +125,9 @@ def fit(measurements, model: str | BushingModel = DEFAULT_MODEL, preset: str = "
         False skips the profiles and the posterior sampling (a third to half of the time): no
         band then, and ``FitResult.save(ensemble=...)`` refuses.
     jacobian : str
-        How the least squares and the identifiability get the residuals' Jacobian: ``exact``
-        (default: the forces' sensitivities, computed with them; ``identification.forward.parameter_jacobian``)
-        or ``difference`` (forward differences, one simulation per coordinate). The multi-axis
-        tests' rows are differences either way (the coupled kernels have no sensitivities).
+        The residuals' Jacobian: ``exact`` (default: the forces' sensitivities,
+        ``identification.forward.parameter_jacobian``) or ``difference`` (forward differences;
+        the multi-axis tests' rows are differences either way).
     multiaxis : sequence of MultiAxisMeasurement, str or Path, optional
         Multi-axis tests (CSV time_s,dx_mm,dy_mm,Fx_N,Fy_N[,dz_mm,Fz_N]: ``identification.measured.multiaxis``)
         fitted with the one-axis tests, or alone: each axis's force at each sample a residual in
@@ -151,6 +154,8 @@ def fit(measurements, model: str | BushingModel = DEFAULT_MODEL, preset: str = "
         without a coupling or with one they cannot carry (spherical on a plane test).
     MissingExtraError
         The ``fit`` extra is not installed.
+    TypeError
+        A keyword that is not a setting (its name).
 
     Warns
     -----
@@ -165,52 +170,57 @@ def fit(measurements, model: str | BushingModel = DEFAULT_MODEL, preset: str = "
     require("fit", "identification.fit")
     from threadpoolctl import threadpool_limits
     started = time.perf_counter()
-    request = training_request(measurements, model, preset, seed, screening, starts, kdyn, ensemble, jacobian,
-                               multiaxis, coupling, fixed)
+    options = FitOptions.of(options, **keywords)
+    request = training_request(measurements, model, options)
     # One BLAS thread here as in every task: a multi-threaded BLAS may sum in another order,
     # and the scales and the Jacobian's SVD computed here must not depend on the engine.
     with threadpool_limits(limits=1):
-        if request.model.linear is not None:
-            result = fit_linear(request, started)
-        else:
-            owned = engine is None
-            engine = engine or make_engine(workers, scheduler)
-            # an engine made here is closed here, and aborted if the search is left by an exception
-            # (Ctrl-C, SIGTERM): see identification.fitting.engine
-            with engine if owned else contextlib.nullcontext():
-                result = search.run(request, engine, progress, started)
+        result = fit_linear(request, started) if request.model.linear is not None else \
+            _searched(request, options, started)
     if not result.converged:
         warnings.warn(result.warning, FitNotConvergedWarning, stacklevel=2)
     return result
 
 
-def training_request(measurements, model: str | BushingModel = DEFAULT_MODEL, preset: str = "default", seed: int = 0,
-                     screening: int | None = None, starts: int | None = None, kdyn=None, ensemble: bool = True,
-                     jacobian: str = "exact", multiaxis=(), coupling: str | None = None, fixed=None) -> SearchRequest:
+def _searched(request: SearchRequest, options: FitOptions, started: float) -> FitResult:
+    """The search's result on the engine ``options`` give or make. An engine made here is closed
+    here, and aborted if the search is left by an exception (Ctrl-C, SIGTERM): see
+    ``identification.fitting.engine``."""
+    owned = options.engine is None
+    engine = options.engine or make_engine(options.workers, options.scheduler)
+    with engine if owned else contextlib.nullcontext():
+        return search.run(request, engine, options.progress, started)
+
+
+def training_request(measurements, model: str | BushingModel = DEFAULT_MODEL,
+                     options: FitOptions | None = None, **keywords) -> SearchRequest:
     """``fit``'s arguments (the same names) read and checked: what one fit fits and how, for
     :func:`fit_linear` (a model whose force is linear in its parameters) or
     ``search.begin`` (every other; ``compare`` runs those step by step). Raises
     IdentificationError as ``fit`` does."""
-    tests, noise, table, multi, bushing = _training(measurements, model, seed, jacobian, kdyn, multiaxis, coupling)
-    if preset not in PRESETS:
-        raise IdentificationError(f"unknown preset {preset!r}; choose one of {', '.join(PRESETS)}")
-    return SearchRequest(tests, noise, bushing, preset, _settings(PRESETS[preset], screening, starts), seed, table,
-                         multi, jacobian, ensemble, tuple(dict(fixed or {}).items()))
+    options = FitOptions.of(options, **keywords)
+    tests, noise, table, multi, bushing = _training(measurements, model, options)
+    if options.preset not in PRESETS:
+        raise IdentificationError(f"unknown preset {options.preset!r}; choose one of {', '.join(PRESETS)}")
+    settings = _settings(PRESETS[options.preset], options.screening, options.starts)
+    return SearchRequest(tests, noise, bushing, options.preset, settings, options.seed, table, multi, options.jacobian,
+                         options.ensemble, tuple(dict(options.fixed or {}).items()))
 
 
-def _training(measurements, model, seed: int, jacobian: str, kdyn, multiaxis, coupling: str | None):
+def _training(measurements, model, options: FitOptions):
     """``fit``'s arguments read and checked: (one-axis tests, their noise levels, the table or
     None, the multi-axis tests with their noise levels and coupling, the model)."""
+    kdyn, coupling = options.kdyn, options.coupling
     table = kdyn if kdyn is None or isinstance(kdyn, KdynTable) else load_kdyn_table(kdyn)
-    multi = as_multiaxis(multiaxis)
+    multi = as_multiaxis(options.multiaxis)
     _check_coupling(multi, coupling)
     empty = measurements is None or (isinstance(measurements, (list, tuple)) and not measurements)
     tests = [] if (empty and (table is not None or multi)) else as_tests(measurements)
     bushing = resolve_model(model)
-    if seed < 0:
-        raise IdentificationError(f"seed = {seed}: give an integer >= 0")
-    if jacobian not in JACOBIANS:
-        raise IdentificationError(f"jacobian = {jacobian!r}: choose one of {', '.join(JACOBIANS)}")
+    if options.seed < 0:
+        raise IdentificationError(f"seed = {options.seed}: give an integer >= 0")
+    if options.jacobian not in JACOBIANS:
+        raise IdentificationError(f"jacobian = {options.jacobian!r}: choose one of {', '.join(JACOBIANS)}")
     noise = [_noise_of(t) for t in tests]
     multi = MultiAxisTraining(multi, [_axis_noise_of(m) for m in multi], coupling or "none")
     return tests, noise, table, multi, bushing

@@ -23,13 +23,14 @@ import csv
 import json
 import time
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from fmu_src.model.registry import DEFAULT_MODEL, MODEL_CHOICES
 from fmu_src.model.parameter_specs import ParameterError
 from fmu_src.parameter_files import parameter_document
 from identification.fitting.engine import make_engine
+from identification.fitting.presets import FitOptions
 from identification.errors import FitNotConvergedWarning, MeasurementError
 from identification.interrupt import writing
 from identification.fitting.progress import bar as progress_bar
@@ -54,11 +55,7 @@ class _Job:
     tests: list
     labels: list           # each test's path relative to the bushing's folder
     model: str
-    preset: str
-    seed: int
-    screening: int | None
-    starts: int | None
-    ensemble: bool = True
+    options: FitOptions    # the fleet's, to run serially in the worker
 
 
 def _fit_bushing(_, job: _Job):
@@ -69,8 +66,7 @@ def _fit_bushing(_, job: _Job):
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", FitNotConvergedWarning)
-            result = fit(job.tests, model=job.model, preset=job.preset, seed=job.seed, engine=SerialEngine(),
-                         progress=False, screening=job.screening, starts=job.starts, ensemble=job.ensemble)
+            result = fit(job.tests, job.model, job.options, engine=SerialEngine())
     except Exception as exc:   # noqa: BLE001 - one bushing's failure must not stop the fleet; its row says why
         return FleetRow(job.name, seconds=time.perf_counter() - started, error=f"{type(exc).__name__}: {exc}"), None
     provenance = dict(result.provenance(), data=[t.measurement.source for t in job.tests])
@@ -81,12 +77,15 @@ def _fit_bushing(_, job: _Job):
     return row, document
 
 
-def fit_many(folder: str | Path, out_dir: str | Path, workers: int | None = None, scheduler=None,
-             preset: str = "default", seed: int = 0, screening: int | None = None, starts: int | None = None,
-             progress: bool = True, ensemble: bool = True) -> list[FleetRow]:
+def fit_many(folder: str | Path, out_dir: str | Path, options: FitOptions | None = None,
+             **keywords) -> list[FleetRow]:
     """Fit every bushing under ``folder`` (see the module docstring); returns the summary rows
-    in the order of the folder names. ``ensemble=False``: each fit skips its ensemble (see
-    ``fitting.fit``), which the fleet's files do not hold."""
+    in the order of the folder names. The keywords are ``fit``'s (``FitOptions``): ``workers``
+    and ``scheduler`` run the fleet, ``progress`` draws its bar, the others go to every fit,
+    which runs serially in its worker; ``ensemble=False``: each fit skips its ensemble, which
+    the fleet's files do not hold."""
+    options = FitOptions.of(options, **keywords)
+    each = replace(options, workers=None, scheduler=None, engine=None, progress=False)
     folder, out_dir = Path(folder), Path(out_dir)
     if not folder.is_dir():
         raise MeasurementError(f"fleet folder {folder} does not exist or is not a directory")
@@ -103,11 +102,11 @@ def fit_many(folder: str | Path, out_dir: str | Path, workers: int | None = None
             if model not in MODEL_CHOICES:
                 raise MeasurementError(f"{path / MANIFEST}: model {model!r} is not one of {', '.join(MODEL_CHOICES)}")
             labels = [_label(t.measurement.source, path) for t in manifest.tests]
-            jobs.append(_Job(path.name, manifest.tests, labels, model, preset, seed, screening, starts, ensemble))
+            jobs.append(_Job(path.name, manifest.tests, labels, model, each))
         except (MeasurementError, ParameterError, OSError, UnicodeDecodeError) as exc:
             rows[path.name] = FleetRow(path.name, error=f"{type(exc).__name__}: {exc}")
 
-    bar = progress_bar(len(bushings), "bushings", "bushing", progress, leave=True)
+    bar = progress_bar(len(bushings), "bushings", "bushing", options.progress, leave=True)
     if bar is not None:
         bar.update(len(rows))
 
@@ -124,7 +123,7 @@ def fit_many(folder: str | Path, out_dir: str | Path, workers: int | None = None
 
     try:
         if jobs:
-            with make_engine(workers, scheduler) as engine:
+            with make_engine(options.workers, options.scheduler) as engine:
                 engine.map(_fit_bushing, jobs, None, each=finished, chunk_size=1)
     except Exception as exc:   # noqa: BLE001 - the engine failed: record it, keep what was fitted
         for job in jobs:

@@ -1,11 +1,15 @@
 """The search presets, defined once: how much of each search phase a fit runs.
 
 ``fit(preset=...)``, the command line's ``--preset`` (its choices and help) and the parameter
-file's provenance all read them here.
+file's provenance all read them here. ``FitOptions``: a fit's settings (a preset among them) as
+one value. The front doors (``fit``, ``fit_many``) take them as keywords, as they always have,
+turn them into one ``FitOptions`` (``FitOptions.of``) and pass that on; the layers below take the
+value, not the keywords again. A keyword they do not know is refused by name.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields, replace
+from typing import Any, Mapping
 
 PAPER_GA = {"population": 300, "generations": 200, "crossover_probability": 0.8, "mutation_probability": 0.05}
 """The paper's genetic algorithm (pymoo: uniform crossover, polynomial mutation per coordinate)."""
@@ -90,3 +94,41 @@ def describe(preset: str) -> str:
     stages = ", ".join(f"{s} x {e}" for s, e in PRESETS[preset].stages)
     return (f"{global_phase(preset)}, then successive halving of bounded trust-region least squares "
             f"(starts x evaluations: {stages}) on chi^2/n over every sample")
+
+
+@dataclass(frozen=True)
+class FitOptions:
+    """A fit's settings (``fit``'s keywords; see its docstring for each).
+
+    What is searched and how: ``preset`` (``presets``), ``seed`` (>= 0), ``screening`` and
+    ``starts`` (overrides of the preset's Sobol points and first-stage starts), ``ensemble``
+    (profiles and posterior), ``jacobian`` (``exact`` or ``difference``), ``fixed`` (parameters
+    held, model units). Further data fitted with the tests: ``kdyn`` (a dynamic-stiffness table
+    or its path), ``multiaxis`` (multi-axis tests or paths) with their ``coupling``. Where it
+    runs: ``workers`` (local processes, default every core), ``scheduler`` (a Dask cluster),
+    ``engine`` (one to reuse), ``progress`` (bars on stderr)."""
+    preset: str = "default"
+    seed: int = 0
+    screening: int | None = None
+    starts: int | None = None
+    ensemble: bool = True
+    jacobian: str = "exact"
+    fixed: Mapping[str, float] | None = None
+    kdyn: Any = None
+    multiaxis: Any = ()
+    coupling: str | None = None
+    workers: int | None = None
+    scheduler: Any = None
+    engine: Any = None
+    progress: bool = True
+
+    @classmethod
+    def of(cls, options: FitOptions | None = None, /, **keywords) -> FitOptions:
+        """``options`` (default: every default) with ``keywords`` put in; an unknown keyword
+        raises TypeError naming it and the known ones."""
+        known = {f.name for f in fields(cls)}
+        unknown = sorted(set(keywords) - known)
+        if unknown:
+            raise TypeError(f"unknown keyword{'s' if len(unknown) > 1 else ''} {', '.join(unknown)}; "
+                            f"the fit takes {', '.join(f.name for f in fields(cls))}")
+        return replace(options if options is not None else cls(), **keywords)
