@@ -17,7 +17,7 @@ from fmu_src.kernels import tangents
 from fmu_src.model.registry import MODELS, get_model
 from fmu_src.parameter_files import load_parameters
 from fmu_src.kernels.vector_tangents import vectorize
-from identification.forward.population import _step_sizes, simulate_population_at
+from identification.forward.population import CommunicationPoints, _step_sizes, simulate_population_at
 from identification.errors import IdentificationError
 from identification.forward.parameter_jacobian import _tangent_names, population_sensitivities, python_sensitivities
 from identification.measured.measurements import load_measurement
@@ -119,11 +119,12 @@ def test_sensitivities_equal_central_differences_every_model(name):
     seeds = np.random.default_rng(1).standard_normal((1, values.shape[1], lanes)) * values[:, :, None]
     forces, sensitivities = python_sensitivities(name, lanes)(values, seeds, t, x, v, index, v, 100,
                                                               *_step_sizes(t))
-    plain = simulate_population_at(values, t, x, v, index, v, 100, model=name)
+    points = CommunicationPoints(t, x, v, index, v)
+    plain = simulate_population_at(values, points, 100, model=name)
     assert np.array_equal(forces, plain)
     for k in range(lanes):
-        up = simulate_population_at(values + CENTRAL_STEP * seeds[:, :, k], t, x, v, index, v, 100, model=name)
-        down = simulate_population_at(values - CENTRAL_STEP * seeds[:, :, k], t, x, v, index, v, 100, model=name)
+        up = simulate_population_at(values + CENTRAL_STEP * seeds[:, :, k], points, 100, model=name)
+        down = simulate_population_at(values - CENTRAL_STEP * seeds[:, :, k], points, 100, model=name)
         central = (up - down) / (2.0 * CENTRAL_STEP)
         assert np.linalg.norm(sensitivities[0, :, k] - central[0]) <= 1e-6 * np.linalg.norm(central[0]), (name, k)
 
@@ -226,8 +227,9 @@ def test_compiled_sensitivities_are_the_plain_forces_and_python_lanes():
     index = np.arange(0, t.size, 3)
     seeds = np.random.default_rng(5).standard_normal((2, values.shape[1], lanes)) * values[:, :, None]
     matrix = np.vstack([values, values * 1.1])
-    forces, sensitivities = population_sensitivities(matrix, seeds, t, x, v, index, v[index], 100, model)
-    assert np.array_equal(forces, simulate_population_at(matrix, t, x, v, index, v[index], 100, model=model))
+    points = CommunicationPoints(t, x, v, index, v[index])
+    forces, sensitivities = population_sensitivities(matrix, seeds, points, 100, model)
+    assert np.array_equal(forces, simulate_population_at(matrix, points, 100, model=model))
     _, python = python_sensitivities(model, lanes)(matrix, seeds, t, x, v, index, v[index], 100, *_step_sizes(t))
     assert np.allclose(sensitivities, python, rtol=1e-12, atol=1e-12 * np.max(np.abs(python)))
 
@@ -306,4 +308,4 @@ def test_the_sensitivities_check_their_output_points_as_the_forces_do():
     seeds = np.zeros(values.shape + (2,))
     for index in (np.array([3, 2]), np.array([0, t.size])):
         with pytest.raises(ValueError, match="increasing indices into time_s"):
-            population_sensitivities(values, seeds, t, t, t, index, t[:2], model=model)
+            population_sensitivities(values, seeds, CommunicationPoints(t, t, t, index, t[:2]), model=model)

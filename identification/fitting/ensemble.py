@@ -241,9 +241,7 @@ class ProbeMeasure:
         from identification.forward.parameter_jacobian import population_sensitivities
         driven = self.driven
         matrix, seeds = self.space.to_parameters_and_seeds(np.asarray(theta, dtype=float)[None, :])
-        forces, sensitivities = population_sensitivities(matrix, seeds, driven.time_s, driven.displacement_mm,
-                                                         driven.velocity_mm_s, driven.output_index,
-                                                         driven.output_velocity_mm_s, model=self.space.bushing)
+        forces, sensitivities = population_sensitivities(matrix, seeds, driven, model=self.space.bushing)
         value = float(self.of_forces(forces)[0])
         if self.measure == "energy":
             step = np.diff(self.displacement)[:, None]

@@ -273,10 +273,8 @@ class Objective:
         scale = 1.0 / math.sqrt(self.size)
         parts, derivatives = [], []
         for test in self.tests:
-            d = test.driven
-            predicted, sensitivity = population_sensitivities(matrix, seeds, d.time_s, d.displacement_mm,
-                                                              d.velocity_mm_s, d.output_index, d.output_velocity_mm_s,
-                                                              FIT_MAX_SUBSTEPS, self.bushing)
+            predicted, sensitivity = population_sensitivities(matrix, seeds, test.driven, FIT_MAX_SUBSTEPS,
+                                                              self.bushing)
             parts.append((predicted - test.measured_N) * (scale / test.sigma_N))
             derivatives.append(sensitivity * (scale / test.sigma_N))
         parts.append(self._difference_part(matrix))

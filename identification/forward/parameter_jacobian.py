@@ -42,8 +42,8 @@ from fmu_src.kernels import numba_binding as _kernels, tangents
 from fmu_src.model import elements, integration
 from fmu_src.model.registry import BushingModel, DEFAULT_MODEL, resolve_model
 from fmu_src.kernels.jit import numba
-from identification.forward.population import (_input_arrays, _population_loop, _step_sizes, output_points,
-                                               parameter_matrix)
+from identification.forward.population import (CommunicationPoints, _input_arrays, _population_loop, _step_sizes,
+                                               output_points, parameter_matrix)
 
 _MAX_SUBSTEPS = integration.DEFAULT_MAX_SUBSTEPS
 
@@ -217,16 +217,15 @@ def python_sensitivities(model: str | BushingModel, lanes: int) -> Callable:
     return types.FunctionType(_population_loop.__code__, namespace, "_population_loop")
 
 
-def population_sensitivities(parameter_sets, seeds, time_s, displacement_mm, velocity_mm_s, output_index,
-                             output_velocity_mm_s, max_substeps: int = _MAX_SUBSTEPS,
+def population_sensitivities(parameter_sets, seeds, points: CommunicationPoints, max_substeps: int = _MAX_SUBSTEPS,
                              model: str | BushingModel = DEFAULT_MODEL) -> tuple[np.ndarray, np.ndarray]:
-    """Forces [N], shape (P, outputs), as ``population.simulate_population_at`` gives them (the
-    same bits), and their derivatives, shape (P, outputs, K), in the K directions ``seeds`` (P, m,
-    K): the derivatives of each row's m parameters (in the model's order) along each direction.
-    NaN (both) from where a candidate fails. More than MAX_LANES directions run in chunks
-    (:func:`lane_chunk`)."""
-    t, x, v = _input_arrays(time_s, displacement_mm, velocity_mm_s)
-    out_index, out_velocity = output_points(t, output_index, output_velocity_mm_s)
+    """Forces [N], shape (P, outputs), as ``population.simulate_population_at`` gives them on
+    ``points`` (the same bits), and their derivatives, shape (P, outputs, K), in the K directions
+    ``seeds`` (P, m, K): the derivatives of each row's m parameters (in the model's order) along
+    each direction. NaN (both) from where a candidate fails. More than MAX_LANES directions run in
+    chunks (:func:`lane_chunk`)."""
+    t, x, v = _input_arrays(points.time_s, points.displacement_mm, points.velocity_mm_s)
+    out_index, out_velocity = output_points(t, points.output_index, points.output_velocity_mm_s)
     bushing = resolve_model(model)
     matrix = parameter_matrix(parameter_sets, bushing)
     seeds = np.ascontiguousarray(seeds, dtype=float)

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import inspect
 import types
+from dataclasses import dataclass
 from typing import Mapping
 
 from fmu_src.kernels.jit import numba
@@ -216,14 +217,28 @@ def simulate_population_held(parameter_sets, time_s, displacement_mm, velocity_m
                    out_velocity, max_substeps, *_step_sizes(t))
 
 
-def simulate_population_at(parameter_sets, time_s, displacement_mm, velocity_mm_s, output_index,
-                           output_velocity_mm_s, max_substeps: int = _MAX_SUBSTEPS,
+@dataclass(frozen=True)
+class CommunicationPoints:
+    """The path a population runs on: the communication points ``time_s`` [s] (increasing), the
+    displacement there ``displacement_mm`` [mm] and each step's velocity ``velocity_mm_s``
+    [mm/s]; the forces are read at ``time_s[output_index]`` (increasing indices), the viscous
+    feedthrough taken at ``output_velocity_mm_s`` [mm/s] (one each). One axis: 1-D arrays; the
+    coupled form: (points, d) and (outputs, d). ``input_path.DrivenInput`` and
+    ``DrivenVectorInput`` carry the same names and serve as well."""
+    time_s: np.ndarray
+    displacement_mm: np.ndarray
+    velocity_mm_s: np.ndarray
+    output_index: np.ndarray
+    output_velocity_mm_s: np.ndarray
+
+
+def simulate_population_at(parameter_sets, points: CommunicationPoints, max_substeps: int = _MAX_SUBSTEPS,
                            model: str | BushingModel = DEFAULT_MODEL) -> np.ndarray:
-    """Forces [N], shape (P, outputs), at the communication points ``time_s[output_index]``
-    (increasing), with the force's viscous feedthrough taken at ``output_velocity_mm_s``; the
-    input between communication points as in :func:`simulate_population_held`."""
-    t, x, v = _input_arrays(time_s, displacement_mm, velocity_mm_s)
-    out_index, out_velocity = output_points(t, output_index, output_velocity_mm_s)
+    """Forces [N], shape (P, outputs), at the output points of ``points``
+    (``CommunicationPoints``); the input between communication points as in
+    :func:`simulate_population_held`."""
+    t, x, v = _input_arrays(points.time_s, points.displacement_mm, points.velocity_mm_s)
+    out_index, out_velocity = output_points(t, points.output_index, points.output_velocity_mm_s)
     model = resolve_model(model)
     return _forces(compiled_model(model), parameter_matrix(parameter_sets, model), t, x, v, out_index, out_velocity,
                    max_substeps, *_step_sizes(t))
@@ -237,29 +252,28 @@ def simulate_coupled_held(parameter_sets, time_s, displacement_mm, velocity_mm_s
     :func:`simulate_population_held` for one axis: the force at t_k+1 with the velocity v_k). Runs
     on all cores."""
     v = np.atleast_2d(np.asarray(velocity_mm_s, dtype=float))
-    return simulate_coupled_at(parameter_sets, time_s, displacement_mm, v, np.arange(v.shape[0]),
-                               np.vstack([v[:1], v[:-1]]), max_substeps, model)
+    points = CommunicationPoints(time_s, displacement_mm, v, np.arange(v.shape[0]), np.vstack([v[:1], v[:-1]]))
+    return simulate_coupled_at(parameter_sets, points, max_substeps, model)
 
 
-def simulate_coupled_at(parameter_sets, time_s, displacement_mm, velocity_mm_s, output_index, output_velocity_mm_s,
-                        max_substeps: int = _MAX_SUBSTEPS, model: str | BushingModel = DEFAULT_MODEL) -> np.ndarray:
+def simulate_coupled_at(parameter_sets, points: CommunicationPoints, max_substeps: int = _MAX_SUBSTEPS,
+                        model: str | BushingModel = DEFAULT_MODEL) -> np.ndarray:
     """Force vectors [N], shape (P, outputs, d), of P parameter sets of ``model``'s coupled form at
-    the communication points ``time_s[output_index]`` (increasing) of the path ``displacement_mm``
-    (points, d = 2 or 3) [mm] with the steps' velocities ``velocity_mm_s`` (points, d) [mm/s], the
-    viscous feedthrough taken at ``output_velocity_mm_s`` (outputs, d): the coupled counterpart of
-    :func:`simulate_population_at`. Runs on all cores."""
+    the output points of ``points`` (``CommunicationPoints``: the displacement and the steps'
+    velocities (points, d = 2 or 3), the output velocities (outputs, d)): the coupled counterpart
+    of :func:`simulate_population_at`. Runs on all cores."""
     model = resolve_model(model)
     if model.coupled is None:
         raise ValueError(f"the {model.name} model has no coupled form")
-    t = np.ascontiguousarray(time_s, dtype=float)
-    x = np.atleast_2d(np.asarray(displacement_mm, dtype=float))
-    v = np.atleast_2d(np.asarray(velocity_mm_s, dtype=float))
+    t = np.ascontiguousarray(points.time_s, dtype=float)
+    x = np.atleast_2d(np.asarray(points.displacement_mm, dtype=float))
+    v = np.atleast_2d(np.asarray(points.velocity_mm_s, dtype=float))
     d = x.shape[1]
     if not (t.ndim == 1 and t.size >= 2 and x.shape == v.shape == (t.size, d) and d in (2, 3)):
         raise ValueError(f"time (points,) and displacement and velocity (points, 2 or 3): got {t.shape}, {x.shape}, "
                          f"{v.shape}")
-    out_index = np.ascontiguousarray(output_index, dtype=np.int64)
-    out_velocity = np.atleast_2d(np.asarray(output_velocity_mm_s, dtype=float))
+    out_index = np.ascontiguousarray(points.output_index, dtype=np.int64)
+    out_velocity = np.atleast_2d(np.asarray(points.output_velocity_mm_s, dtype=float))
     if not (out_index.ndim == 1 and out_index.size >= 1 and out_velocity.shape == (out_index.size, d)
             and np.all(np.diff(out_index) > 0) and 0 <= out_index[0] and out_index[-1] < t.size):
         raise ValueError("output_index must be increasing indices into time_s, one output velocity vector each")

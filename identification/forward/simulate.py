@@ -73,8 +73,7 @@ def simulate_driven(matrix: np.ndarray, driven: DrivenInput, max_substeps: int |
     (``population.parameter_matrix``) on a prepared input, at its output samples
     (``driven.sample_index``). NaN from where a candidate fails."""
     kwargs = {} if max_substeps is None else {"max_substeps": max_substeps}
-    return simulate_population_at(matrix, driven.time_s, driven.displacement_mm, driven.velocity_mm_s,
-                                  driven.output_index, driven.output_velocity_mm_s, model=model, **kwargs)
+    return simulate_population_at(matrix, driven, model=model, **kwargs)
 
 
 def simulate_driven_vector(matrix: np.ndarray, driven: DrivenVectorInput, max_substeps: int | None = None,
@@ -89,8 +88,7 @@ def simulate_driven_vector(matrix: np.ndarray, driven: DrivenVectorInput, max_su
     parts = []
     if coupled_axes and bushing.coupled is not None:
         group = DrivenVectorInput(driven.components[:coupled_axes])
-        parts.append(simulate_coupled_at(matrix, group.time_s, group.displacement_mm, group.velocity_mm_s,
-                                         group.output_index, group.output_velocity_mm_s, model=bushing, **kwargs))
+        parts.append(simulate_coupled_at(matrix, group, model=bushing, **kwargs))
     alone = driven.components[coupled_axes if bushing.coupled is not None else 0:]
     parts += [simulate_driven(matrix, c, max_substeps, bushing)[:, :, None] for c in alone]
     return np.concatenate(parts, axis=2)
