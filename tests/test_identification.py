@@ -307,7 +307,8 @@ def test_paper_ga_preset_runs_the_ga_then_the_least_squares_stages(monkeypatch):
 
     def counted_ga(*args, **kwargs):
         theta, misfits = genetic_algorithm(*args, **kwargs)
-        ga_runs.append((kwargs["population"], kwargs["generations"], len(misfits)))
+        settings = args[4] if len(args) > 4 else kwargs["settings"]
+        ga_runs.append((settings["population"], settings["generations"], len(misfits)))
         return theta, misfits
 
     def no_screening(*args, **kwargs):

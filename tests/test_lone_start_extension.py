@@ -50,7 +50,7 @@ def records(final_thetas, waiting_thetas, waiting_stage=0):
 
 
 def extend(found, starts=3):
-    return _extend_if_alone(DoubleWell(), SerialEngine(), found, (starts, 50), 1, RESIDUALS, COORDINATES, _Bars())
+    return _extend_if_alone(DoubleWell(), SerialEngine(), found, (starts, 50), 1, (RESIDUALS, COORDINATES), _Bars())
 
 
 def agreeing(found):

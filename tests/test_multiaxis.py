@@ -270,14 +270,14 @@ def test_the_multiaxis_rows_of_the_jacobian_are_its_forward_differences(fit_rig)
     sensitivities) from differences: those rows equal difference_jacobian's bit for bit."""
     from identification.measured.measurements import load_measurement
     from identification.fitting.multistart import Problem, difference_jacobian
-    from identification.fitting.objectives import Objective
+    from identification.fitting.objectives import MultiAxisTests, Objective
     from identification.measured.rig_tests import RigTest
     from identification.fitting.search_space import SearchSpace
     folder, sine, files = fit_rig
     ellipse = load_multiaxis(files["ellipse"])
     tests = [RigTest(load_measurement(sine), "sine")]
     space = SearchSpace.from_measurements([tests[0].measurement] + ellipse.components(), "single_bouc_wen")
-    objective = Objective(tests, model="single_bouc_wen", multiaxis=[ellipse], coupling="radial")
+    objective = Objective(tests, model="single_bouc_wen", multiaxis=MultiAxisTests([ellipse], coupling="radial"))
     assert objective.difference_size == ellipse.force_N.size
     theta = space.to_coordinates(FIT_TRUTH)
     residual, jacobian = Problem(objective, space, "exact").residuals_and_jacobian(theta)

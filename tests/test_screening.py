@@ -9,7 +9,7 @@ import pytest
 
 from identification.fitting.engine import SerialEngine
 from identification.fitting.fit import training_request
-from identification.fitting.multistart import Problem, screen
+from identification.fitting.multistart import PrefixScreening, Problem, screen
 from identification.fitting.presets import PRESETS, SCREENING_PREFIX, SearchSettings
 from identification.fitting.search import begin
 from identification.measured.kdyn_table import load_kdyn_table
@@ -44,7 +44,8 @@ def test_the_prefix_is_the_start_of_every_test_with_its_noise_and_steps(table5_p
 
 def test_screening_on_a_prefix_keeps_the_best_eighth_in_order_with_the_whole_tests_misfits(table5_problem):
     tests, problem = table5_problem
-    theta, misfits = screen(problem, SerialEngine(), 256, seed=3, prefix=prefix_problem(tests, problem), kept=1 / 8)
+    theta, misfits = screen(problem, SerialEngine(), 256, seed=3,
+                            prefix=PrefixScreening(prefix_problem(tests, problem), 1 / 8))
     all_theta, all_misfits = screen(prefix_problem(tests, problem), SerialEngine(), 256, seed=3)
     chosen = np.sort(np.argsort(all_misfits, kind="stable")[:32])
     assert theta.shape == (32, all_theta.shape[1]) and np.array_equal(theta, all_theta[chosen])
@@ -57,8 +58,8 @@ def test_on_the_table5_tests_the_prefix_keeps_every_point_the_whole_screening_wo
     # of the 128 starts of 8192) are all among the 128 kept
     tests, problem = table5_problem
     settings = PRESETS["default"]
-    theta, misfits = screen(problem, SerialEngine(), 1024, seed=0, prefix=prefix_problem(tests, problem),
-                            kept=settings.prefix_kept)
+    theta, misfits = screen(problem, SerialEngine(), 1024, seed=0,
+                            prefix=PrefixScreening(prefix_problem(tests, problem), settings.prefix_kept))
     all_theta, all_misfits = screen(problem, SerialEngine(), 1024, seed=0)
     best = all_theta[np.argsort(all_misfits, kind="stable")[:16]]
     assert all(any(np.array_equal(point, kept) for kept in theta) for point in best)

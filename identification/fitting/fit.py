@@ -305,7 +305,7 @@ def fit_linear(request: SearchRequest, started: float) -> FitResult:
         scales = SearchSpace.from_table(table)
         scale = {"displacement": scales.k_ref, "velocity": scales.c_ref}
         values = {**{name: scale[regressor] for name, regressor in bushing.linear.regressors}, **held}
-    objective = Objective(tests, noise, model=bushing, table=table, **multi.objective_arguments())
+    objective = Objective(tests, noise, model=bushing, table=table, multiaxis=multi)
     if table is not None:
         def residuals(solved):
             return objective.residual_matrix(parameter_matrix([{**dict(zip(free, solved)), **held}], bushing))[0]

@@ -28,12 +28,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Mapping
 
 import numpy as np
 from scipy.optimize import least_squares
 from scipy.stats import qmc
 
 from identification.fitting.objectives import Objective
+from identification.fitting.presets import PAPER_GA
 from identification.fitting.search_space import SearchSpace
 
 DIFFERENCE_STEP = 1e-6
@@ -106,28 +108,40 @@ class StartRecord:
     from then on, counted (``failed_starts``), and keeps the last point where it was finite."""
 
 
-def screen(problem: Problem, engine, count: int, seed: int, progress=None,
-           anchored: dict[int, float] | None = None, anchored_count: int = 0, prefix: Problem | None = None,
-           kept: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
-    """``count`` scrambled Sobol points over the box and their misfits; with ``anchored``
-    ({coordinate index: value}, from the data: ``identification.fitting.loop_start``), ``anchored_count``
-    more: the first Sobol points with those coordinates set to those values. With ``prefix`` (the
-    problem on the start of each test: ``Objective.prefix``), every point is screened on it first
-    and only the best ``kept`` fraction of them (in their order) is returned, with the misfits of
+@dataclass(frozen=True)
+class AnchoredStarts:
+    """``count`` more screened points, the first Sobol points with the coordinates ``values``
+    ({coordinate index: value}, from the data: ``identification.fitting.loop_start``) set."""
+    values: dict[int, float]
+    count: int
+
+
+@dataclass(frozen=True)
+class PrefixScreening:
+    """Every point screened first on ``problem``, the problem on the start of each test
+    (``Objective.prefix``), and only the best ``kept`` fraction (in their order) screened whole."""
+    problem: Problem
+    kept: float
+
+
+def screen(problem: Problem, engine, count: int, seed: int, progress=None, anchored: AnchoredStarts | None = None,
+           prefix: PrefixScreening | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """``count`` scrambled Sobol points over the box and their misfits, with the ``anchored``
+    starts added. With ``prefix``, only the points it keeps are returned, with the misfits of
     ``problem``: each point's simulation is its own, so a point's misfit has the same bits however
     it was selected."""
     bounds = problem.space.bounds()
     unit = qmc.Sobol(len(bounds), scramble=True, seed=np.random.default_rng(seed)).random(count)
     theta = bounds[:, 0] + unit * (bounds[:, 1] - bounds[:, 0])
-    if anchored and anchored_count:
-        extra = theta[np.arange(anchored_count) % count].copy()
-        for index, value in anchored.items():
+    if anchored is not None and anchored.values and anchored.count:
+        extra = theta[np.arange(anchored.count) % count].copy()
+        for index, value in anchored.values.items():
             extra[:, index] = value
         theta = np.vstack([theta, extra])
         count = len(theta)
     if prefix is not None:
-        partial = _misfits(prefix, engine, theta, progress)
-        chosen = np.sort(np.argsort(partial, kind="stable")[:max(1, math.ceil(kept * count))])
+        partial = _misfits(prefix.problem, engine, theta, progress)
+        chosen = np.sort(np.argsort(partial, kind="stable")[:max(1, math.ceil(prefix.kept * count))])
         theta = theta[chosen]
     return theta, _misfits(problem, engine, theta, progress)
 
@@ -138,12 +152,14 @@ def _misfits(problem: Problem, engine, theta: np.ndarray, progress=None) -> np.n
         lambda n: progress(n * 256))))
 
 
-def genetic_algorithm(problem: Problem, engine, seed: int, progress=None, population: int = 300,
-                      generations: int = 200, crossover_probability: float = 0.8,
-                      mutation_probability: float = 0.05) -> tuple[np.ndarray, np.ndarray]:
+def genetic_algorithm(problem: Problem, engine, seed: int, progress=None,
+                      settings: Mapping[str, float] = PAPER_GA) -> tuple[np.ndarray, np.ndarray]:
     """The paper's GA (pymoo: uniform crossover, polynomial mutation with the given
-    probability per coordinate) over the box; returns its final population and misfits.
-    Each generation's population is evaluated through the engine."""
+    probability per coordinate) over the box, ``settings`` as ``presets.PAPER_GA`` names them
+    (population, generations, crossover_probability, mutation_probability); returns its final
+    population and misfits. Each generation's population is evaluated through the engine."""
+    population, generations = settings["population"], settings["generations"]
+    crossover_probability, mutation_probability = settings["crossover_probability"], settings["mutation_probability"]
     from pymoo.algorithms.soo.nonconvex.ga import GA
     from pymoo.core.problem import Problem as PymooProblem
     from pymoo.operators.crossover.ux import UniformCrossover

@@ -143,14 +143,23 @@ class PreparedTable:
                               (angle - rows.loss_angle_deg) * (rows.weight / LOSS_ANGLE_UNCERTAINTY_DEG)])
 
 
+@dataclass(frozen=True)
+class MultiAxisTests:
+    """Multi-axis tests (``identification.measured.multiaxis``) an objective fits: the
+    ``measurements``, each axis's noise level per test (``noise``; None: estimated from each
+    axis's force) and the ``coupling`` the model runs with on them (none, radial, spherical:
+    ``multiaxis.coupled_axes``)."""
+    measurements: Sequence[MultiAxisMeasurement] = ()
+    noise: Sequence[Sequence[NoiseEstimate]] | None = None
+    coupling: str = "none"
+
+
 class Objective:
     """Misfit (chi^2/n) of candidate parameter sets of ``model``; see the module docstring."""
 
     def __init__(self, tests: Sequence[RigTest], noise: Sequence[NoiseEstimate] | None = None,
                  steps: Sequence[int | None] | None = None, model: str | BushingModel = DEFAULT_MODEL,
-                 table: KdynTable | None = None, search: bool = False,
-                 multiaxis: Sequence[MultiAxisMeasurement] = (),
-                 multiaxis_noise: Sequence[Sequence[NoiseEstimate]] | None = None, coupling: str = "none"):
+                 table: KdynTable | None = None, search: bool = False, multiaxis: MultiAxisTests = MultiAxisTests()):
         """``steps``: communication steps per sample of each test (None: chosen from the
         signal, ``input_path.steps_per_sample``); ``identification.fitting.refinement`` raises them
         where a candidate's response needs it. ``table``: a dynamic-stiffness table whose rows
@@ -158,11 +167,10 @@ class Objective:
         if ``search``. Candidates are (P, m) matrices of ``model``'s parameters in its order
         (``population.parameter_matrix``). ``model``: the model or its name, resolved here
         (``bushing``; ``model`` is its name); a worker receives the name and resolves it once.
-        ``multiaxis``: multi-axis tests (``identification.measured.multiaxis``), each axis's force a residual
-        in that axis's noise units (``multiaxis_noise``: per test, per axis; default: estimated),
-        the model run on them with ``coupling`` (none, radial, spherical: ``multiaxis.coupled_axes``);
-        their steps per sample are the signal's (the refinement does not change them)."""
-        if not tests and table is None and not multiaxis:
+        ``multiaxis``: multi-axis tests (``MultiAxisTests``), each axis's force a residual in that
+        axis's noise units, the model run on them with their coupling; their steps per sample are
+        the signal's (the refinement does not change them)."""
+        if not tests and table is None and not multiaxis.measurements:
             raise ValueError("the objective needs at least one training test, multi-axis test or dynamic-stiffness "
                              "table")
         noise = list(noise) if noise is not None else [estimate_noise(t.measurement.force_N) for t in tests]
@@ -184,12 +192,12 @@ class Objective:
         self._source_table = table
         self.search = search and table is not None
         self.table = PreparedTable.of(table, self.bushing, search) if table is not None else None
-        self._source_multiaxis = tuple(multiaxis)
-        self.coupling = coupling
-        self.multiaxis_noise = [list(levels) for levels in multiaxis_noise] if multiaxis_noise is not None else \
-            [[estimate_noise(m.force_N[:, c]) for c in range(m.force_N.shape[1])] for m in multiaxis]
-        self.multiaxis = [PreparedMultiAxis.of(m, levels, coupling)
-                          for m, levels in zip(self._source_multiaxis, self.multiaxis_noise)]
+        noise = [list(levels) for levels in multiaxis.noise] if multiaxis.noise is not None else \
+            [[estimate_noise(m.force_N[:, c]) for c in range(m.force_N.shape[1])] for m in multiaxis.measurements]
+        self._source_multiaxis = MultiAxisTests(tuple(multiaxis.measurements), noise, multiaxis.coupling)
+        self.coupling = multiaxis.coupling
+        self.multiaxis = [PreparedMultiAxis.of(m, levels, multiaxis.coupling)
+                          for m, levels in zip(multiaxis.measurements, noise)]
         self.size = (sum(t.measured_N.size for t in self.tests) + sum(m.size for m in self.multiaxis)
                      + (self.table.size if self.table else 0))
 
@@ -197,7 +205,7 @@ class Objective:
         """The same objective (of ``tests``, the ones it was made of) with other steps per
         sample (the table's loop as it is)."""
         return Objective(tests, self.noise, steps, self.bushing, self._source_table, self.search,
-                         self._source_multiaxis, self.multiaxis_noise, self.coupling)
+                         self._source_multiaxis)
 
     def prefix(self, tests: Sequence[RigTest], fraction: float) -> "Objective | None":
         """The same objective (of ``tests``, the ones it was made of) on the first ``fraction``
@@ -221,7 +229,7 @@ class Objective:
         if not self.search:
             return self
         return Objective(tests, self.noise, self.steps_per_sample, self.bushing, self._source_table, False,
-                         self._source_multiaxis, self.multiaxis_noise, self.coupling)
+                         self._source_multiaxis)
 
     def __getstate__(self):
         """Everything but the model, which does not pickle: a worker resolves its name."""

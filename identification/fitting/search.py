@@ -28,12 +28,12 @@ from identification.fitting.result import MIN_AGREEING, FitResult, RigTestFit, T
 from identification.measured.kdyn_table import KdynTable
 from identification.fitting.loop_start import LOOP_STARTS, anchored_coordinates, slow_loop_start
 from identification.measured.measurements import Measurement
-from identification.measured.multiaxis import MultiAxisMeasurement, vector_nrmse
-from identification.fitting.multistart import (Problem, StartRecord, failed_starts, first_records, jacobian, run_stages,
-                                               screen, simulations_per_jacobian)
+from identification.measured.multiaxis import vector_nrmse
+from identification.fitting.multistart import (AnchoredStarts, PrefixScreening, Problem, StartRecord, failed_starts,
+                                               first_records, jacobian, run_stages, screen, simulations_per_jacobian)
 from identification.measured.repeatability import estimate_repeatability
 from identification.measured.noise import NoiseEstimate
-from identification.fitting.objectives import Objective, nrmse
+from identification.fitting.objectives import MultiAxisTests, Objective, nrmse
 from identification.fitting.presets import PAPER_GA, SearchSettings
 from identification.fitting.progress import SearchProgress, notice_later
 from identification.fitting.refinement import refine_steps
@@ -43,14 +43,9 @@ from identification.fitting.table_start import sines_as_table, table_start
 
 
 @dataclass(frozen=True)
-class MultiAxisTraining:
-    """The multi-axis training tests, each axis's noise level and the coupling they are run with."""
-    measurements: list[MultiAxisMeasurement]
-    noise: list[list[NoiseEstimate]]
-    coupling: str
-
-    def objective_arguments(self) -> dict:
-        return {"multiaxis": self.measurements, "multiaxis_noise": self.noise, "coupling": self.coupling}
+class MultiAxisTraining(MultiAxisTests):
+    """The multi-axis training tests, each axis's noise level (estimated) and the coupling they
+    are run with; an objective's (``MultiAxisTests``) with each test's fit."""
 
     def components(self) -> list[Measurement]:
         return [c for m in self.measurements for c in m.components()]
@@ -314,7 +309,7 @@ class Search:
             if note:
                 self.notes.append(note)
         objective = Objective(request.tests, request.noise, model=self.space.bushing, table=request.table,
-                              search=request.table is not None, **multi.objective_arguments())
+                              search=request.table is not None, multiaxis=multi)
         self.n, self.d = objective.size, len(self.space.names)     # residuals, coordinates
         return Problem(objective, self.space, self.jacobian_kind)
 
@@ -350,12 +345,11 @@ class Search:
         self.bars = SearchProgress(self.progress, settings, settings.global_evaluations(points) + kept)
         if settings.genetic:
             from identification.fitting.multistart import genetic_algorithm
-            theta, misfits = genetic_algorithm(problem, self.engine, self.request.seed, self.bars.screening,
-                                               **PAPER_GA)
+            theta, misfits = genetic_algorithm(problem, self.engine, self.request.seed, self.bars.screening, PAPER_GA)
         else:
+            anchored = AnchoredStarts(loop and anchored_coordinates(loop, self.space), LOOP_STARTS)
             theta, misfits = screen(problem, self.engine, settings.screening, self.request.seed, self.bars.screening,
-                                    anchored=loop and anchored_coordinates(loop, self.space),
-                                    anchored_count=LOOP_STARTS, prefix=prefix, kept=settings.prefix_kept)
+                                    anchored, prefix and PrefixScreening(prefix, settings.prefix_kept))
         self.evaluations += settings.global_evaluations(points) + kept
         return theta, misfits
 
@@ -374,7 +368,7 @@ class Search:
         refinement = _check_steps(self.problem, tests, records, n, d)
         problem = Problem(refinement.objective.with_fit_loop(tests), space, self.jacobian_kind)
         records = run_stages(problem, engine, records, [last], bars.stage, first_stage=len(early))
-        records, added, agreeing = _extend_if_alone(problem, engine, records, last, len(early), n, d, bars)
+        records, added, agreeing = _extend_if_alone(problem, engine, records, last, len(early), (n, d), bars)
         final_count = last[0] + added
         if added:
             self.notes.append(f"note: only {agreeing} of the {last[0]} final starts reached the best misfit, so {added} "
@@ -467,15 +461,16 @@ def _identifiability_jacobian(problem: Problem, theta: np.ndarray, notes: list[s
 
 
 def _extend_if_alone(problem: Problem, engine, records: list[StartRecord], last: tuple[int, int], stage: int,
-                     n: int, d: int, bars) -> tuple[list[StartRecord], int, int]:
+                     size: tuple[int, int], bars) -> tuple[list[StartRecord], int, int]:
     """If fewer than MIN_AGREEING of the last stage's starts reach the best misfit within the
     ensemble threshold, up to ``last[0]`` more starts run the last stage too (once): those that
     stopped in the latest earlier stage first, each group by misfit. A lone best start thus
     gets its chance to be confirmed, or a better optimum is found, before the fit says it is
-    not converged. Returns the records (sorted as ``run_stages`` sorts them), how many starts
-    were added and how many agreed before."""
+    not converged. ``size``: (residuals, coordinates) of the misfit's threshold. Returns the
+    records (sorted as ``run_stages`` sorts them), how many starts were added and how many
+    agreed before."""
     best = min((r.misfit for r in records if r.stage == stage and not r.failed), default=np.inf)
-    agreeing = agreeing_starts(records, stage, best, misfit_threshold(best, n, d)) if np.isfinite(best) else 0
+    agreeing = agreeing_starts(records, stage, best, misfit_threshold(best, *size)) if np.isfinite(best) else 0
     waiting = sorted((r for r in records if r.stage < stage and not r.failed),
                      key=lambda r: (-r.stage, r.misfit, r.start))[:last[0]]
     if agreeing >= MIN_AGREEING or not waiting:
