@@ -314,3 +314,24 @@ def test_no_function_is_longer_than_a_reader_can_hold():
             if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)) and node.end_lineno - node.lineno >= 100:
                 long.append(f"{path.relative_to(REPO)}:{node.lineno} {node.name}, {node.end_lineno - node.lineno + 1} lines")
     assert not long, long
+
+
+COMPILED_KERNELS = {"identification/forward/population.py": {"_population_loop", "_STEP"},
+                    "identification/forward/steady_state.py": {"_sine_steady_state"}}
+"""Loops numba compiles, which take scalars and arrays (no records): exempt from the count below."""
+
+
+def test_no_function_of_the_identification_or_the_fmi_layer_takes_more_than_seven_parameters():
+    import ast
+    many = []
+    for path in [*(REPO / "identification").rglob("*.py"), *(REPO / "fmu_src" / "fmi").rglob("*.py")]:
+        name = path.relative_to(REPO).as_posix()
+        for node in ast.walk(ast.parse(path.read_text())):
+            if not isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                continue
+            arguments = node.args
+            names = [a.arg for a in arguments.posonlyargs + arguments.args + arguments.kwonlyargs]
+            count = len(names) - (names[:1] in (["self"], ["cls"])) + bool(arguments.vararg) + bool(arguments.kwarg)
+            if count > 7 and node.name not in COMPILED_KERNELS.get(name, ()):
+                many.append(f"{name}:{node.lineno} {node.name}, {count} parameters")
+    assert not many, many

@@ -508,7 +508,8 @@ def table_fit(table: KdynTable | None, parameters: ParameterSet) -> TableFit | N
     a fitted table, or one held out (``compare``)."""
     if table is None:
         return None
-    from identification.forward.dynamic_stiffness import MAX_CYCLES, STEPS_PER_CYCLE, TOLERANCE, run_sines, stiffness_from_sums
+    from identification.forward.dynamic_stiffness import (MAX_CYCLES, STEPS_PER_CYCLE, SteadyStateLoop, run_sines,
+                                                          stiffness_from_sums)
     from identification.fitting.objectives import PreparedTable
     model = parameters.model
     prepared = PreparedTable.of(table, model)
@@ -516,8 +517,8 @@ def table_fit(table: KdynTable | None, parameters: ParameterSet) -> TableFit | N
     matrix = parameter_matrix([parameters.parameters], model)
 
     def steady(steps):
-        result, _ = run_sines(matrix, model, rows.amplitude_mm, rows.frequency_hz, rows.preload_mm, steps, MAX_CYCLES,
-                              TOLERANCE)
+        result, _ = run_sines(matrix, model, rows.amplitude_mm, rows.frequency_hz, rows.preload_mm,
+                              SteadyStateLoop(steps))
         if np.any(result[:, 3] == 1):
             warnings.warn(f"{table.name}: some cases of the fitted set reach no steady state within {MAX_CYCLES} "
                           "cycles", CharacterisationWarning, stacklevel=4)

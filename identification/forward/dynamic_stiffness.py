@@ -28,7 +28,7 @@ import math
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Sequence
+from typing import Any, Sequence
 
 import numpy as np
 
@@ -127,10 +127,21 @@ class DynamicStiffness:
         return "\n".join(lines)
 
 
+@dataclass(frozen=True)
+class SteadyStateLoop:
+    """How each sine runs to its steady state (``steady_state``): ``steps_per_cycle`` integration
+    steps per cycle; until the relative change of |K*| between cycles is below ``tolerance`` (0:
+    exactly ``max_cycles`` cycles, a smooth function of the parameters, as a fit needs), at most
+    ``max_cycles`` (one cap, or one per case); ``max_substeps`` per step before a case fails."""
+    steps_per_cycle: int = STEPS_PER_CYCLE
+    max_cycles: Any = MAX_CYCLES
+    tolerance: float = TOLERANCE
+    max_substeps: int = MAX_SUBSTEPS
+
+
 def characterise(parameters, amplitudes_mm: Sequence[float] = DEFAULT_AMPLITUDES_MM,
                  frequencies_hz: Sequence[float] = DEFAULT_FREQUENCIES_HZ, model: str | BushingModel | None = None,
-                 preload_mm: float = 0.0, steps_per_cycle: int = STEPS_PER_CYCLE, tolerance: float = TOLERANCE,
-                 max_cycles: int = MAX_CYCLES) -> DynamicStiffness:
+                 preload_mm: float = 0.0, **loop) -> DynamicStiffness:
     """Dynamic stiffness |K*| and loss angle on every pair of amplitudes and frequencies: the
     data sheet a supplier gives.
 
@@ -147,6 +158,9 @@ def characterise(parameters, amplitudes_mm: Sequence[float] = DEFAULT_AMPLITUDES
         The model the parameters must be for (or its name).
     preload_mm : float
         Static displacement [mm] the sines are about.
+
+    Other Parameters
+    ----------------
     steps_per_cycle : int
         Integration steps per cycle (>= 16).
     tolerance : float
@@ -164,6 +178,8 @@ def characterise(parameters, amplitudes_mm: Sequence[float] = DEFAULT_AMPLITUDES
     ------
     IdentificationError
         Invalid grid values or a simulation that fails.
+    TypeError
+        A keyword that is not a loop setting (``SteadyStateLoop``).
 
     Warns
     -----
@@ -173,16 +189,18 @@ def characterise(parameters, amplitudes_mm: Sequence[float] = DEFAULT_AMPLITUDES
     # here, not at the top: the command line imports this module for its defaults
     from identification.forward.population import parameter_matrix
     from identification.forward.parameter_sets import parameter_sets
+    loop = SteadyStateLoop(**loop)
     bushing, sets = parameter_sets(parameters, model)
     amplitudes = _grid_values(amplitudes_mm, "amplitude", "mm", PLAUSIBLE_AMPLITUDE_MM)
     frequencies = _grid_values(frequencies_hz, "frequency", "Hz", PLAUSIBLE_FREQUENCY_HZ)
-    _check_loop(preload_mm, steps_per_cycle, tolerance, max_cycles)
+    _check_loop(preload_mm, loop)
+    loop = SteadyStateLoop(int(loop.steps_per_cycle), int(loop.max_cycles), loop.tolerance, loop.max_substeps)
     case_amplitude = np.repeat(amplitudes, frequencies.size)
     case_frequency = np.tile(frequencies, amplitudes.size)
     cases = case_amplitude.size
     members = len(sets)
     result, last = run_sines(parameter_matrix(sets, bushing), bushing, case_amplitude, case_frequency,
-                             np.full(cases, float(preload_mm)), int(steps_per_cycle), int(max_cycles), tolerance)
+                             np.full(cases, float(preload_mm)), loop)
     failed = (result[:, 3] == 2) | ~np.all(np.isfinite(last), axis=1)
     if failed[:cases].any():
         i = int(np.argmax(failed[:cases]))
@@ -196,7 +214,7 @@ def characterise(parameters, amplitudes_mm: Sequence[float] = DEFAULT_AMPLITUDES
         warnings.warn(f"{members - len(runs)} of the {members} ensemble members fail on some case (overflow or too many "
                       "substeps) and are left out of the min/max columns", CharacterisationWarning, stacklevel=2)
     best = tables[0]
-    _warn_unsteady(tables, case_amplitude, case_frequency, max_cycles, tolerance)
+    _warn_unsteady(tables, case_amplitude, case_frequency, loop.max_cycles, loop.tolerance)
     table = DynamicStiffness(case_amplitude, case_frequency, np.full(cases, float(preload_mm)),
                              **{name: best[name] for name in RESULT_COLUMNS}, cycles=best["cycles"],
                              converged=best["converged"], loop_force_N=best["loop"], model=bushing.name,
@@ -207,8 +225,9 @@ def characterise(parameters, amplitudes_mm: Sequence[float] = DEFAULT_AMPLITUDES
     return table
 
 
-def _check_loop(preload_mm: float, steps_per_cycle: int, tolerance: float, max_cycles: int) -> None:
+def _check_loop(preload_mm: float, loop: SteadyStateLoop) -> None:
     """``characterise``'s loop settings, each refused with its value and what is allowed."""
+    steps_per_cycle, tolerance, max_cycles = loop.steps_per_cycle, loop.tolerance, loop.max_cycles
     if not math.isfinite(preload_mm):
         raise IdentificationError(f"preload = {preload_mm} mm: give a finite displacement")
     if int(steps_per_cycle) != steps_per_cycle or steps_per_cycle < 16:
@@ -235,23 +254,22 @@ def _warn_unsteady(tables, case_amplitude, case_frequency, max_cycles: int, tole
 
 
 def run_sines(matrix: np.ndarray, model: str | BushingModel, amplitude_mm: np.ndarray, frequency_hz: np.ndarray,
-              preload_mm: np.ndarray, steps_per_cycle: int, max_cycles, tolerance: float,
-              max_substeps: int = MAX_SUBSTEPS):
-    """Every parameter set (rows of ``matrix``) on every case (equal-length arrays): the compiled
-    loop of ``identification.forward.steady_state``, cases of all sets in parallel. Returns its
-    ``result`` (P*cases, 4: a, b, cycles, status; set-major) and ``last`` (P*cases, steps).
-    ``max_cycles``: one cap for all cases, or one per case. ``tolerance`` 0 runs exactly
-    ``max_cycles`` cycles (a smooth function of the parameters, as a fit needs; status 1 then
-    means done). ``max_substeps`` per communication step before a case fails (status 2)."""
+              preload_mm: np.ndarray, loop: SteadyStateLoop = SteadyStateLoop()):
+    """Every parameter set (rows of ``matrix``) on every case (equal-length arrays), run as
+    ``loop`` says: the compiled loop of ``identification.forward.steady_state``, cases of all
+    sets in parallel. Returns its ``result`` (P*cases, 4: a, b, cycles, status; set-major) and
+    ``last`` (P*cases, steps). Status 1: no steady state within the cycles (with tolerance 0:
+    done); 2: the case failed (too many substeps)."""
     from identification.forward.population import compiled_model
+    steps_per_cycle, tolerance = loop.steps_per_cycle, loop.tolerance
     members, cases = matrix.shape[0], amplitude_mm.size
-    cycles = np.broadcast_to(np.asarray(max_cycles, dtype=np.int64), (cases,))
+    cycles = np.broadcast_to(np.asarray(loop.max_cycles, dtype=np.int64), (cases,))
     rows = np.repeat(np.arange(members, dtype=np.int64), cases)
     result = np.zeros((rows.size, 4))
     last = np.zeros((rows.size, steps_per_cycle))
     compiled_model(model)._sine_steady_state(
         matrix, rows, np.tile(amplitude_mm, members), np.tile(frequency_hz, members), np.tile(preload_mm, members),
-        steps_per_cycle, min(MIN_CYCLES, int(cycles.min())), np.tile(cycles, members), tolerance, max_substeps,
+        steps_per_cycle, min(MIN_CYCLES, int(cycles.min())), np.tile(cycles, members), tolerance, loop.max_substeps,
         result, last)
     return result, last
 
