@@ -6,7 +6,7 @@ The sensitivity of each measure (the 10 Hz sine's rms force, the step's force at
 rise and at 10 s) to a 10 % change of each parameter of Table 5 (identification.analysis.parameter_sensitivity),
 ranked, against the ranks the paper computed in ADAMS (Tables 1 and 3, typed in
 identification.analysis.parameter_sensitivity.PAPER_RANKS); prints Spearman's rho per measure and the parameter
-ranked first. tests/test_identification.py asserts rho > 0.7 and the first ranks.
+ranked first. tests/identification/fitting/test_identification.py asserts rho > 0.7 and the first ranks.
 """
 from __future__ import annotations
 

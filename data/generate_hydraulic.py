@@ -6,7 +6,7 @@ Truth: the project's hydraulic model (``fmu_src/models/hydraulic_model.py``) wit
 ``params_hydraulic_mount.json`` (a 10 Hz inertia track, a 0.1 mm decoupler): the model's own
 synthetic data, on which a fit of that model must reach the noise floor. Its equations are
 checked independently elsewhere (scipy's Radau, ``tests/references/``; the closed form,
-``tests/test_hydraulic_model.py``).
+``tests/fmu_src/model/test_hydraulic_model.py``).
 
 Files (prefix ``synthetic_hydraulic``), the data of issue 43's recovery test:
 

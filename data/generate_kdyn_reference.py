@@ -1,6 +1,6 @@
 """Generate data/kdyn_table5_table6_grid.csv: the dynamic stiffness and loss angle of the paper's
 Table 5 parameter set on the grid of its Table 6 (0.5-3 mm, 1-30 Hz), computed by this project
-(``identification.forward.dynamic_stiffness``; SYNTHETIC, not measured). tests/test_dynamic_stiffness.py
+(``identification.forward.dynamic_stiffness``; SYNTHETIC, not measured). tests/identification/forward/test_dynamic_stiffness.py
 recomputes it, so that a change in the numbers shows in review.
 
     python data/generate_kdyn_reference.py

@@ -410,7 +410,7 @@ class BushingSlave(Fmi2Slave):
         # pythonfmu 0.7 releases the instance, its class and its log queue once when an
         # exception is raised and once more when the instance is freed (PySlaveInstance's
         # cleanPyObject, twice): freeing a failed instance then corrupts memory and crashes the
-        # host (libcosim at its exit; tests/test_fmu_bad_values.py). One extra reference each,
+        # host (libcosim at its exit; tests/fmu_src/fmi/test_fmu_bad_values.py). One extra reference each,
         # never given back, absorbs the second release: a few kB leaked per failed instance.
         for kept in (self, type(self), self._get_log_queue()):
             ctypes.pythonapi.Py_IncRef(ctypes.py_object(kept))

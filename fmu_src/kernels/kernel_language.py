@@ -25,7 +25,7 @@ tool adds what it infers (C types, activities) and what it writes (C, tangents),
 naming of the versions it makes per argument pattern. :func:`with_bodies` is how both the tangent
 generator and its lanes (``vector_tangents``) keep a kernel's control flow.
 
-``tests/test_kernel_language.py`` runs every entry in Python, numba and C (bit for bit) and its
+``tests/fmu_src/kernels/test_kernel_language.py`` runs every entry in Python, numba and C (bit for bit) and its
 tangent against complex step (or, for the zero-tangent entries, checks the tangent is 0).
 """
 from __future__ import annotations

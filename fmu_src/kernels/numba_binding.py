@@ -425,7 +425,7 @@ def compile_axes(axes) -> tuple[list, dict, str]:
     (the plain-Python step) if numba is not importable or fails, if the host is not a Python
     interpreter or its executable cannot be told (:func:`host_executable`), or if
     $BUSHING_FMU_STEP is "python". The compiled and the plain-Python steps give the same forces
-    (tests/test_fmu_compiled_step.py)."""
+    (tests/fmu_src/fmi/test_fmu_compiled_step.py)."""
     choice = os.environ.get(STEP_ENVIRONMENT, "").lower()
     if choice == "python":
         return list(axes), {}, f"pure-Python step ({STEP_ENVIRONMENT}=python)"

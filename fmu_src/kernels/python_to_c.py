@@ -37,7 +37,7 @@ a float in C), ``is``/``in``, bit operations; calls of any other function (``rou
 int; a tuple as a truth value. Anything else the translator does not know is refused the same
 way: a kernel that the C cannot follow must fail the build, not run differently. The C is compiled without contraction
 of multiplications and additions (``-ffp-contract=off``), so on the same processor it gives the
-same floats as the Python and numba kernels (``tests/test_native_fmu.py`` checks 1e-12, and
+same floats as the Python and numba kernels (``tests/fmu_src/fmi/test_native_fmu.py`` checks 1e-12, and
 bitwise where it can).
 """
 from __future__ import annotations

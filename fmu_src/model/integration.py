@@ -45,7 +45,7 @@ import math
 
 THETA = 0.35
 """Largest relative change of the Bouc-Wen gain g (and of lam) allowed within one substep.
-Measured against Radau at 1 ms steps (tests/test_model_core.py): the force error stays below
+Measured against Radau at 1 ms steps (tests/fmu_src/model/test_model_core.py): the force error stays below
 5e-4 of its peak for the paper's tables, c1 = 0.01 and a 30 Hz, 3 mm sine; 0.5 would give 5e-3."""
 
 THETA_JUMP = 0.1
@@ -273,7 +273,7 @@ def walk_along_xi(z, xi_total, A, beta, gamma, n, heun_limit, theta, max_pieces)
 # integral(psi*s dt) = A*xi_parallel - (s1 - s0). The frame is that of the mean of z and its linear
 # prediction at the step's end (the midpoint rule: second order in the frame's turn). Substeps
 # also bound that turn, weighted by the nonlinear share of the gain (THETA_ROTATION). Measured against scipy's Radau on circles, ellipses and random plane paths:
-# tests/test_coupled_models.py.
+# tests/fmu_src/model/test_coupled_models.py.
 
 THETA_ROTATION = 0.1
 """Largest turn of z's direction [rad] per substep, weighted by the nonlinear share

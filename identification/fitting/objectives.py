@@ -45,7 +45,7 @@ bushing needs 1-5 at 1 kHz; candidates near the blow-up of dz/dxi ~ |z|^n (n > 1
 FAILED_RESIDUAL = 1e3
 MIN_NOISE_FRACTION = 1e-3
 """Noise levels below 0.1 % of a test's rms force are taken as 0.1 %: the forward model's own
-accuracy at 1 kHz is about 0.04 % (tests/test_forward_model.py), so a fit cannot resolve less."""
+accuracy at 1 kHz is about 0.04 % (tests/identification/forward/test_forward_model.py), so a fit cannot resolve less."""
 MIN_PREFIX_SAMPLES = 50
 """The shortest prefix of a test a candidate is first screened on (``Objective.prefix``)."""
 

@@ -16,7 +16,7 @@ best start so far) and again at the best fit, every test's m is doubled while th
 m and 2m differ by a chi^2 (in the test's noise units, over the samples the objective
 counts) of more than ERROR_BUDGET of the region's delta chi^2, shared equally among the
 tests. The difference estimates the error of m (the input path's error falls about 4x per
-halving, ``tests/test_forward_model.py``), so the forward model's own error uses at most about
+halving, ``tests/identification/forward/test_forward_model.py``), so the forward model's own error uses at most about
 a tenth of the region. Where the fit stays above the noise floor, delta chi^2 is widened by
 s^2 (``identification.fitting.ensemble``) and the budget with it: a model error far above the
 forward model's is not worth finer steps. m stops at MAX_REFINED_STEPS.

@@ -22,7 +22,7 @@ samples and made fits drift to stiff corners (c1 -> 0.002 N*s/mm, a time constan
 at 1 kHz) that no data support and that make every solver stiff.
 
 Every constraint is a bound, so bounded least squares and any box optimizer can search
-the space as it is. ``tests/test_search_space.py`` checks that the paper's Tables 2, 4, 5,
+the space as it is. ``tests/identification/fitting/test_search_space.py`` checks that the paper's Tables 2, 4, 5,
 each parameter moved by +-50 %, lie inside with a margin.
 """
 from __future__ import annotations

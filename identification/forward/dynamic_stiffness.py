@@ -18,7 +18,7 @@ Peak force: the largest |F| over the last cycle [N], preload included.
 Each sine runs ``steps_per_cycle`` communication steps per cycle on the compiled path (all cases
 in parallel on every core). With the default 256 steps the input's secant path carries a first
 harmonic (pi/N)^2/3 = 5e-5 smaller than the sine's, which bounds the accuracy of a linear
-model's K* (tests/test_dynamic_stiffness.py checks the closed forms).
+model's K* (tests/identification/forward/test_dynamic_stiffness.py checks the closed forms).
 
 Units: mm, Hz, N/mm, degrees, mJ, N; parameters in the paper's N-mm-s units.
 """

@@ -25,7 +25,7 @@ the input path between samples. So the fit drives the same compiled kernel with:
 - the output: eq. 5 at each sample instant with the interpolant's velocity there.
 
 It converges, as the step shrinks, to the continuous-time solution driven by the
-interpolant (``tests/test_forward_model.py``: at the truth, below 0.1 times a 1 % noise level
+interpolant (``tests/identification/forward/test_forward_model.py``: at the truth, below 0.1 times a 1 % noise level
 on 1 kHz sines at 10 and 30 Hz, against scipy's Radau on the paper's equations).
 
 Where the displacement holds exactly still for a long run (a step test's hold), the forces

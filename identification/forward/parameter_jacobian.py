@@ -21,7 +21,7 @@ compiles and caches on disk like the plain kernels
 What the derivative is where the forward model is not differentiable: the derivative of the
 branch the kernels take (a Bouc-Wen block's sgn switches, the substep count of a step, which is
 piecewise constant in p); ``tangents``' module docstring states each one-sided value. Away from
-those it is the exact derivative of the computed forces (``tests/test_fit_jacobian.py`` checks it
+those it is the exact derivative of the computed forces (``tests/identification/fitting/test_fit_jacobian.py`` checks it
 against central differences of the plain forward model).
 
 Units as in the models: mm, mm/s, N, s; the derivatives in N per unit of each search coordinate.

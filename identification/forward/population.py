@@ -4,7 +4,7 @@ One definition. Each model's own source (``fmu_src/models/<name>_model.py``) is 
 ``fmu_src/kernels/numba_binding.py`` (a generated module named after its content, in the cache
 folder, its kernels and the shared machinery compiled), with the population loop below
 appended. The FMU runs the same functions, as plain Python or compiled the same way;
-``tests/test_compiled_core.py`` checks the two agree bitwise for every model. Compilation
+``tests/fmu_src/kernels/test_compiled_core.py`` checks the two agree bitwise for every model. Compilation
 takes a few seconds on a model's first use; numba caches the machine code on disk, so later
 processes load it.
 

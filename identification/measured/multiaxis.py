@@ -18,7 +18,7 @@ or not (its one-axis model on each axis alone): :data:`COUPLED_AXES`. Compiled w
 (``population``). The six-axis FMU, a co-simulation slave, holds the secant velocity over each
 communication step instead (``population.simulate_coupled_held``); at 1 kHz on a 10 Hz circle the
 two differ by a few 1e-3 of the force, and the interpolant's is closer to the continuous-time force
-(``tests/test_multiaxis.py``).
+(``tests/identification/measured/test_multiaxis.py``).
 
 Multi-axis tests train a fit (``fit(..., multiaxis=[...], coupling=...)``, ``fit --multiaxis FILE
 --coupling radial``) as one-axis tests do: every axis's force at every sample a residual in that

@@ -1,5 +1,5 @@
-/* A minimal non-Python FMI 2.0 co-simulation host, for tests/test_c_host.py and
- * tests/test_native_fmu.py: it loads an FMU's shared library the way a C/C++ tool does.
+/* A minimal non-Python FMI 2.0 co-simulation host, for tests/fmu_src/fmi/test_c_host.py and
+ * tests/fmu_src/fmi/test_native_fmu.py: it loads an FMU's shared library the way a C/C++ tool does.
  *
  * usage: fmi2_host LIBPYTHON FMU_SO MODEL_GUID RESOURCES_URI REF_X REF_V REF_F STEPS STEP_S
  *

@@ -1,4 +1,4 @@
-/* A minimal C co-simulation master for FMI 2.0 and 3.0, for tests/test_platforms.py: it runs a
+/* A minimal C co-simulation master for FMI 2.0 and 3.0, for tests/fmu_src/fmi/test_platforms.py: it runs a
  * native FMU's library the way a C/C++ tool does, on any CPU it is compiled for (under qemu-user
  * for another one), reading its inputs from stdin so that every binary gets the same bits.
  *

@@ -1,5 +1,5 @@
 /* A C master that puts a native bushing FMU (FMI 2.0, Table 5 defaults) through what it must
- * survive, for tests/test_native_fmu.py, which builds it and the FMU with
+ * survive, for tests/fmu_src/fmi/test_native_fmu.py, which builds it and the FMU with
  * -fsanitize=address,undefined: bad inputs, FMU state save/restore and serialization, and 1000
  * instantiate/free cycles. Any unexpected status, any restored run that differs by a bit, and
  * any sanitizer report fails it (exit status != 0); it ends with "all checks passed".

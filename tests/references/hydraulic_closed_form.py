@@ -24,7 +24,7 @@ d/dt is a factor i*omega, and K* = F/X:
 which is the form fmu_src/models/hydraulic_model.py's docstring states. Limits: at omega -> 0 it is
 k0 + kb*kc/(kb + kc) (the static stiffness, the bulge in series with the bellows), at
 omega -> oo k0 + k1 + kb + i*omega*c0 (the fluid cannot move, the Maxwell spring is rigid).
-tests/test_hydraulic_model.py checks this algebra against a direct solve of the 3x3 system.
+tests/fmu_src/model/test_hydraulic_model.py checks this algebra against a direct solve of the 3x3 system.
 
 Units: parameters in N-mm-s (k in N/mm, c in N.s/mm, mf in N.s^2/mm), K* in N/mm.
 """

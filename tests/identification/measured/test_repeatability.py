@@ -11,7 +11,7 @@ from identification.fitting.result import RigTestFit
 from identification.measured.noise import NoiseEstimate
 from identification.measured.repeatability import Repeatability, cycle_starts, estimate_repeatability
 
-DATA = Path(__file__).resolve().parents[1] / "data"
+DATA = Path(__file__).resolve().parents[3] / "data"
 RATE_HZ = 1000.0
 
 

@@ -12,7 +12,7 @@ from fmu_src.fmi import runtime_messages
 from fmu_src.fmi.runtime_messages import MESSAGES, Message
 from fmu_harness import BushingFmu
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[3]
 C_LAYER = ROOT / "fmu_src" / "fmi" / "native" / "c"
 SLAVE = ROOT / "fmu_src" / "fmi" / "pythonfmu_slave.py"
 SHORTEST = 24

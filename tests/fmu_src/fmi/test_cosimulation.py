@@ -5,7 +5,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[3]
 sys.path.insert(0, str(REPO / "examples" / "cosim"))
 
 import shaker_rig  # noqa: E402

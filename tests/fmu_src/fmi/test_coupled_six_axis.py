@@ -178,7 +178,7 @@ def test_a_groups_axes_given_different_parameters_are_refused_at_the_step_naming
 
 def test_each_output_depends_on_every_displacement_of_its_group(coupled_fmu):
     # the group's hysteresis turns with every member's displacement; the proposed model's dashpots
-    # act per component and Berg has none (tests/test_model_description.py: the outputs move so)
+    # act per component and Berg has none (tests/fmu_src/fmi/test_model_description.py: the outputs move so)
     fmu_path, _ = coupled_fmu
     description = read_model_description(fmu_path)
     dependencies = {unknown.variable.name: sorted(v.name for v in unknown.dependencies)

@@ -15,7 +15,7 @@ from conftest import paper_parameters
 from identification.measured.signals import Sine
 from python_core import simulate_python_core
 
-HOST_SOURCE = Path(__file__).with_name("c_host") / "fmi2_host.c"
+HOST_SOURCE = Path(__file__).resolve().parents[2] / "c_host" / "fmi2_host.c"
 
 
 def shared_libpython() -> Path | None:

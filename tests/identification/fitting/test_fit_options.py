@@ -10,7 +10,7 @@ from identification.fitting.fit import training_request
 from identification.fitting.fleet import fit_many
 from identification.measured.rig_tests import training_tests
 
-DATA = Path(__file__).resolve().parents[1] / "data"
+DATA = Path(__file__).resolve().parents[3] / "data"
 
 
 def test_options_take_keywords_over_a_value_and_refuse_an_unknown_one_by_name():

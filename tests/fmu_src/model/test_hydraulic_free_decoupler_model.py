@@ -14,7 +14,7 @@ import pytest
 
 from fmu_src.model.registry import MODELS
 
-REFERENCES = Path(__file__).resolve().parent / "references"
+REFERENCES = Path(__file__).resolve().parents[2] / "references"
 
 
 def _load(name):
@@ -29,7 +29,7 @@ mount = _load("free_decoupler_mount")
 
 MODEL = "hydraulic_free_decoupler"
 DEFAULTS = {name: float(value) for name, value in json.loads(
-    (Path(__file__).resolve().parents[1] / "data" / "params_hydraulic_free_decoupler.json").read_text())
+    (Path(__file__).resolve().parents[3] / "data" / "params_hydraulic_free_decoupler.json").read_text())
     ["parameters"].items()}
 """data/params_hydraulic_free_decoupler.json as plain JSON: the track tuned to 9.98 Hz, a plate free
 within +-0.12 mm, its 2000 N/mm cage engaging over 0.005 mm, centred by 5 N/mm."""
@@ -142,10 +142,10 @@ def test_switches_are_where_the_plate_meets_its_cage():
                                                ("width", -0.005, "width = -0.005 [mm] must be >= 0"),
                                                ("kcage", -1.0, "kcage = -1.0 [N/mm] must be >= 0")])
 def test_a_parameter_file_with_a_negative_travel_width_or_cage_is_refused(tmp_path, name, value, says):
-    # the parameter files' reader (the FMUs' refusals are in tests/test_fmu_baselines.py)
+    # the parameter files' reader (the FMUs' refusals are in tests/fmu_src/fmi/test_fmu_baselines.py)
     from fmu_src.parameter_files import load_parameters
     from fmu_src.model.parameter_specs import ParameterError
-    document = json.loads((Path(__file__).resolve().parents[1] / "data"
+    document = json.loads((Path(__file__).resolve().parents[3] / "data"
                            / "params_hydraulic_free_decoupler.json").read_text())
     document["parameters"][name] = value
     path = tmp_path / "bad.json"

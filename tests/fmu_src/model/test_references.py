@@ -16,7 +16,7 @@ from fmu_harness import BushingFmu
 from fmu_src.parameter_files import read_parameter_set
 from identification.forward.simulate import simulate
 
-REFERENCES = Path(__file__).resolve().parent / "references"
+REFERENCES = Path(__file__).resolve().parents[2] / "references"
 _spec = importlib.util.spec_from_file_location("generate_references", REFERENCES / "generate_references.py")
 generator = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(generator)   # numpy and scipy only at import; nothing of the project

@@ -10,7 +10,7 @@ from conftest import paper_equations, paper_parameters
 from fmu_src.model.registry import MODELS
 from test_baseline_models import BOUC_WEN, SPENCER, bouc_wen_rhs, spencer_rhs
 
-REFERENCES = Path(__file__).resolve().parent / "references"
+REFERENCES = Path(__file__).resolve().parents[2] / "references"
 
 def berg_rhs(p, s, x, v):
     """Berg's model: d/dt of the travel is v, the reversal force and direction hold between

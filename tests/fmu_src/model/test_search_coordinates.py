@@ -13,7 +13,7 @@ from fmu_src.model.definition import SearchCoordinate
 from fmu_src.model.search_coordinates import KIND, evaluation_order
 from identification.fitting.search_space import SearchSpace
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[3]
 SPACE = SearchSpace(1850.0, 2.7, 4400.0, 0.001, x_ref=2.0)
 # what the kinds that read other parameters read, at plausible values of a proposed-model set
 OTHERS = {"k1": 400.0, "k2": 50.0, "n": 0.8, "beta": 2e-3, "c1": 30.0, "mf": 0.07,

@@ -15,7 +15,7 @@ from identification.measured.signals import Sine, Step, sample_times
 from identification.measured.rig_tests import RigTest
 from identification.fitting.search_space import SearchSpace
 
-sys.path.insert(0, str(Path(__file__).resolve().parent / "references"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "references"))
 import filled_rubber  # noqa: E402
 
 SPRING_AND_FRICTION = {"k0": 500.0, "k3": 10.0, "Ff_max": 60.0, "x2": 0.08}
@@ -88,7 +88,7 @@ def test_a_data_sheet_alone_gives_the_fractional_models_parameters():
     # the truth's own data sheet (no noise; data/kdyn_synthetic_filled_rubber.csv): the fit matches
     # it to the table's uncertainty and lands near the truth that made it
     from identification.measured.kdyn_table import load_kdyn_table
-    table = load_kdyn_table(Path(__file__).resolve().parents[1] / "data" / "kdyn_synthetic_filled_rubber.csv")
+    table = load_kdyn_table(Path(__file__).resolve().parents[3] / "data" / "kdyn_synthetic_filled_rubber.csv")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         result = fit([], model="fractional", kdyn=table, seed=0, progress=False, ensemble=False)

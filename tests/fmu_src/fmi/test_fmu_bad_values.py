@@ -271,7 +271,7 @@ def test_instances_that_failed_to_start_can_be_freed_and_the_host_runs_on(fmu_pa
     # The native FMU fails at the exit of initialization mode: the script prints no status of
     # the step then, and each failed instance is freed as well.
     # (The aborts at interpreter exit this run once had, "corrupted double-linked list", are gone:
-    # tests/test_host_exit.py.)
+    # tests/fmu_src/fmi/test_host_exit.py.)
     result = subprocess.run([sys.executable, "-c", FAIL_FREE_AND_RUN_AGAIN, str(fmu_path)], capture_output=True,
                             text=True, timeout=300)
     assert result.returncode == 0, (result.returncode, result.stderr[-2000:])

@@ -20,7 +20,7 @@ from identification.errors import IdentificationError
 from identification.measured.kdyn_table import KDYN_UNCERTAINTY, LOSS_ANGLE_UNCERTAINTY_DEG, KdynTable, load_kdyn_table
 from identification.fitting.objectives import Objective
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[3]
 TABLE5 = load_parameters(REPO / "data" / "params_table5_combined.json")
 FREQUENCIES = [0.5, 1.0, 5.0, 10.0, 30.0, 80.0]
 

@@ -1,6 +1,6 @@
 """Which step the pythonfmu FMU runs (compiled_kernels.compile_axes): the compiled (numba) step in a
 host process that is a Python interpreter, the pure-Python step in a C/C++ host that embeds Python
-(numba's kernels corrupted such a host's heap, tests/test_c_host.py), told by the operating
+(numba's kernels corrupted such a host's heap, tests/fmu_src/fmi/test_c_host.py), told by the operating
 system's name for the process's executable on Linux, Windows and macOS. The platform is faked here
 (sys.platform and the system call's library); the sentence the FMU logs says which step and why."""
 import ntpath

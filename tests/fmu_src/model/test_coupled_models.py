@@ -17,8 +17,8 @@ from fmu_src.model.registry import MODELS, get_model
 from fmu_src.model.integration import DEFAULT_MAX_SUBSTEPS, OK, vector_friction_force, vector_gain
 from fmu_src.parameter_files import read_parameter_set
 
-REFERENCES = Path(__file__).resolve().parent / "references"
-DATA = Path(__file__).resolve().parents[1] / "data"
+REFERENCES = Path(__file__).resolve().parents[2] / "references"
+DATA = Path(__file__).resolve().parents[3] / "data"
 COUPLED = [name for name, model in MODELS.items() if model.coupled is not None]
 STEP_S = 1e-3
 

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples" / "cosim"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[3] / "examples" / "cosim"))
 import implicit_coupling as coupling  # noqa: E402
 
 

@@ -17,7 +17,7 @@ from identification.analysis import race
 from identification.analysis.race import out_of_race
 from identification.forward import parameter_jacobian
 
-DATA = Path(__file__).resolve().parents[1] / "data"
+DATA = Path(__file__).resolve().parents[3] / "data"
 
 
 @dataclass

@@ -14,7 +14,7 @@ import pytest
 from conftest import DATA
 from identification import load_measurement
 
-REFERENCES = Path(__file__).resolve().parent / "references"
+REFERENCES = Path(__file__).resolve().parents[2] / "references"
 _spec = importlib.util.spec_from_file_location("voided_bushing", REFERENCES / "voided_bushing.py")
 voided_bushing = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(voided_bushing)     # numpy and scipy only

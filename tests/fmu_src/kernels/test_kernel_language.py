@@ -2,7 +2,7 @@
 every tool that reads the kernels, and means the same in each.
 
 - Python, numba and the C translation give the same result bit for bit (the C compiled with the
-  native FMU's flags, tests/test_python_to_c.py's harness);
+  native FMU's flags, tests/fmu_src/kernels/test_python_to_c.py's harness);
 - the tangent generator's derivative of a ``chain`` entry equals its derivative written out here
   by hand (an analytic reference), and a ``zero`` entry (a count, a test) carries none;
 - a call outside the table is refused by the translator and the tangent generator alike, naming the
@@ -21,7 +21,7 @@ from fmu_src.kernels.python_to_c import Translation, TranslationError
 from fmu_src.kernels.tangents import TangentError, tangent
 from test_python_to_c import python_lines, run_in_c, value_type
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[3]
 
 
 def call_exp(a):
@@ -194,7 +194,7 @@ def test_the_tangent_of_every_entry(name):
         if len(floats) != len(arguments) or not all(math.isfinite(a) and a != 0.0 for a in arguments) \
                 or len(set(arguments)) < len(arguments):
             continue    # ints, tuples and infinities carry no tangent to check here; at 0 and at a tie the
-            #             stated one-sided values hold (tests/test_tangents.py)
+            #             stated one-sided values hold (tests/fmu_src/kernels/test_tangents.py)
         directions = tuple(0.5 + i for i in range(len(arguments)))
         value, derivative = tangent(function, inactive=())(*arguments, *directions)
         assert _bits(value) == _bits(function(*arguments)), (name, arguments)

@@ -16,18 +16,18 @@ import pytest
 from fmu_src.model.registry import MODELS
 from fmu_src.model.integration import OK
 
-REFERENCES = Path(__file__).resolve().parent / "references"
+REFERENCES = Path(__file__).resolve().parents[2] / "references"
 _spec = importlib.util.spec_from_file_location("hydraulic_closed_form", REFERENCES / "hydraulic_closed_form.py")
 closed_form = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(closed_form)   # numpy only; nothing of the project
 
 DEFAULTS = {name: float(value) for name, value in json.loads(
-    (Path(__file__).resolve().parents[1] / "data" / "params_hydraulic_mount.json").read_text())["parameters"].items()}
+    (Path(__file__).resolve().parents[3] / "data" / "params_hydraulic_mount.json").read_text())["parameters"].items()}
 """data/params_hydraulic_mount.json as plain JSON: the track tuned to sqrt((kb + kc)/mf)/(2*pi) = 9.98 Hz,
 a 0.1 mm decoupler."""
 LINEAR = dict(DEFAULTS, gap=0.0, ct=0.0)
 DEFAULTS_OF_FREE_PLATE = {name: float(value) for name, value in json.loads(
-    (Path(__file__).resolve().parents[1] / "data" / "params_hydraulic_free_decoupler.json").read_text())
+    (Path(__file__).resolve().parents[3] / "data" / "params_hydraulic_free_decoupler.json").read_text())
     ["parameters"].items()}
 
 MAX_SUBSTEPS = 20000

@@ -15,7 +15,7 @@ from identification.fitting.search import begin
 from identification.measured.kdyn_table import load_kdyn_table
 from identification.measured.rig_tests import training_tests
 
-DATA = Path(__file__).resolve().parents[1] / "data"
+DATA = Path(__file__).resolve().parents[3] / "data"
 
 
 @pytest.fixture(scope="module")

@@ -20,7 +20,7 @@ from identification.forward.simulate import simulate_multiaxis
 from identification.measured.multiaxis import load_multiaxis, vector_nrmse, write_multiaxis
 from test_coupled_models import run_coupled
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[3]
 _spec = importlib.util.spec_from_file_location("coupled_references",
                                                REPO / "tests" / "references" / "generate_coupled_references.py")
 references = importlib.util.module_from_spec(_spec)
@@ -134,14 +134,14 @@ def rig(tmp_path_factory):
                                                                   0 * s]), t)
         path = folder / f"synthetic_sine_{amplitude}mm_{frequency}Hz.csv"
         write_measurement(path, t, line[:, 0], force[:, 0] + 3.0 * rng.standard_normal(t.size),
-                          ["SYNTHETIC: tests/test_multiaxis.py"])
+                          ["SYNTHETIC: tests/identification/measured/test_multiaxis.py"])
         sines.append(path)
     held = {}
     for coupled in (True, False):
         xy, force = continuous_truth(TRUTH, references.ellipse(2.0, 1.2, 4.7), t, coupled)
         held[coupled] = write_multiaxis(folder / f"synthetic_ellipse_{'coupled' if coupled else 'uncoupled'}.csv",
                                         t, xy, force + 3.0 * rng.standard_normal(xy.shape),
-                                        ["SYNTHETIC: tests/test_multiaxis.py"])
+                                        ["SYNTHETIC: tests/identification/measured/test_multiaxis.py"])
     return folder, sines, held
 
 
@@ -188,7 +188,7 @@ def fit_rig(tmp_path_factory):
     sine = folder / "synthetic_sine_2mm_10Hz.csv"
     line, force = continuous_truth(FIT_TRUTH, x, t)
     write_measurement(sine, t, line[:, 0], force[:, 0] + NOISE_N * rng.standard_normal(t.size),
-                      ["SYNTHETIC: tests/test_multiaxis.py"])
+                      ["SYNTHETIC: tests/identification/measured/test_multiaxis.py"])
     files = {}
     for name, path, duration in (("ellipse", references.ellipse(2.0, 1.2, 4.7), 1.0),
                                  ("circle", references.circle(1.0, 9.7), 0.5),
@@ -197,7 +197,7 @@ def fit_rig(tmp_path_factory):
         xy, force = continuous_truth(FIT_TRUTH, path, s)
         files[name] = write_multiaxis(folder / f"synthetic_{name}.csv", s, xy,
                                       force + NOISE_N * rng.standard_normal((s.size, 2)),
-                                      ["SYNTHETIC: tests/test_multiaxis.py"])
+                                      ["SYNTHETIC: tests/identification/measured/test_multiaxis.py"])
     return folder, sine, files
 
 

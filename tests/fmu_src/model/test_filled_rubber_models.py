@@ -20,10 +20,10 @@ from identification.forward.dynamic_stiffness import characterise
 from identification.measured.signals import Random, Sine, Step, sample_times
 from model_exchange import simulate_model_exchange
 
-sys.path.insert(0, str(Path(__file__).resolve().parent / "references"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "references"))
 import filled_rubber  # noqa: E402
 
-DATA = Path(__file__).resolve().parents[1] / "data"
+DATA = Path(__file__).resolve().parents[3] / "data"
 FILLED = ("berg", "fractional")
 MM = 1e-3
 

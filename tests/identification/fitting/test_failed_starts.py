@@ -17,7 +17,7 @@ from identification.fitting.ensemble import ProfileProblem, _profile_task, ident
 from identification.fitting.multistart import (EXACT_JACOBIAN_LIMIT, StartRecord, _least_squares_task, exact_usable,
                                                failed_starts, jacobian, run_stages)
 
-DATA = Path(__file__).resolve().parents[1] / "data"
+DATA = Path(__file__).resolve().parents[3] / "data"
 TABLE2 = DATA / "synthetic_table2_noise1pct"
 
 

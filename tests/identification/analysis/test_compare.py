@@ -11,7 +11,7 @@ from identification.__main__ import main
 from identification.analysis.compare import Assessment, recommend
 from identification.fitting.result import TableFit
 
-DATA = Path(__file__).resolve().parents[1] / "data"
+DATA = Path(__file__).resolve().parents[3] / "data"
 FILLED = DATA / "synthetic_filled_rubber"
 
 
