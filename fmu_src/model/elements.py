@@ -6,6 +6,8 @@
   exponent and a damping that ramps in over a depth), as the multibody tools' bushing limits;
 - ``pchip_slope``, ``pchip_end_slope``, ``hermite``: the monotone cubic through a measured static
   curve's knots (scipy's PchipInterpolator), for a backbone;
+- ``track_substeps``: the substeps of a hydraulic mount's fluid column (its inertia track) over a
+  step, which both hydraulic models take;
 
 Like ``integration``, this module is compiled by numba once for every model that imports it
 (``fmu_src/kernels/numba_binding.py``), translated into C with the kernels that call it, and
@@ -104,3 +106,21 @@ def hermite(u, xa, xb, fa, fb, da, db):
     t = (u - xa) / h
     return (fa * (1.0 + 2.0 * t) * (1.0 - t) * (1.0 - t) + da * h * t * (1.0 - t) * (1.0 - t)
             + fb * t * t * (3.0 - 2.0 * t) - db * h * t * t * (1.0 - t))
+
+
+THETA_TRACK = 0.25
+"""A substep h_s of a fluid column's Runge-Kutta method keeps h_s*(sqrt((kb + kc)/mf) +
+(cf + 2*ct*|w|)/mf) <= THETA_TRACK: the method's error on the column's free motion is then about
+THETA_TRACK^5/120 = 8e-6 of it a substep."""
+
+
+def track_substeps(kb, kc, mf, cf, ct, w, h):
+    """The substeps over h [s] that keep each within THETA_TRACK of the fluid column's fastest
+    rate: its natural frequency on the bulge and chamber stiffnesses kb, kc [N/mm] with its mass
+    mf [N.s^2/mm], plus its damping rate (cf [N.s/mm] and the quadratic ct [N.s^2/mm^2] at its
+    velocity w [mm/s]). A decoupler only softens what the column feels, so this bounds it too."""
+    rate = math.sqrt((kb + kc) / mf) + (cf + 2.0 * ct * abs(w)) / mf
+    count = h * rate / THETA_TRACK
+    if not count < 1e9:         # inf or NaN (w not finite, mf vanishing): more than any budget
+        return 1_000_000_000
+    return max(1, int(math.ceil(count)))

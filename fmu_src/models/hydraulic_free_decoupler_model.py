@@ -33,7 +33,7 @@ decoupler kind; with gap = 0 this one is a linear membrane of stiffness kd + kca
 Units N-mm-s; the state is ``(y, w, f1)`` as in ``hydraulic_model`` (fluid displacement [mm] and
 velocity [mm/s] in the mount's coordinates, the Maxwell force [N]), stepped the same way: the
 Maxwell element exactly, the fluid column by the classical Runge-Kutta method on substeps of at
-most ``hydraulic_model.THETA_TRACK`` over its fastest rate, which bounds the engaged column's too
+most ``elements.THETA_TRACK`` over its fastest rate, which bounds the engaged column's too
 (the plate only softens what the column feels).
 
 With the default set a sine from rest settles within ``settling_s`` = 2 s: inside the gap the
@@ -44,12 +44,12 @@ from __future__ import annotations
 import math
 
 from ..model.parameter_specs import SPRING, ParameterSpec
-from ..model.elements import dead_zone
+from ..model.elements import dead_zone, track_substeps
 from ..model.integration import NOT_FINITE, OK, TOO_MANY_SUBSTEPS, maxwell_decay, maxwell_step
 from ..model.definition import BushingModel, SearchBox, SearchCoordinate, StateSpec, TrackStart
 from ..model.search_coordinates import KIND
 from .berg_model import CUBIC
-from .hydraulic_model import PARAMETER_SPECS as MEMBRANE_SPECS, POSITIVE, THETA_TRACK
+from .hydraulic_model import PARAMETER_SPECS as MEMBRANE_SPECS, POSITIVE
 
 SHARED = {spec.name: spec for spec in MEMBRANE_SPECS}
 """The rubber's and the fluid column's specs, as the membrane mount declares them."""
@@ -114,17 +114,6 @@ def jump(m, state, jump_mm):
     k0, k3, c0, k1, rate1, kb, kc, mf, cf, ct, free, width, cage, compliance = m
     y, w, f1 = state
     return (y, w, f1 + k1 * jump_mm), OK
-
-
-def track_substeps(kb, kc, mf, cf, ct, w, h):
-    """The substeps over h [s] that keep each within THETA_TRACK of the column's fastest rate,
-    the rate of the column with the plate on its cage (``hydraulic_model.track_substeps``'s
-    bound: a kernel of another model's module is not compiled into this one's)."""
-    rate = math.sqrt((kb + kc) / mf) + (cf + 2.0 * ct * abs(w)) / mf
-    count = h * rate / THETA_TRACK
-    if not count < 1e9:         # inf or NaN (w not finite, mf vanishing): more than any budget
-        return 1_000_000_000
-    return max(1, int(math.ceil(count)))
 
 
 def integrate(m, state, x, v, h, max_substeps):

@@ -35,7 +35,7 @@ complex stiffness
 Units N-mm-s; the state is ``(y, w, f1)``: the fluid column's displacement [mm] and velocity
 [mm/s] and the Maxwell force [N]. How it is stepped: the Maxwell element exactly
 (``integration.maxwell_step``); the fluid column by the classical Runge-Kutta method on
-substeps of at most THETA_TRACK over its fastest rate (its natural frequency plus its damping
+substeps of at most ``elements.THETA_TRACK`` over its fastest rate (its natural frequency plus its damping
 rate), with x + v*t exact within each: the column's equations are not stiff (the decoupler is
 algebraic), so a 1 ms step at a 10 Hz track takes one substep.
 
@@ -48,14 +48,10 @@ from __future__ import annotations
 import math
 
 from ..model.parameter_specs import DAMPING, SPRING, ParameterSpec
+from ..model.elements import track_substeps
 from ..model.integration import NOT_FINITE, OK, TOO_MANY_SUBSTEPS, maxwell_decay, maxwell_step
 from ..model.definition import BushingModel, SearchBox, SearchCoordinate, StateSpec, TrackStart
 from ..model.search_coordinates import KIND
-
-THETA_TRACK = 0.25
-"""A substep h_s of the fluid column's Runge-Kutta method keeps h_s*(sqrt((kb + kc)/mf) +
-(cf + 2*ct*|w|)/mf) <= THETA_TRACK: the method's error on the column's free motion is then about
-THETA_TRACK^5/120 = 8e-6 of it a substep."""
 
 POSITIVE = dict(minimum=0.0, exclusive=True)
 
@@ -134,15 +130,6 @@ def jump(m, state, jump_mm):
     k0, c0, k1, rate1, kb, kc, mf, cf, ct, gap, kd = m
     y, w, f1 = state
     return (y, w, f1 + k1 * jump_mm), OK
-
-
-def track_substeps(kb, kc, mf, cf, ct, w, h):
-    """The substeps over h [s] that keep each within THETA_TRACK of the column's fastest rate."""
-    rate = math.sqrt((kb + kc) / mf) + (cf + 2.0 * ct * abs(w)) / mf
-    count = h * rate / THETA_TRACK
-    if not count < 1e9:         # inf or NaN (w not finite, mf vanishing): more than any budget
-        return 1_000_000_000
-    return max(1, int(math.ceil(count)))
 
 
 def integrate(m, state, x, v, h, max_substeps):
