@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import re
 
+import numpy as np
+from fmpy import simulate_fmu
 from fmpy import extract, read_model_description
 from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import (FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
@@ -84,3 +86,18 @@ class BushingFmu:
     def free(self) -> None:
         self.fmu.terminate()
         self.fmu.freeInstance()
+
+
+MM = 1e-3
+
+
+def simulate_with_fmpy(fmu_path, time_s, x_mm, v_mm_s, start_values=None):
+    """Force [N] at the sample times from fmpy's simulate_fmu, one communication step per sample."""
+    signals = np.zeros(time_s.size, dtype=[("time", float), ("x", float), ("v", float)])
+    signals["time"], signals["x"], signals["v"] = time_s, x_mm * MM, v_mm_s * MM
+    step = float(np.median(np.diff(time_s)))
+    result = simulate_fmu(str(fmu_path), start_time=0.0, stop_time=time_s[-1], step_size=step,
+                          output_interval=step, input=signals, output=["F"],
+                          start_values=start_values or {})
+    assert np.allclose(result["time"], time_s, rtol=0, atol=1e-9)
+    return result["F"]

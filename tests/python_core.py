@@ -11,7 +11,7 @@ from typing import Mapping
 import numpy as np
 
 from fmu_src.model.registry import get_model
-from fmu_src.model.integration import advance
+from fmu_src.model.integration import DEFAULT_MAX_SUBSTEPS, OK, advance
 
 
 def simulate_python_core(params: Mapping[str, float], time_s, displacement_mm, velocity_mm_s,
@@ -45,3 +45,20 @@ def simulate_python_core(params: Mapping[str, float], time_s, displacement_mm, v
             state_x = x_k + v_k * h * (i + 1)
         forces[k + 1] = bushing.force(constants, state, state_x, v_k)
     return forces
+
+
+def run_coupled(model, params, path, step_s: float = 1e-3):
+    """The coupled model's force vectors (samples - 1, 3) along ``path`` (samples, 2 or 3) [mm], one
+    step of ``step_s`` [s] between samples."""
+    kernels, m = model.coupled, model.constants(params)
+    path = np.column_stack([path, np.zeros((len(path), 3 - path.shape[1]))])
+    x0 = tuple(float(c) for c in path[0])
+    state, state_x, out = kernels.initial_state(m, x0), x0, []
+    for k in range(len(path) - 1):
+        x = tuple(float(c) for c in path[k])
+        v = tuple(float(c) for c in (path[k + 1] - path[k]) / step_s)
+        state, _, status = kernels.step(m, state, state_x, x, v, step_s, DEFAULT_MAX_SUBSTEPS)
+        assert status == OK
+        state_x = tuple(x[i] + v[i] * step_s for i in range(3))
+        out.append(kernels.force(m, state, state_x, v))
+    return np.array(out)

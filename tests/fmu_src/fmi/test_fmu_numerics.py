@@ -1,10 +1,9 @@
 """The built FMU, driven by fmpy, against measurements, the core and independent references."""
 import numpy as np
 import pytest
-from fmpy import simulate_fmu
 
 from conftest import DATA, paper_force, paper_parameters, reference_force
-from fmu_harness import BushingFmu
+from fmu_harness import BushingFmu, simulate_with_fmpy
 from identification.measured.measurements import load_measurement
 from identification.fitting.objectives import nrmse
 from identification.forward.input_path import prepare_input
@@ -13,18 +12,6 @@ from identification.forward.simulate import simulate
 from python_core import simulate_python_core
 
 MM = 1e-3  # m per mm
-
-
-def simulate_with_fmpy(fmu_path, time_s, x_mm, v_mm_s, start_values=None):
-    """Force [N] at the sample times from fmpy's simulate_fmu, one communication step per sample."""
-    signals = np.zeros(time_s.size, dtype=[("time", float), ("x", float), ("v", float)])
-    signals["time"], signals["x"], signals["v"] = time_s, x_mm * MM, v_mm_s * MM
-    step = float(np.median(np.diff(time_s)))
-    result = simulate_fmu(str(fmu_path), start_time=0.0, stop_time=time_s[-1], step_size=step,
-                          output_interval=step, input=signals, output=["F"],
-                          start_values=start_values or {})
-    assert np.allclose(result["time"], time_s, rtol=0, atol=1e-9)
-    return result["F"]
 
 
 @pytest.mark.parametrize("name, protocol", [("sine_2mm_10Hz", Sine(2.0, 10.0, 1.0)),

@@ -27,7 +27,7 @@ from fmu_src.fmi.native import platforms
 from fmu_src.model.registry import MODEL_NAMES
 from fmu_src.parameter_files import load_parameters, read_parameter_set, read_six_axis, save_parameters
 from identification.measured.signals import Random, sample_times
-from test_fmu_numerics import simulate_with_fmpy
+from fmu_harness import simulate_with_fmpy
 from test_six_axis_fmu import axis_signals, run_with_fmpy
 
 MISSING = {version: native_build.missing_platforms(version) for version in (2, 3)}

@@ -7,7 +7,7 @@ from fmu_src.model.registry import MODELS
 from fmu_src.models.proposed_model import PARAMETER_NAMES
 from identification.forward.population import simulate_population_held
 from identification.measured.signals import Random, Sine, sample_times
-from test_fmu_numerics import simulate_with_fmpy
+from fmu_harness import simulate_with_fmpy
 
 
 def population():

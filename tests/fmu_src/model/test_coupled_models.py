@@ -16,6 +16,7 @@ import pytest
 from fmu_src.model.registry import MODELS, get_model
 from fmu_src.model.integration import DEFAULT_MAX_SUBSTEPS, OK, vector_friction_force, vector_gain
 from fmu_src.parameter_files import read_parameter_set
+from python_core import run_coupled
 
 REFERENCES = Path(__file__).resolve().parents[2] / "references"
 DATA = Path(__file__).resolve().parents[3] / "data"
@@ -37,22 +38,6 @@ def run_one_axis(model, params, xs):
         assert status == OK
         state_x = xs[k] + v * STEP_S
         out.append(model.force(m, state, state_x, v))
-    return np.array(out)
-
-
-def run_coupled(model, params, path):
-    """The coupled model's force vectors (samples - 1, 3) along ``path`` (samples, 2 or 3) [mm]."""
-    kernels, m = model.coupled, model.constants(params)
-    path = np.column_stack([path, np.zeros((len(path), 3 - path.shape[1]))])
-    x0 = tuple(float(c) for c in path[0])
-    state, state_x, out = kernels.initial_state(m, x0), x0, []
-    for k in range(len(path) - 1):
-        x = tuple(float(c) for c in path[k])
-        v = tuple(float(c) for c in (path[k + 1] - path[k]) / STEP_S)
-        state, _, status = kernels.step(m, state, state_x, x, v, STEP_S, DEFAULT_MAX_SUBSTEPS)
-        assert status == OK
-        state_x = tuple(x[i] + v[i] * STEP_S for i in range(3))
-        out.append(kernels.force(m, state, state_x, v))
     return np.array(out)
 
 

@@ -202,7 +202,7 @@ def test_every_derived_model_compiles_equal_to_its_python_kernels(base):
 @pytest.mark.parametrize("base", ["single_bouc_wen", "berg"])
 def test_the_derived_kernels_tangents_are_their_complex_step_derivatives(base):
     from fmu_src.kernels.tangents import tangent
-    from test_tangents import Cs, STEP, flat, on_complex_numbers
+    from complex_step import Cs, STEP, flat, on_complex_numbers
     derived = get_model(f"{base}+backbone4+limits+rig")
     params = {name: value for name, value in defaults(base).items() if name not in get_model(base).static_spring}
     params.update(BACKBONE, **LIMITS, rig_displacement_zero=0.1, rig_force_zero=20.0)

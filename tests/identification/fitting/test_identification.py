@@ -189,7 +189,7 @@ def test_a_cli_fit_builds_an_fmu_that_carries_the_fitted_set(tmp_path, capsys):
 
     import build_fmu
     from identification.cli.arguments import main
-    from test_fmu_numerics import simulate_with_fmpy
+    from fmu_harness import simulate_with_fmpy
 
     out, ssv = tmp_path / "fitted.json", tmp_path / "fitted.ssv"
     assert main(["fit", "--sine", str(DATA / "synthetic_table5_sine_2mm_10Hz.csv"), "--seed", "0",
@@ -228,7 +228,7 @@ def test_reduced_budget_fit_reaches_the_floor_through_the_cli_and_a_built_fmu(tm
 
     import build_fmu
     from identification.cli.arguments import main
-    from test_fmu_numerics import simulate_with_fmpy
+    from fmu_harness import simulate_with_fmpy
 
     out, ssv = tmp_path / "fitted.json", tmp_path / "fitted.ssv"
     assert main(["fit", "--sine", str(DATA / "synthetic_table5_sine_2mm_10Hz.csv"),

@@ -18,7 +18,6 @@ from fmu_src.parameter_files import save_parameters
 from identification.measured.measurements import write_measurement
 from identification.forward.simulate import simulate_multiaxis
 from identification.measured.multiaxis import load_multiaxis, vector_nrmse, write_multiaxis
-from test_coupled_models import run_coupled
 
 REPO = Path(__file__).resolve().parents[3]
 _spec = importlib.util.spec_from_file_location("coupled_references",
