@@ -150,9 +150,10 @@ def fit_command(args) -> int:
         if result.records:
             written.append(plot_waterfall([r.misfit for r in result.records], [r.stage for r in result.records],
                                           result.misfit, result.threshold, args.plots / "waterfall.png"))
-        for test in tests:
+        for test, fitted in zip(tests, result.tests):    # each test's force as the fit computed it
             m = test.measurement
-            predicted = simulate(result.parameters, m.time_s, m.displacement_mm, m.measured_velocity_mm_s)
+            predicted = fitted.predicted_N if fitted.predicted_N is not None else \
+                simulate(result.parameters, m.time_s, m.displacement_mm, m.measured_velocity_mm_s)
             written.append(plot_comparison(m, {model: predicted}, args.plots / f"fit_{measurement_name(m.source)}.png"))
         for m in multiaxis:
             predicted = simulate_multiaxis(result.parameters, m.time_s, m.displacement_mm, coupling=args.coupling,

@@ -51,12 +51,15 @@ MIN_AGREEING = 2
 @dataclass
 class RigTestFit:
     """One training test at the fitted parameters: its noise level, for a sine what the device
-    repeats from cycle to cycle (``repeatability``; None for other tests), and the NRMSE."""
+    repeats from cycle to cycle (``repeatability``; None for other tests), the NRMSE, and the
+    force it was computed from (``predicted_N`` [N] at the test's samples, kept so that nothing
+    simulates it again; None where not kept)."""
     name: str
     kind: str
     noise: NoiseEstimate
     nrmse: float
     repeatability: Repeatability | None = None
+    predicted_N: np.ndarray | None = field(default=None, repr=False, compare=False)
 
     @property
     def noise_fraction(self) -> float:

@@ -498,7 +498,7 @@ def test_fits(tests, noise, parameters: ParameterSet, steps=None) -> list[RigTes
         predicted = simulate(parameters, m.time_s, m.displacement_mm, m.measured_velocity_mm_s,
                              steps_per_sample=m_steps)
         repeats = estimate_repeatability(m.time_s, m.displacement_mm, m.force_N) if test.kind == "sine" else None
-        fits.append(RigTestFit(test.name, test.kind, level, nrmse(predicted, m.force_N), repeats))
+        fits.append(RigTestFit(test.name, test.kind, level, nrmse(predicted, m.force_N), repeats, predicted))
     return fits
 
 
