@@ -49,7 +49,7 @@ def chi2_at_truth(truth: dict) -> list[tuple]:
         levels.append(NoiseEstimate(NOISE * rms, rms))
     signal_chosen = Objective(tests, levels)
     core = parameter_matrix([truth])
-    refined = refine_steps(signal_chosen, tests, core, misfit_threshold(1.0, 1, 14)).objective
+    refined = refine_steps(signal_chosen, core, misfit_threshold(1.0, 1, 14)).objective
     rows = []
     for objective in (signal_chosen, refined):
         residuals = objective.residual_matrix(core)[0] * np.sqrt(objective.size)  # noise units

@@ -189,6 +189,7 @@ class Objective:
                                    steps=m_steps)
             sigma = max(level.sigma_N, MIN_NOISE_FRACTION * level.rms_force_N)
             self.tests.append(PreparedTest(test.name, driven, m.force_N[driven.sample_index], sigma))
+        self.rig_tests = list(tests)     # what it was made of: with_steps, prefix, with_fit_loop derive from them
         self._source_table = table
         self.search = search and table is not None
         self.table = PreparedTable.of(table, self.bushing, search) if table is not None else None
@@ -201,21 +202,20 @@ class Objective:
         self.size = (sum(t.measured_N.size for t in self.tests) + sum(m.size for m in self.multiaxis)
                      + (self.table.size if self.table else 0))
 
-    def with_steps(self, tests: Sequence[RigTest], steps: Sequence[int]) -> "Objective":
-        """The same objective (of ``tests``, the ones it was made of) with other steps per
-        sample (the table's loop as it is)."""
-        return Objective(tests, self.noise, steps, self.bushing, self._source_table, self.search,
+    def with_steps(self, steps: Sequence[int]) -> "Objective":
+        """The same objective with other steps per sample (the table's loop as it is)."""
+        return Objective(self.rig_tests, self.noise, steps, self.bushing, self._source_table, self.search,
                          self._source_multiaxis)
 
-    def prefix(self, tests: Sequence[RigTest], fraction: float) -> "Objective | None":
-        """The same objective (of ``tests``, the ones it was made of) on the first ``fraction``
-        of each test's samples (at least MIN_PREFIX_SAMPLES), with the same noise levels and steps
-        per sample: a cheap first look at a candidate (``multistart.screen``). None where it has a
-        table or multi-axis tests, whose cost no prefix of the time series lowers."""
+    def prefix(self, fraction: float) -> "Objective | None":
+        """The same objective on the first ``fraction`` of each test's samples (at least
+        MIN_PREFIX_SAMPLES), with the same noise levels and steps per sample: a cheap first look
+        at a candidate (``multistart.screen``). None where it has a table or multi-axis tests,
+        whose cost no prefix of the time series lowers."""
         if self.table is not None or self.multiaxis:
             return None
         cut = []
-        for test in tests:
+        for test in self.rig_tests:
             m = test.measurement
             k = min(len(m), max(MIN_PREFIX_SAMPLES, math.ceil(fraction * len(m))))
             # a prefix of a step may end inside its ramp: as a plain time series, whose kind checks nothing
@@ -223,21 +223,23 @@ class Objective:
                                        force_N=m.force_N[:k], velocity_mm_s=m.velocity_mm_s[:k])))
         return Objective(cut, self.noise, self.steps_per_sample, self.bushing)
 
-    def with_fit_loop(self, tests: Sequence[RigTest]) -> "Objective":
+    def with_fit_loop(self) -> "Objective":
         """The same objective with the table's fit loop instead of its search loop (itself if it
         has none)."""
         if not self.search:
             return self
-        return Objective(tests, self.noise, self.steps_per_sample, self.bushing, self._source_table, False,
-                         self._source_multiaxis)
+        return Objective(self.rig_tests, self.noise, self.steps_per_sample, self.bushing, self._source_table,
+                         False, self._source_multiaxis)
 
     def __getstate__(self):
-        """Everything but the model, which does not pickle: a worker resolves its name."""
-        return {name: value for name, value in self.__dict__.items() if name != "bushing"}
+        """Everything but the model, which does not pickle (a worker resolves its name), and the
+        tests it was made of (a worker evaluates; only the process that made it derives others)."""
+        return {name: value for name, value in self.__dict__.items() if name not in ("bushing", "rig_tests")}
 
     def __setstate__(self, state):
         self.__dict__.update(state)
         self.bushing = resolve_model(self.model)
+        self.rig_tests = None
 
     @property
     def steps_per_sample(self) -> list[int]:

@@ -25,13 +25,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Sequence
 
 import numpy as np
 
 from identification.forward.input_path import prepare_input
 from identification.fitting.objectives import FIT_MAX_SUBSTEPS, Objective
-from identification.measured.rig_tests import RigTest
 from identification.forward.simulate import simulate_driven
 
 ERROR_BUDGET = 0.1
@@ -54,16 +52,16 @@ class Refinement:
     evaluations: int
 
 
-def refine_steps(objective: Objective, tests: Sequence[RigTest], row: np.ndarray, delta_chi2: float) -> Refinement:
+def refine_steps(objective: Objective, row: np.ndarray, delta_chi2: float) -> Refinement:
     """Double each test's steps per sample while its forward-model error at the candidate
     ``row`` (one row of the objective's model's parameters) exceeds its share of ``ERROR_BUDGET * delta_chi2``
     (see the module docstring); returns the objective to use from here on.
 
     Where the candidate fails at m (more than FIT_MAX_SUBSTEPS substeps in a communication
     step), finer steps may run it (the substep limit is per step); where it runs at m but
-    fails at 2m, m is kept. If it fails at every m, the test keeps the m it had."""
-    if len(tests) != len(objective.tests):
-        raise ValueError(f"{len(tests)} tests for an objective of {len(objective.tests)}")
+    fails at 2m, m is kept. If it fails at every m, the test keeps the m it had. The tests are
+    the objective's own (``Objective.rig_tests``)."""
+    tests = objective.rig_tests
     candidate = np.atleast_2d(row)
     if not tests:      # a dynamic-stiffness table alone: its steps per cycle are fixed
         return Refinement(objective, False, (), 0)
@@ -94,7 +92,7 @@ def refine_steps(objective: Objective, tests: Sequence[RigTest], row: np.ndarray
         steps.append(m)
         errors.append(error)
     changed = steps != objective.steps_per_sample
-    refined = objective.with_steps(tests, steps) if changed else objective
+    refined = objective.with_steps(steps) if changed else objective
     # cost in evaluations of every test at its signal's m (a simulation's cost grows with m)
     evaluations = math.ceil(work / max(1, sum(objective.steps_per_sample)))
     return Refinement(refined, changed, tuple(errors), evaluations)

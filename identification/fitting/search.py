@@ -339,7 +339,7 @@ class Search:
         points = settings.screening + (LOOP_STARTS if loop else 0)
         prefix = None
         if settings.prefix_fraction is not None and not settings.genetic:
-            objective = problem.objective.prefix(self.request.tests, settings.prefix_fraction)
+            objective = problem.objective.prefix(settings.prefix_fraction)
             prefix = objective and Problem(objective, self.space, "difference")
         kept = math.ceil(settings.prefix_kept * points) if prefix else 0
         self.bars = SearchProgress(self.progress, settings, settings.global_evaluations(points) + kept)
@@ -360,26 +360,26 @@ class Search:
         best fit; if that changes them, the last stage runs once more, and a third check only
         reports (identification.fitting.refinement). A lone best start gets company before the
         check at the best fit (_extend_if_alone)."""
-        tests, space, engine, bars = self.request.tests, self.space, self.engine, self.bars
+        space, engine, bars = self.space, self.engine, self.bars
         self._first_stage()
         *early, last = self.request.settings.stages
         n, d = self.n, self.d
         records = run_stages(self.problem, engine, self.first_records, early[1:], bars.stage, first_stage=1)
-        refinement = _check_steps(self.problem, tests, records, n, d)
-        problem = Problem(refinement.objective.with_fit_loop(tests), space, self.jacobian_kind)
+        refinement = _check_steps(self.problem, records, n, d)
+        problem = Problem(refinement.objective.with_fit_loop(), space, self.jacobian_kind)
         records = run_stages(problem, engine, records, [last], bars.stage, first_stage=len(early))
         records, added, agreeing = _extend_if_alone(problem, engine, records, last, len(early), (n, d), bars)
         final_count = last[0] + added
         if added:
             self.notes.append(f"note: only {agreeing} of the {last[0]} final starts reached the best misfit, so {added} "
                               f"more start{'s' if added > 1 else ''} of the earlier stages also ran the last stage")
-        refinement_at_best = _check_steps(problem, tests, records, n, d)
+        refinement_at_best = _check_steps(problem, records, n, d)
         self.evaluations += refinement.evaluations + refinement_at_best.evaluations
         if refinement_at_best.changed:
             problem = Problem(refinement_at_best.objective, space, self.jacobian_kind)
             records = run_stages(problem, engine, records, [(final_count, last[1])],
                                  lambda s, k: bars.stage(s, k, again=True, total=final_count), first_stage=len(early))
-            final_check = _check_steps(problem, tests, records, n, d)
+            final_check = _check_steps(problem, records, n, d)
             self.evaluations += final_check.evaluations
             if final_check.changed:
                 self.notes.append(f"note: at the best fit the forward model would need "
@@ -481,11 +481,11 @@ def _extend_if_alone(problem: Problem, engine, records: list[StartRecord], last:
     return records, len(waiting), agreeing
 
 
-def _check_steps(problem: Problem, tests, records, n: int, d: int):
+def _check_steps(problem: Problem, records, n: int, d: int):
     """``refinement.refine_steps`` at the best start of the latest stage (its misfit sets the
     region's delta chi^2)."""
     best = _best_record([r for r in records if r.stage == records[0].stage and not r.failed] or records)
-    return refine_steps(problem.objective, tests, problem.space.to_parameters(best.theta[None, :]),
+    return refine_steps(problem.objective, problem.space.to_parameters(best.theta[None, :]),
                         misfit_threshold(best.misfit, n, d) * n)
 
 

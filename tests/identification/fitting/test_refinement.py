@@ -54,7 +54,7 @@ def test_a_sharply_saturating_bushing_gets_finer_steps_and_then_meets_the_forwar
     tests, objective = sine_test(SHARPLY_SATURATING)
     assert objective.steps_per_sample == [1]                                  # the signal alone asks for one
     assert rms_residual_in_noise_levels(objective, SHARPLY_SATURATING) > 0.1  # measured 0.17: not enough
-    refinement = refine_steps(objective, tests, parameter_matrix([SHARPLY_SATURATING]), DELTA_CHI2)
+    refinement = refine_steps(objective, parameter_matrix([SHARPLY_SATURATING]), DELTA_CHI2)
     assert refinement.changed and refinement.objective.steps_per_sample == [2]
     # the target for the forward model at the truth: <= 0.1 of a 1 % noise level (measured 0.036)
     assert rms_residual_in_noise_levels(refinement.objective, SHARPLY_SATURATING) <= 0.1
@@ -64,7 +64,7 @@ def test_a_sharply_saturating_bushing_gets_finer_steps_and_then_meets_the_forwar
 def test_the_papers_bushings_keep_one_step_per_sample(table):
     params = paper_parameters(table)
     tests, objective = sine_test(params)
-    refinement = refine_steps(objective, tests, parameter_matrix([params]), DELTA_CHI2)
+    refinement = refine_steps(objective, parameter_matrix([params]), DELTA_CHI2)
     assert not refinement.changed and refinement.objective is objective
     assert rms_residual_in_noise_levels(objective, params) <= 0.1
 
@@ -75,13 +75,13 @@ def test_far_above_the_floor_the_widened_region_does_not_ask_for_finer_steps():
     tests, objective = sine_test(SHARPLY_SATURATING)
     core = parameter_matrix([SHARPLY_SATURATING])
     n = objective.size
-    assert refine_steps(objective, tests, core, misfit_threshold(1.0, n, 14) * n).changed
-    assert not refine_steps(objective, tests, core, misfit_threshold(10.0, n, 14) * n).changed
+    assert refine_steps(objective, core, misfit_threshold(1.0, n, 14) * n).changed
+    assert not refine_steps(objective, core, misfit_threshold(10.0, n, 14) * n).changed
 
 
 def test_steps_are_only_doubled_and_never_beyond_the_cap():
     tests, _ = sine_test(SHARPLY_SATURATING)
     for start, most in ((3, 12), (12, 12), (5, 10)):
         objective = Objective(tests, None, [start])
-        refinement = refine_steps(objective, tests, parameter_matrix([SHARPLY_SATURATING]), 0.0)  # no budget at all
+        refinement = refine_steps(objective, parameter_matrix([SHARPLY_SATURATING]), 0.0)  # no budget at all
         assert refinement.objective.steps_per_sample == [most] and most <= MAX_REFINED_STEPS

@@ -27,12 +27,12 @@ def table5_problem():
 
 
 def prefix_problem(tests, problem, fraction=SCREENING_PREFIX):
-    return Problem(problem.objective.prefix(tests, fraction), problem.space, "difference")
+    return Problem(problem.objective.prefix(fraction), problem.space, "difference")
 
 
 def test_the_prefix_is_the_start_of_every_test_with_its_noise_and_steps(table5_problem):
     tests, problem = table5_problem
-    prefix = problem.objective.prefix(tests, 0.1)
+    prefix = problem.objective.prefix(0.1)
     sine, whole = prefix.tests[0], problem.objective.tests[0]
     assert np.array_equal(sine.measured_N, whole.measured_N[:101])      # a tenth of the sine's 1001 samples
     step, whole = prefix.tests[1], problem.objective.tests[1]
@@ -69,7 +69,7 @@ def test_a_table_or_multi_axis_training_is_screened_whole():
     tests = training_tests(sine=[DATA / "synthetic_hydraulic_sine_1mm_8Hz.csv"])
     table = load_kdyn_table(DATA / "kdyn_synthetic_hydraulic_train.csv")
     problem = begin(training_request(tests, "hydraulic", kdyn=table), SerialEngine(), False, 0.0).prepare()
-    assert problem.objective.prefix(tests, 0.1) is None
+    assert problem.objective.prefix(0.1) is None
 
 
 def test_a_prefix_setting_must_be_a_fraction():

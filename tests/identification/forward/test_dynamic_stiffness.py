@@ -338,9 +338,9 @@ def test_the_search_loop_is_coarser_and_close_to_the_fit_loop():
     exact = characterise(TABLE5, [0.5, 2.0, 3.0], [1.0, 10.0, 30.0])
     table = KdynTable.from_characterisation(exact)
     search = Objective([], table=table, search=True)
-    fit_loop = search.with_fit_loop([])
+    fit_loop = search.with_fit_loop()
     assert set(search.table.cycles) == {3} and search.table.steps_per_cycle == 32
-    assert (set(search.with_steps([], []).table.cycles), fit_loop.with_fit_loop([]) is fit_loop) == ({3}, True)
+    assert (set(search.with_steps([]).table.cycles), fit_loop.with_fit_loop() is fit_loop) == ({3}, True)
     assert set(fit_loop.table.cycles) == {6} and fit_loop.table.steps_per_cycle == 64
     matrix = parameter_matrix([TABLE5])
     coarse, fine = (o.residual_matrix(matrix)[0] * math.sqrt(o.size) for o in (search, fit_loop))
