@@ -105,9 +105,7 @@ def print_warning(message: str) -> None:
 
 def fit_command(args) -> int:
     from identification.fitting.fit import fit
-    from identification.forward.simulate import simulate_multiaxis
     from identification.analysis.plots import plot_comparison, plot_multiaxis, plot_waterfall
-    from identification.forward.simulate import simulate
 
     # the parameter file and the ensemble carry the fit's provenance: JSON; SSP holds values only
     for path, option, suffix in ((args.out, "--out", ".json"), (args.ssv, "--ssv", ".ssv"),
@@ -150,15 +148,13 @@ def fit_command(args) -> int:
         if result.records:
             written.append(plot_waterfall([r.misfit for r in result.records], [r.stage for r in result.records],
                                           result.misfit, result.threshold, args.plots / "waterfall.png"))
-        for test, fitted in zip(tests, result.tests):    # each test's force as the fit computed it
+        # each test's force as the fit computed it (the one-axis tests' fits first, then the multi-axis ones)
+        for test, fitted in zip(tests, result.tests):
             m = test.measurement
-            predicted = fitted.predicted_N if fitted.predicted_N is not None else \
-                simulate(result.parameters, m.time_s, m.displacement_mm, m.measured_velocity_mm_s)
-            written.append(plot_comparison(m, {model: predicted}, args.plots / f"fit_{measurement_name(m.source)}.png"))
-        for m in multiaxis:
-            predicted = simulate_multiaxis(result.parameters, m.time_s, m.displacement_mm, coupling=args.coupling,
-                                           velocity_mm_s=m.velocity_mm_s)
-            written.append(plot_multiaxis(m, {f"{bushing.title}, {args.coupling}": predicted},
+            written.append(plot_comparison(m, {model: fitted.predicted_N},
+                                           args.plots / f"fit_{measurement_name(m.source)}.png"))
+        for m, fitted in zip(multiaxis, result.tests[len(tests):]):
+            written.append(plot_multiaxis(m, {f"{bushing.title}, {args.coupling}": fitted.predicted_N},
                                           args.plots / f"fit_{measurement_name(m.source)}.png"))
         if table is not None:
             written += _plot_table_fit(result, table, args.plots)

@@ -52,8 +52,8 @@ MIN_AGREEING = 2
 class RigTestFit:
     """One training test at the fitted parameters: its noise level, for a sine what the device
     repeats from cycle to cycle (``repeatability``; None for other tests), the NRMSE, and the
-    force it was computed from (``predicted_N`` [N] at the test's samples, kept so that nothing
-    simulates it again; None where not kept)."""
+    force it was computed from (``predicted_N`` [N] at the test's samples, (samples, axes) for a
+    multi-axis test; kept so that nothing simulates it again)."""
     name: str
     kind: str
     noise: NoiseEstimate

@@ -59,7 +59,8 @@ class MultiAxisTraining(MultiAxisTests):
                                            velocity_mm_s=m.velocity_mm_s)
             noise = NoiseEstimate(math.sqrt(sum(level.sigma_N ** 2 for level in levels)),
                                   math.sqrt(float(np.mean(np.sum(m.force_N ** 2, axis=1)))))
-            fits.append(RigTestFit(m.name, f"{len(m.axes)}-axis", noise, vector_nrmse(predicted, m.force_N)))
+            fits.append(RigTestFit(m.name, f"{len(m.axes)}-axis", noise, vector_nrmse(predicted, m.force_N),
+                                   predicted_N=predicted))
         return fits
 
 
