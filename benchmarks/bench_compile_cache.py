@@ -11,12 +11,11 @@ from __future__ import annotations
 
 import argparse
 import os
-import platform
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
+import harness
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -47,8 +46,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--model", default="proposed")
     args = parser.parse_args()
-    print(f"{time.strftime('%Y-%m-%d')}, {platform.machine()}, Python {platform.python_version()}: "
-          f"python benchmarks/bench_compile_cache.py --model {args.model}")
+    print(harness.provenance())
     with tempfile.TemporaryDirectory() as folder:
         cache = Path(folder)
         print(f"first call, empty cache (compiling):   {first_call(args.model, cache):6.2f} s")

@@ -22,10 +22,8 @@ from __future__ import annotations
 import argparse
 import importlib.util
 import math
-import platform
 import tempfile
 import time
-from datetime import date
 from pathlib import Path
 
 import numpy as np
@@ -38,6 +36,7 @@ from fmu_src.parameter_files import save_six_axis  # noqa: E402
 from identification import fit, training_tests  # noqa: E402
 from identification.measured.measurements import write_measurement  # noqa: E402
 from identification.measured.multiaxis import write_multiaxis  # noqa: E402
+import harness  # noqa: E402
 
 _spec = importlib.util.spec_from_file_location("coupled_references",
                                                REPO / "tests" / "references" / "generate_coupled_references.py")
@@ -187,9 +186,7 @@ def main() -> None:
             fmus[coupling] = build_fmu.build_fmu(params, scratch / coupling, model="six_axis")
         t = np.arange(round(1.0 / STEP_S) + 1) * STEP_S
         period = round(1.0 / 4.7 / STEP_S)
-        print(f"\n{date.today()}, {platform.machine()}, Python {platform.python_version()}: "
-              f"python benchmarks/bench_coupled_prediction.py --model {args.model} --seed {args.seed} "
-              f"--training {args.training}")
+        print("\n" + harness.provenance())
         print(f"{'path (unseen, 1 s)':24s} {'coupled FMU':>12s} {'uncoupled FMU':>14s}   NRMSE of the force vector")
         energies = []
         worst = 0.0

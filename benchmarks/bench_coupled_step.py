@@ -18,11 +18,9 @@ from __future__ import annotations
 
 import argparse
 import os
-import platform
 import statistics
 import subprocess
 import tempfile
-from datetime import date
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
@@ -31,6 +29,7 @@ import build_fmu  # noqa: E402
 from bench_fmu_step import _c_master  # noqa: E402
 from fmu_src.fmi.native.build import fmi_header_directory  # noqa: E402
 from fmu_src.parameter_files import load_parameters, read_six_axis, save_six_axis  # noqa: E402
+import harness  # noqa: E402
 
 AXES = ("x", "y", "z", "rx", "ry", "rz")
 
@@ -62,8 +61,7 @@ def main() -> None:
         for k in range(args.repeats):
             for key, fmu in fmus.items():
                 times[key] += _c_master(master, fmu, work / f"run_{key}_{k}", args.steps, 1)
-    print(f"{date.today()}, {platform.machine()}, Python {platform.python_version()}: python "
-          f"benchmarks/bench_coupled_step.py --steps {args.steps} --repeats {args.repeats}")
+    print(harness.provenance())
     print("C master, 10 Hz sines a third of a half period apart axis by axis; us/step, median; ratio: median "
           "over the runs of the coupled time over the uncoupled one's")
     for label, key, base in (("six proposed axes, uncoupled", "proposed_none", None),

@@ -12,8 +12,6 @@ on the force; docs/data.md).
 from __future__ import annotations
 
 import argparse
-import platform
-import time
 from pathlib import Path
 
 import numpy as np
@@ -23,6 +21,7 @@ REPO = Path(__file__).resolve().parents[1]
 from fmu_src.parameter_files import load_parameters  # noqa: E402
 from identification.measured.signals import Step, sample_times  # noqa: E402
 from identification.forward.simulate import simulate  # noqa: E402
+import harness  # noqa: E402
 
 RATE_HZ = 1000.0
 WINDOW_S = 0.05
@@ -41,8 +40,7 @@ def main() -> None:
     params = load_parameters(REPO / "data" / "params_table5_combined.json")
     t = sample_times(10.0, RATE_HZ)
     x, v = Step(2.0, 0.4, 10.0).signals(t)
-    print(f"{time.strftime('%Y-%m-%d')}, {platform.machine()}, Python {platform.python_version()}: "
-          f"python benchmarks/bench_displacement_noise.py --seed {args.seed}")
+    print(harness.provenance())
     print(f"{'displacement noise (rms)':26s} {'relaxation over 10 s':>22s}")
     print(f"{'none (commanded x, v)':26s} {relaxation(t, simulate(params, t, x, v)):22.1%}")
     rng = np.random.default_rng(args.seed)

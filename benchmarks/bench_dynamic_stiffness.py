@@ -11,9 +11,7 @@ the cases needed, and the same for an ensemble of 20 members (Table 5 with k0 an
 from __future__ import annotations
 
 import argparse
-import platform
 import statistics
-import time
 from pathlib import Path
 
 import numpy as np
@@ -22,15 +20,7 @@ REPO = Path(__file__).resolve().parents[1]
 
 from fmu_src.parameter_files import load_parameters  # noqa: E402
 from identification.forward.dynamic_stiffness import characterise  # noqa: E402
-
-
-def timed(function, repeats):
-    times = []
-    for _ in range(repeats):
-        started = time.perf_counter()
-        result = function()
-        times.append(time.perf_counter() - started)
-    return result, times
+import harness  # noqa: E402
 
 
 def main() -> None:
@@ -38,17 +28,16 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=5)
     args = parser.parse_args()
     table5 = load_parameters(REPO / "data" / "params_table5_combined.json")
-    print(f"{platform.processor() or platform.machine()}, Python {platform.python_version()}, "
-          f"{time.strftime('%Y-%m-%d %H:%M')}")
-    _, (first,) = timed(lambda: characterise(table5), 1)
-    table, times = timed(lambda: characterise(table5), args.repeats)
+    print(harness.provenance())
+    _, (first,) = harness.timed(lambda: characterise(table5), 1)
+    table, times = harness.timed(lambda: characterise(table5), args.repeats)
     print(f"one set, {len(table)} cases: first call {first:.2f} s (cache load or compile), then best "
           f"{min(times):.3f} s, median {statistics.median(times):.3f} s; cycles per case "
           f"{table.cycles.min()}-{table.cycles.max()} (median {int(np.median(table.cycles))})")
     rng = np.random.default_rng(0)
     members = [table5] + [dict(table5, k0=table5["k0"] * f, c1=table5["c1"] * g)
                           for f, g in rng.uniform(0.8, 1.2, (19, 2))]
-    ensemble, times = timed(lambda: characterise(members), args.repeats)
+    ensemble, times = harness.timed(lambda: characterise(members), args.repeats)
     print(f"ensemble of {len(members)} sets, {len(ensemble)} cases: best {min(times):.3f} s, "
           f"median {statistics.median(times):.3f} s")
 

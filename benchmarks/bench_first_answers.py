@@ -18,13 +18,13 @@ from __future__ import annotations
 
 import argparse
 import os
-import platform
 import re
 import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
+import harness
 
 REPO = Path(__file__).resolve().parents[1]
 DATA = REPO / "data"
@@ -74,11 +74,7 @@ def main() -> None:
                                                                "(ten minutes or more)")
     parser.add_argument("--workers", type=int, default=2)
     args = parser.parse_args()
-    commit = subprocess.run(["git", "-C", str(REPO), "rev-parse", "--short", "HEAD"], capture_output=True,
-                            text=True).stdout.strip()
-    print(f"{time.strftime('%Y-%m-%d %H:%M')}, {platform.machine()}, {os.cpu_count()} cores, Python "
-          f"{platform.python_version()}, commit {commit}: python benchmarks/bench_first_answers.py"
-          + (" --fit" if args.fit else "") + (" --compare" if args.compare else ""))
+    print(harness.provenance())
     if args.fit:
         first_fit(args.workers)
     if args.compare:

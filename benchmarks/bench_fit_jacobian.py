@@ -24,14 +24,12 @@ Jacobian, from forward differences and from the reference, with their relative d
 from __future__ import annotations
 
 import argparse
-import os
-import platform
 import resource
-import subprocess
 import time
 from pathlib import Path
 
 import numpy as np
+import harness
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -98,12 +96,7 @@ def main() -> None:
 
     warnings.simplefilter("ignore", FitNotConvergedWarning)
     tests = training_tests(sine=[args.sine], step=[args.step], rise_times_s=[args.rise_time])
-    commit = subprocess.run(["git", "-C", str(REPO), "rev-parse", "--short", "HEAD"], capture_output=True,
-                            text=True).stdout.strip()
-    dirty = subprocess.run(["git", "-C", str(REPO), "status", "--porcelain"], capture_output=True,
-                           text=True).stdout.strip()
-    print(f"machine: {platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}; "
-          f"commit {commit}{' with uncommitted changes' if dirty else ''}; {time.strftime('%Y-%m-%d %H:%M')}")
+    print(harness.provenance())
     print(f"tests: {Path(args.sine).name}, {Path(args.step).name} (rise {args.rise_time} s); default preset, "
           f"seed {args.seed}, {args.workers} workers, ensemble {'off' if args.no_ensemble else 'on'}")
     started = time.perf_counter()

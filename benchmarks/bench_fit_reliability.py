@@ -29,7 +29,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import platform
 import sys
 import time
 import warnings
@@ -46,6 +45,7 @@ from identification.measured.signals import Sine, Step, sample_times  # noqa: E4
 from identification.measured.rig_tests import RigTest  # noqa: E402
 from identification.fitting.search_space import SearchSpace  # noqa: E402
 from identification.forward.simulate import simulate  # noqa: E402
+import harness  # noqa: E402
 
 NOISE = 0.01
 FLOOR = 1.25
@@ -221,8 +221,7 @@ def main() -> None:
                         help="read the truths from this JSON file if it exists, else draw them and write it")
     args = parser.parse_args()
 
-    print(f"machine: {platform.machine()}, Python {platform.python_version()}, {time.strftime('%Y-%m-%d')}",
-          file=sys.stderr)
+    print(harness.provenance(), file=sys.stderr)
     rows = []
     drawn = load_or_draw_truths(args.truths, args.truths_file)
     for index, (name, truth) in enumerate(drawn):

@@ -13,7 +13,6 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import platform
 import tempfile
 import time
 from pathlib import Path
@@ -26,6 +25,7 @@ from fmu_src.parameter_files import load_parameters  # noqa: E402
 from identification.measured.measurements import write_measurement  # noqa: E402
 from identification.measured.signals import Sine, Step, sample_times  # noqa: E402
 from identification.forward.simulate import simulate  # noqa: E402
+import harness  # noqa: E402
 
 
 def bushings(count: int):
@@ -68,8 +68,7 @@ def main() -> None:
         started = time.perf_counter()
         rows = fit_many(fleet, Path(tmp) / "out", workers=args.workers)
         seconds = time.perf_counter() - started
-    print(f"machine: {platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}, "
-          f"{time.strftime('%Y-%m-%d')}; {args.workers} workers")
+    print(f"{harness.provenance()}; {args.workers} workers")
     for row in rows:
         print(f"  {row.name:22s} misfit {row.misfit:.4f} {'converged' if row.converged else 'NOT converged'} "
               f"{row.seconds:6.1f} s{'  ' + row.error if row.error else ''}")

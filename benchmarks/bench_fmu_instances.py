@@ -13,16 +13,15 @@ numba cache is already filled (the FMU's default cache directory, filled by a ru
 from __future__ import annotations
 
 import argparse
-import platform
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
 
 from bench_fmu_step import TRIVIAL_SLAVE  # noqa: E402
+import harness  # noqa: E402
 
 INSTANCES = """
 import sys, time
@@ -69,8 +68,7 @@ def main() -> None:
     args = parser.parse_args()
     import build_fmu
     from pythonfmu import FmuBuilder
-    print(f"{time.strftime('%Y-%m-%d')}, {platform.machine()}, Python {platform.python_version()}: "
-          f"python benchmarks/bench_fmu_instances.py --instances {args.instances}")
+    print(harness.provenance())
     with tempfile.TemporaryDirectory() as folder:
         work = Path(folder)
         bushing = build_fmu.build_fmu(out_dir=work / "bushing")

@@ -38,6 +38,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+import harness
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -302,8 +303,8 @@ def main() -> None:
     args = parser.parse_args()
     if args.native_against:
         result = measure_native_against(args.native_against, args.steps, args.repeats)
-        print(f"machine: {platform.machine()}, Python {platform.python_version()}; C master, {100 * args.steps} "
-              f"steps a run, {args.repeats} runs each, alternating; us/step, median")
+        print(f"{harness.provenance()}\nC master, {100 * args.steps} steps a run, {args.repeats} runs each, "
+              "alternating; us/step, median")
         print(f"{'model':12s} {'this tree':>10s} {args.native_against[:12]:>12s} {'ratio':>6s}")
         for model, (new, old, ratio) in result.items():
             print(f"{model:12s} {new * 1e6:10.3f} {old * 1e6:12.3f} {ratio:6.3f}")
@@ -320,8 +321,8 @@ def main() -> None:
                             str(args.repeats)], env=environment, capture_output=True, text=True, check=True)
     plain = json.loads(child.stdout.strip().splitlines()[-1])
 
-    print(f"machine: {platform.machine()}, {platform.processor() or 'cpu'}, Python {platform.python_version()}, "
-          f"{args.steps} steps x {args.repeats} repeats, sine 2 mm (0.02 rad) / 10 Hz, step {STEP_S * 1e3:g} ms")
+    print(f"{harness.provenance()}\n{platform.processor() or 'cpu'}; {args.steps} steps x {args.repeats} repeats, "
+          f"sine 2 mm (0.02 rad) / 10 Hz, step {STEP_S * 1e3:g} ms")
     print(f"{'what':46s} {'compiled':>9s} {'ratio':>6s} {'pure Py':>9s} {'ratio':>6s}   (us/step, median; "
           "ratio: median over the repeats of the time over its trivial FMU's just before)")
     for key, label in (("trivial", "trivial pythonfmu FMU (F = 2x)"),

@@ -12,8 +12,6 @@ b*(i*omega)^alpha (both independent of b), 2000 frequencies per band, log-spaced
 from __future__ import annotations
 
 import math
-import platform
-from datetime import date
 from pathlib import Path
 
 import numpy as np
@@ -21,6 +19,7 @@ import numpy as np
 REPO = Path(__file__).resolve().parents[1]
 
 from fmu_src.models.fractional_model import ELEMENTS, MODEL  # noqa: E402
+import harness  # noqa: E402
 
 BANDS_HZ = ((0.01, 300.0), (0.001, 1000.0), (1.0, 100.0))
 ORDERS = (0.05, 0.1, 0.2, 0.22, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 0.95)
@@ -34,8 +33,7 @@ def realised(alpha: float, frequency_hz: np.ndarray) -> np.ndarray:
 
 
 def main() -> None:
-    print(f"{date.today()}, {platform.processor() or platform.machine()}, Python {platform.python_version()}: "
-          f"{ELEMENTS} Maxwell elements and a dashpot (python benchmarks/bench_fractional_realisation.py)")
+    print(f"{harness.provenance()}\n{ELEMENTS} Maxwell elements and a dashpot")
     header = "alpha " + "".join(f"| {low:g}-{high:g} Hz: |K*| err, phase err " for low, high in BANDS_HZ)
     print(header)
     for alpha in ORDERS:

@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import argparse
 import importlib.util
-import platform
 import subprocess
 import sys
 import time
@@ -38,6 +37,7 @@ REPO = Path(__file__).resolve().parents[1]
 
 from fmu_src.parameter_files import load_parameters  # noqa: E402
 from identification.forward.dynamic_stiffness import characterise  # noqa: E402
+import harness  # noqa: E402
 
 _spec = importlib.util.spec_from_file_location("hydraulic_closed_form",
                                                REPO / "tests" / "references" / "hydraulic_closed_form.py")
@@ -188,10 +188,7 @@ def main() -> None:
     parser.add_argument("--speed", action="store_true", help="the native FMU's step in a C master")
     parser.add_argument("--workers", type=int, default=2)
     args = parser.parse_args()
-    commit = subprocess.run(["git", "-C", str(REPO), "rev-parse", "--short", "HEAD"], capture_output=True,
-                            text=True).stdout.strip()
-    print(f"machine: {platform.machine()}, Python {platform.python_version()}; commit {commit}; "
-          f"{time.strftime('%Y-%m-%d %H:%M')}")
+    print(harness.provenance())
     params = load_parameters(REPO / "data" / "params_hydraulic_mount.json", "hydraulic")
     closed_form_check(params)
     data_sheet(params, args.figure)

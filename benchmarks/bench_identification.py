@@ -14,12 +14,12 @@ Then the cost of one candidate of the fit's objective on the paper's two trainin
 from __future__ import annotations
 
 import argparse
-import platform
 import sys
 import time
 from pathlib import Path
 
 import numpy as np
+import harness
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "tests"))   # the Python core loop (tests/python_core.py)
@@ -89,8 +89,8 @@ def main() -> None:
     objective(matrix)
     objective_cost = (time.perf_counter() - started) / len(matrix)
 
-    print(f"machine: {platform.machine()}, Python {platform.python_version()}; sine 2 mm / 10 Hz, 1 s at 1 kHz; "
-          f"{len(matrix)} candidates near the optimum, {np.isnan(compiled[:, -1]).sum()} of them failed")
+    print(f"{harness.provenance()}\nsine 2 mm / 10 Hz, 1 s at 1 kHz; {len(matrix)} candidates near the optimum, "
+          f"{np.isnan(compiled[:, -1]).sum()} of them failed")
     print(f"{'per candidate':45s} {'ms':>10s} {'speed-up':>9s}")
     print(f"{'solve_ivp Radau loop (' + str(len(ivp_sample)) + ' candidates)':45s} {ivp_cost * 1e3:10.1f} {1.0:9.0f}")
     print(f"{'Python core (20 candidates)':45s} {python_cost * 1e3:10.2f} {ivp_cost / python_cost:9.0f}")

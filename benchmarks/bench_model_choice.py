@@ -32,11 +32,9 @@ print each model's fit time (target for the filled-rubber models: <= 3 min on 2 
 from __future__ import annotations
 
 import argparse
-import platform
 import sys
 import tempfile
 import time
-from datetime import date
 from pathlib import Path
 
 import numpy as np
@@ -51,6 +49,7 @@ from identification.fitting.objectives import nrmse  # noqa: E402
 from identification.measured.repeatability import estimate_repeatability  # noqa: E402
 from identification.measured.rig_tests import training_tests  # noqa: E402
 from identification.fitting.search_space import KelvinVoigtFit  # noqa: E402
+import harness  # noqa: E402
 
 DATA = REPO / "data"
 BRFD = DATA / "brfd"
@@ -63,8 +62,7 @@ def filled_rubber(out: Path, models, ensemble: bool) -> None:
     validation = [Path(f"{FILLED}_random_2mm.csv"), Path(f"{FILLED}_sine_0.1mm_30Hz.csv")]
     table = load_kdyn_table(DATA / "kdyn_synthetic_filled_rubber.csv")
     result = compare_models(models, tests, validation, out, ensemble=ensemble, table=table)
-    print(f"\n{date.today()}, {platform.machine()}, Python {platform.python_version()}: "
-          "python benchmarks/bench_model_choice.py filled-rubber")
+    print("\n" + harness.provenance())
     print(f"{'model':17s} {'largest |K*| error':>19s} {'largest loss-angle error':>25s} {'fit s':>7s}")
     for a in result["assessments"]:
         mark = "  <- recommended (targets 3 %, 1 deg)" if a.model == result["recommendation"].model else ""
@@ -83,8 +81,7 @@ def friction_damper(out: Path, models, ensemble: bool, held_out: bool = True) ->
     result = compare_models(models, tests, others if held_out else [], out, ensemble=ensemble)
     chosen = result["recommendation"].model
     trained_kv = result["parameters"].get("kelvin_voigt")
-    print(f"\n{date.today()}, {platform.machine()}, Python {platform.python_version()}: "
-          f"python benchmarks/bench_model_choice.py friction-damper{'' if held_out else ' --no-held-out'}")
+    print("\n" + harness.provenance())
     given = "held-out sines given to compare" if held_out else "trained on one sine, no held-out file given to compare"
     print(f"recommended: {chosen} ({given}); NRMSE per sine, over a least-squares Kelvin-Voigt fitted to the file "
           "itself, over the one trained on the same sine (target <= 0.5), and over what the device repeats")
@@ -131,8 +128,7 @@ def voided(out: Path, models, ensemble: bool) -> None:
     bushings = [options.model(name) for name in models]
     result = compare_models(bushings, tests, held_out, out, ensemble=ensemble, fixed=options.fixed)
     chosen = result["recommendation"].model
-    print(f"\n{date.today()}, {platform.machine()}, Python {platform.python_version()}: "
-          "python benchmarks/bench_model_choice.py voided")
+    print("\n" + harness.provenance())
     print(f"recommended: {chosen}; NRMSE on the held-out files (target <= 2 %):")
     for path in held_out:
         print(f"  {path.name:44s} {result['errors'][path.name, chosen][0]:7.2%}")

@@ -37,13 +37,10 @@ from __future__ import annotations
 
 import argparse
 import ctypes
-import os
-import platform
 import sys
 import tempfile
 import time
 from dataclasses import dataclass
-from datetime import datetime, timezone
 from pathlib import Path
 
 import numpy as np
@@ -55,6 +52,7 @@ REPO = Path(__file__).resolve().parents[1]
 
 import build_fmu  # noqa: E402
 from identification.measured.signals import Sine  # noqa: E402
+import harness  # noqa: E402
 
 SINE = Sine(2.0, 10.0, 1.0)                     # the paper's sine: 2 mm, 10 Hz, mm and s
 SOLVERS = {"Radau": Radau, "BDF": BDF}
@@ -278,9 +276,8 @@ def main() -> None:
     args = parser.parse_args()
     times = np.arange(round(args.duration * 1000.0) + 1) / 1000.0
     rtols = [float(r) for r in args.rtols.split(",")]
-    print(f"{datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC, {platform.machine()}, {os.cpu_count()} cores, "
-          f"Python {platform.python_version()}: model exchange on the sine {SINE.amplitude_mm:g} mm "
-          f"{SINE.frequency_hz:g} Hz, {args.duration:g} s, native FMU (FMI 2.0), scipy Radau/BDF")
+    print(f"{harness.provenance()}\nmodel exchange on the sine {SINE.amplitude_mm:g} mm {SINE.frequency_hz:g} Hz, "
+          f"{args.duration:g} s, native FMU (FMI 2.0), scipy Radau/BDF")
     rows = []
     with tempfile.TemporaryDirectory() as folder:
         for name in args.models.split(","):

@@ -26,13 +26,12 @@ from __future__ import annotations
 
 import argparse
 import csv
-import os
-import platform
 import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
+import harness
 
 REPO = Path(__file__).resolve().parents[1]
 DATA = REPO / "data"
@@ -85,11 +84,7 @@ def main() -> None:
     unknown = [case for case in args.cases if case not in CASES]
     if unknown:
         parser.error(f"unknown cases {', '.join(unknown)}: choose from {', '.join(CASES)}")
-    commit = subprocess.run(["git", "-C", str(REPO), "rev-parse", "--short", "HEAD"], capture_output=True,
-                            text=True).stdout.strip()
-    print(f"{time.strftime('%Y-%m-%d %H:%M')}, {platform.machine()}, {os.cpu_count()} cores, Python "
-          f"{platform.python_version()}, commit {commit}: python benchmarks/bench_race.py {' '.join(sys.argv[1:])}",
-          flush=True)
+    print(harness.provenance(), flush=True)
     closing = []
     for case in args.cases or list(CASES):
         with tempfile.TemporaryDirectory() as folder:

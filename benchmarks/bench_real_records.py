@@ -11,11 +11,8 @@ and prints its time and training NRMSE (target: <= 2 min each). Then fits ``--le
 from __future__ import annotations
 
 import argparse
-import platform
-import sys
 import time
 import warnings
-from datetime import date
 from pathlib import Path
 
 import numpy as np
@@ -27,6 +24,7 @@ from identification.errors import FitNotConvergedWarning  # noqa: E402
 from identification.fitting.fit import fit  # noqa: E402
 from identification.measured.measurements import Measurement, load_measurement  # noqa: E402
 from identification.measured.rig_tests import RigTest  # noqa: E402
+import harness  # noqa: E402
 
 RECORD = REPO / "data" / "brfd" / "sine_0.5Hz30lbtension1amplitude.csv.gz"
 
@@ -57,8 +55,7 @@ def main() -> None:
     args = parser.parse_args()
     record = load_measurement(RECORD)
     ensemble = not args.no_ensemble
-    print(f"{date.today()}, {platform.machine()}, Python {platform.python_version()}: "
-          f"python benchmarks/bench_real_records.py {' '.join(sys.argv[1:])}")
+    print(harness.provenance())
     print(f"{RECORD.name}: {len(record)} samples, {record.time_s[-1]:.1f} s")
     print(f"{'model':26s} {'fit [s]':>8s} {'NRMSE':>8s}  (target <= 120 s)")
     for model in [name.strip() for name in args.models.split(",") if name.strip()]:

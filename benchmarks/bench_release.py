@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import platform
 import re
 import resource
 import shutil
@@ -31,6 +30,7 @@ import zipfile
 from pathlib import Path
 
 from fmu_src.fmi.native.build import FLAGS, WARNINGS
+import harness
 
 REPO = Path(__file__).resolve().parents[1]
 TOKEN = re.compile(rb'(?:guid|instantiationToken)="(\{[^"]+\})"')
@@ -94,7 +94,7 @@ def main() -> int:
     parser.add_argument("--against", required=True, help="the earlier commit to build side by side")
     parser.add_argument("--repeats", type=int, default=2)
     args = parser.parse_args()
-    print(f"{time.strftime('%Y-%m-%d')}, {platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}")
+    print(harness.provenance())
     with tempfile.TemporaryDirectory(prefix="bench_release_") as work:
         work = Path(work)
         earlier = work / "earlier"

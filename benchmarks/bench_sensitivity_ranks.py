@@ -10,7 +10,6 @@ ranked first. tests/identification/fitting/test_identification.py asserts rho > 
 """
 from __future__ import annotations
 
-import platform
 import time
 from pathlib import Path
 
@@ -21,13 +20,13 @@ REPO = Path(__file__).resolve().parents[1]
 from fmu_src.parameter_files import load_parameters  # noqa: E402
 from fmu_src.models.proposed_model import PARAMETER_NAMES  # noqa: E402
 from identification.analysis.parameter_sensitivity import MEASURES, PAPER_RANKS, sensitivity  # noqa: E402
+import harness  # noqa: E402
 
 
 def main() -> None:
     started = time.perf_counter()
     table = sensitivity(load_parameters(REPO / "data" / "params_table5_combined.json"))
-    print(f"{time.strftime('%Y-%m-%d')}, {platform.machine()}, Python {platform.python_version()}: "
-          "python benchmarks/bench_sensitivity_ranks.py")
+    print(harness.provenance())
     print(f"{'measure':12s} {'Spearman rho':>12s}  first (ours)  first (paper)")
     for measure in MEASURES:
         ranks = table.ranks(measure)

@@ -12,7 +12,6 @@ errors against Spencer's noise-free forces over the paper's §5 grid and the ran
 from __future__ import annotations
 
 import argparse
-import platform
 import time
 from pathlib import Path
 
@@ -22,6 +21,7 @@ from fmu_src.parameter_files import load_parameters  # noqa: E402
 from identification.fitting.fit import fit  # noqa: E402
 from identification.analysis.paper_verification import format_errors, grid_errors  # noqa: E402
 from identification.measured.rig_tests import training_tests  # noqa: E402
+import harness  # noqa: E402
 
 DATA = REPO / "data"
 
@@ -31,8 +31,7 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args()
     started = time.perf_counter()
-    print(f"{time.strftime('%Y-%m-%d')}, {platform.machine()}, Python {platform.python_version()}: "
-          f"python benchmarks/bench_spencer_containment.py --seed {args.seed}")
+    print(harness.provenance())
     tests = training_tests(sine=[DATA / "synthetic_spencer_sine_2mm_10Hz.csv"],
                            step=[DATA / "synthetic_spencer_step_2mm_rise0.4s.csv"], rise_times_s=[0.4])
     result = fit(tests, model="proposed", seed=args.seed)
