@@ -244,9 +244,8 @@ def compiled_module(model, appendix: str = "", prefix: str = "bushing") -> types
 
 COMPILED_IN_FMU = ("jump", "integrate")
 """The kernels an FMU runs compiled one axis at a time (the plain-Python step's fallback for the
-message of a failed step). force() is a few multiplications, which plain Python does in 0.44 us
-against 1.2 us for numba's dispatch (Table 5, measured 2026-11-23); prepare() and
-initial_state() run once."""
+message of a failed step). force() is a few multiplications, which plain Python does faster than
+numba's dispatch (docs/benchmarks.md, "Figures behind the code's constants"); prepare() and initial_state() run once."""
 
 
 def _step_axes(params, rows, h, max_substeps, histories, next_histories):
@@ -409,10 +408,11 @@ def host_executable() -> tuple[str | None, str]:
 
 def _python_host(executable: str) -> bool:
     """Whether ``executable`` (:func:`host_executable`) is a Python interpreter (fmpy,
-    libcosimpy, ... run in one), not a C/C++ tool that embeds Python (measured 2026-11-23:
-    numba-compiled kernels in a C host that embeds libpython, tests/c_host, end in heap
-    corruption; in Python hosts they run clean). By its file name: python, python3.12,
-    python.exe, pythonw.exe, and macOS's framework interpreter .../Python.app/Contents/MacOS/Python."""
+    libcosimpy, ... run in one), not a C/C++ tool that embeds Python (numba-compiled kernels in
+    a C host that embeds libpython, tests/c_host, ended in heap corruption: docs/benchmarks.md,
+    "Figures behind the code's constants"; in Python hosts they run clean). By its file name:
+    python, python3.12, python.exe, pythonw.exe, and macOS's framework interpreter
+    .../Python.app/Contents/MacOS/Python."""
     name = (ntpath.basename(executable) if sys.platform == "win32" else os.path.basename(executable)).lower()
     return name.startswith("python")
 

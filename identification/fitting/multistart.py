@@ -43,10 +43,9 @@ COST_TOLERANCE = 1e-6
 """scipy's ``ftol``: a start ends when an accepted step (one whose actual reduction is more than
 a quarter of the predicted) lowers chi^2 by less than this fraction of itself. That bounds one
 step, not the distance to the minimum, so the measured gap is what justifies it: on the
-reliability benchmark's random 1 (seed 0, one worker, 2026-11-24) the best start ended at
-chi^2/n 0.989420 against 0.989393 with scipy's default 1e-8, 0.06 in chi^2 (n = 2380), 0.3 % of
-the confidence region's delta chi^2 of 23.7; the six final starts agreed either way, and the
-last stage took 4107 simulations instead of 8392 (the fit 63 s instead of 107 s): with 1e-8
+reliability benchmark's random 1 the best start ends a small fraction of the confidence region's
+delta chi^2 above scipy's default 1e-8, the final starts agree either way, and the last stage
+takes half the simulations (docs/benchmarks.md, "Least-squares tolerance"): with 1e-8
 the final starts crawled along flat valleys."""
 
 
@@ -248,8 +247,9 @@ EXACT_JACOBIAN_LIMIT = 1e100
 """An exact Jacobian with an entry beyond this (residuals in noise units per coordinate; a fit's
 are of order 1 to 1e4) is replaced by forward differences at that point: where a Bouc-Wen block's
 z crosses 0 with n < 1 the gain's derivative n*|z|^(n-1) is infinite, and a sensitivity carried
-through it reached 2e303 (proposed model, Table 2 tests, seed 8, 2026-11-26), finite but too large
-for the least squares' scaling and SVD, which then fail on infs. Differences take the secant."""
+through it was seen near the largest double (docs/benchmarks.md, "Figures behind the code's
+constants"), finite but too large for the least squares' scaling and SVD, which then fail on
+infs. Differences take the secant."""
 
 
 def exact_usable(derivative: np.ndarray) -> bool:

@@ -94,9 +94,8 @@ class PreparedMultiAxis:
 SEARCH_SETTLING = 0.25
 """The share of a model's settling time the search's table loop runs (the hydraulic model: 0.5 s
 against the fit loop's 2 s). It only chooses the basins the fit loop refines: at the truth on the
-synthetic mount's sheet it is within 6.4 % and 3.9 deg of the steady state (1.3 % and 0.85 deg
-at half the settling time), and the fit from that sheet reaches the same result with either,
-in 122 s instead of 169 s (measured 2026-11-27)."""
+synthetic mount's sheet it stays near the steady state, and the fit from that sheet reaches the
+same result with either, faster (docs/benchmarks.md, "Figures behind the code's constants")."""
 
 
 @dataclass(frozen=True)

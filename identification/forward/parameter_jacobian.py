@@ -145,9 +145,8 @@ _source_sizes: dict[tuple[str, int], int] = {}
 
 COMPILE_SECONDS_PER_KB = 0.17
 """numba's compile time of a generated sensitivity module per kB of its source, on the project's
-2-core VM (2026-11-27, an empty cache, one module at a time): the proposed model's 14 directions
-(202 kB) 33.5 s, Spencer's 8 (91 kB) 12.5 s, the single Bouc-Wen's 6 (34 kB) 4.8 s, the
-fractional model's 6 (84 kB) 16.9 s. An estimate for the progress shown while it compiles."""
+2-core VM, fitted to four models' modules (docs/benchmarks.md, "Figures behind the code's
+constants"). An estimate for the progress shown while it compiles."""
 
 
 def expected_compile_seconds(model: str | BushingModel, lanes: int) -> float | None:

@@ -50,15 +50,14 @@ FIT_STEPS_PER_CYCLE = 64
 """The secant path through 64 samples per cycle carries a first harmonic (pi/64)^2/3 = 8e-4
 smaller than the sine's: a tenth of KDYN_UNCERTAINTY."""
 FIT_CYCLES = 6
-"""From rest, the sixth cycle's first harmonic is within 8e-4 of the steady state's |K*| and 0.025 deg
-of its loss angle for the paper's Tables 2, 4, 5 on 0.5-3 mm, 1-30 Hz (64 steps per cycle,
-measured 2026-11-23): about a tenth of the uncertainties; twelve cycles would halve little."""
+"""From rest, the sixth cycle's first harmonic is within about a tenth of the uncertainties of the
+steady state for the paper's Tables 2, 4, 5 on 0.5-3 mm, 1-30 Hz (docs/benchmarks.md, "Figures
+behind the code's constants"); twelve cycles would halve little."""
 SEARCH_STEPS_PER_CYCLE, SEARCH_CYCLES = 32, 3
 """The table's loop during the screening and the early least-squares stages, which only choose the
-basins the last stage refines: a quarter of the cost, within 6.9e-3 of the steady state's |K*| and
-0.096 deg of its loss angle at the truth for Tables 2, 4, 5 (measured 2026-11-24; 4 cycles gave
-2.2e-3 and 0.084 deg). The Table 4 round trip (benchmarks/bench_kdyn_fit.py) is as accurate with
-either, and 20 s faster with 3."""
+basins the last stage refines: a quarter of the cost, near the steady state at the truth for
+Tables 2, 4, 5; the Table 4 round trip (benchmarks/bench_kdyn_fit.py) is as accurate with either,
+and faster with 3 (docs/benchmarks.md, "Figures behind the code's constants")."""
 REQUIRED = ("amplitude_mm", "frequency_hz", "kdyn_N_per_mm", "loss_angle_deg")
 """The columns a table to read must have (units in the names)."""
 OPTIONAL = {"preload_mm": 0.0, "weight": 1.0}
