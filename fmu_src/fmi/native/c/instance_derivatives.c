@@ -15,6 +15,22 @@
    would pick between them at random). Available from the exit of initialization mode (the
    state is set there). */
 
+/* BW_OK if each of the count derivatives of the states' rates is finite; else BW_ERROR, naming
+   the first that is not (in function, for the axis or group that label names). */
+static bw_status bw_rates_finite(bw_instance *inst, const char *function, const char *label, const double *d_rates,
+                                 int count) {
+    char where[80];
+    int i;
+    for (i = 0; i < count; i++) {
+        if (!isfinite(d_rates[i])) {
+            snprintf(where, sizeof where, "%s: ", function);
+            BW_MESSAGE_RATE_DERIVATIVE_NOT_FINITE(inst, where, label, i, d_rates[i]);
+            return BW_ERROR;
+        }
+    }
+    return BW_OK;
+}
+
 typedef struct {
     double d_state[BW_MAX_STATES];   /* kernel units */
     double dx, dv;                   /* kernel units */
@@ -119,14 +135,7 @@ static bw_status bw_axis_tangent(bw_instance *inst, const char *function, int a,
     if (d_rates) {
         model->derivatives_tangent(&axis->constants, state, axis->x_now, v, d_state, direction->dx, direction->dv,
                                    d_rates);
-        for (i = 0; i < model->states; i++) {
-            if (!isfinite(d_rates[i])) {
-                char where[80];
-                snprintf(where, sizeof where, "%s: ", function);
-                BW_MESSAGE_RATE_DERIVATIVE_NOT_FINITE(inst, where, spec->label, i, d_rates[i]);
-                return BW_ERROR;
-            }
-        }
+        return bw_rates_finite(inst, function, spec->label, d_rates, model->states);
     }
     return BW_OK;
 }
@@ -148,7 +157,7 @@ static bw_status bw_group_tangent(bw_instance *inst, const char *function, int g
     const bw_coupled_model *kernels = bw_group_kernels(g);
     const void *constants = bw_group_constants(inst, g);
     double state[BW_MAX_GROUP_STATES], d_state[BW_MAX_GROUP_STATES], x[3], v[3], d_force[3];
-    int c, i;
+    int c;
     bw_group_inputs(inst, g, x, v);
     memcpy(state, group->state, sizeof state);
     memcpy(d_state, direction->d_state, sizeof d_state);
@@ -188,14 +197,7 @@ static bw_status bw_group_tangent(bw_instance *inst, const char *function, int g
     }
     if (d_rates) {
         kernels->derivatives_tangent(constants, state, x, v, d_state, direction->dx, direction->dv, d_rates);
-        for (i = 0; i < kernels->states; i++) {
-            if (!isfinite(d_rates[i])) {
-                char where[80];
-                snprintf(where, sizeof where, "%s: ", function);
-                BW_MESSAGE_RATE_DERIVATIVE_NOT_FINITE(inst, where, spec->label, i, d_rates[i]);
-                return BW_ERROR;
-            }
-        }
+        return bw_rates_finite(inst, function, spec->label, d_rates, kernels->states);
     }
     return BW_OK;
 }
