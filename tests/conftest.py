@@ -200,9 +200,9 @@ def pythonfmu_model_fmus(tmp_path_factory) -> dict:
 @pytest.fixture(scope="session")
 def coupled_six_axis_fmus(tmp_path_factory) -> dict:
     """The illustrative six axes with a spherical group (the proposed model on x, y, z) and a conical
-    one (Berg on rx, ry) (``test_coupled_six_axis.six_axis_file``): its parameter file ("file"), its
+    one (Berg on rx, ry) (``example_parameter_files.six_axis_file``): its parameter file ("file"), its
     pythonfmu FMU and its native FMUs ("fmi2", "fmi3")."""
-    from test_coupled_six_axis import six_axis_file
+    from example_parameter_files import six_axis_file
 
     def build(folder):
         path = six_axis_file(folder, {"translation": "spherical", "rotation": "conical"})

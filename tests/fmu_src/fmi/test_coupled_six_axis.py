@@ -1,8 +1,6 @@
 """Coupled groups of the six-axis FMU (``axes.Coupling``: radial x-y, spherical x-y-z, conical
 rx-ry): the parameter file's ``"coupling"``, its checks, and the pythonfmu FMU against the coupled
 kernels, with the mounting, its FMU state and its ModelStructure."""
-import copy
-import json
 import math
 
 import numpy as np
@@ -11,33 +9,17 @@ from fmpy import read_model_description
 
 import build_fmu
 from conftest import DATA
+from example_parameter_files import SIX_AXIS_DEFAULT, six_axis_file
 from fmu_harness import BushingFmu
 from fmu_src.fmi.axes import SIX_AXES, Coupling
 from fmu_src.model.parameter_specs import ParameterError
 from fmu_src.model.integration import DEFAULT_MAX_SUBSTEPS, OK
 from fmu_src.parameter_files import read_six_axis, save_six_axis, six_axis_document
 
-DEFAULT = DATA / "params_six_axis_illustrative.json"
-ROTATIONAL_BERG = {"k0": 3e5, "k3": 1e6, "Ff_max": 2e3, "x2": 0.004, "k1": 1e5, "c1": 1e4, "k2": 5e4, "c2": 100.0}
+DEFAULT = SIX_AXIS_DEFAULT
 """An illustrative torsion set (N.mm/rad, N.mm/rad^3, N.mm, rad, N.mm.s/rad)."""
 STEP_S = 1e-3
 PORTS = [name for axis in SIX_AXES for name in (axis.displacement, axis.velocity)]
-
-
-def six_axis_file(tmp_path, coupling, **changes):
-    """The illustrative six axes with x's set on y and z, Berg on rx and ry, and ``coupling``."""
-    document = json.loads(DEFAULT.read_text())
-    for axis in ("y", "z"):
-        document["axes"][axis] = copy.deepcopy(document["axes"]["x"])
-    for axis in ("rx", "ry"):
-        document["axes"][axis] = {"model": "BergBushing", "parameters": dict(ROTATIONAL_BERG)}
-    document["coupling"] = coupling
-    for key, value in changes.items():
-        axis, name = key.split("__")
-        document["axes"][axis]["parameters"][name] = value
-    path = tmp_path / f"six_{abs(hash(json.dumps(coupling, sort_keys=True)))}.json"
-    path.write_text(json.dumps(document))
-    return path
 
 
 @pytest.fixture(scope="module")

@@ -7,13 +7,12 @@ from fmpy import read_model_description
 from fmpy.validation import validate_fmu
 
 from fmu_src.fmi.fmu_inputs import default_parameter_file
-from fmu_harness import BushingFmu
+from fmu_harness import BushingFmu, simulate_with_fmpy
 from fmu_src.model.registry import MODELS
 from fmu_src.parameter_files import load_parameters
 from identification.forward.population import simulate_model_held
 from identification.measured.signals import Sine, sample_times
 from paper_units import PARAMETER_UNITS, fmu_parameter_units
-from test_fmu_numerics import simulate_with_fmpy
 
 BASELINES = tuple(name for name in MODELS if name != "proposed")
 MM = 1e-3

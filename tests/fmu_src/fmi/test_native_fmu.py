@@ -16,7 +16,7 @@ from conftest import paper_force, paper_parameters
 from fmu_src.model.registry import MODELS
 from identification.measured.signals import Random, Sine, Step, sample_times
 from model_exchange import simulate_model_exchange
-from test_fmu_numerics import simulate_with_fmpy
+from fmu_harness import simulate_with_fmpy
 from test_six_axis_fmu import axis_signals, run_with_fmpy
 
 FMUS = (*MODELS, "six_axis")

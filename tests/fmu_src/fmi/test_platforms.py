@@ -124,10 +124,9 @@ def test_the_aarch64_library_under_qemu_gives_the_x86_64_forces(hosts, tmp_path,
 @needs_qemu
 @pytest.mark.parametrize("version", (2, 3))
 def test_every_model_under_qemu_gives_the_x86_64_forces(hosts, tmp_path, version):
-    from test_coupled_six_axis import six_axis_file
-    from test_derived_models import write_derived_parameter_file
+    from example_parameter_files import derived_parameter_file, six_axis_file
     cases = {model: (model, None) for model in (*MODELS, "six_axis")}
-    cases["derived"] = ("single_bouc_wen+backbone4+limits+maxwell", write_derived_parameter_file(tmp_path))
+    cases["derived"] = ("single_bouc_wen+backbone4+limits+maxwell", derived_parameter_file(tmp_path))
     cases["coupled six axis"] = ("six_axis", six_axis_file(tmp_path, {"translation": "spherical",
                                                                       "rotation": "conical"}))
     results = {}

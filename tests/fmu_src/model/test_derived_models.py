@@ -5,9 +5,7 @@ shift of the base model's input and output; neutral options leave every model bi
 paths (plain Python, numba, C, the tangents, both FMUs) agree on a derived model as on any."""
 from __future__ import annotations
 
-import math
 import shutil
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -19,23 +17,15 @@ from fmu_src.model.parameter_specs import ParameterError
 from fmu_src.model.registry import MODELS, get_model
 from fmu_src.parameter_files import read_parameter_set, save_parameters
 from identification.measured.signals import Random, sample_times
+from example_parameter_files import BACKBONE, LIMITS, defaults
+from example_parameter_files import derived_parameter_file as derived_parameter_file_in
 from python_core import simulate_python_core
 
 T = sample_times(0.3, 1000.0)
 X, V = Random(2.0, 0.3, seed=5).signals(T)
 X = X + 0.01 * np.sin(2 * np.pi * 50 * T)        # a displacement jump at every step, as the FMU may see
 
-LIMITS = dict(limit_gap_pos=1.0, limit_gap_neg=0.5, limit_k_pos=300.0, limit_k_neg=500.0, limit_exponent_pos=2.0,
-              limit_exponent_neg=1.5, limit_c_pos=2.0, limit_c_neg=1.0, limit_depth_pos=0.3, limit_depth_neg=0.2,
-              limit_width=0.05)
 NO_LIMITS = dict(LIMITS, limit_k_pos=0.0, limit_k_neg=0.0, limit_c_pos=0.0, limit_c_neg=0.0)
-BACKBONE = dict(backbone_x1=-3.0, backbone_x2=-1.0, backbone_x3=0.5, backbone_x4=3.0,
-                backbone_F1=-900.0, backbone_F2=-200.0, backbone_F3=50.0, backbone_F4=1200.0)
-
-
-def defaults(name: str) -> dict[str, float]:
-    model = get_model(name)
-    return dict(read_parameter_set(DATA / model.default_file, name).parameters)
 
 
 def test_a_derived_model_is_named_by_its_base_and_options_either_way():
@@ -222,16 +212,9 @@ def test_the_derived_kernels_tangents_are_their_complex_step_derivatives(base):
         assert derivative == pytest.approx(want, rel=1e-9, abs=1e-9 * max(1.0, abs(want)))
 
 
-def write_derived_parameter_file(folder) -> Path:
-    """``folder/params.json``: single_bouc_wen with a backbone, travel limits and a Maxwell element."""
-    params = {name: value for name, value in defaults("single_bouc_wen").items() if name != "k0"}
-    params.update({k: v for k, v in BACKBONE.items()}, **LIMITS, maxwell_k=200.0, maxwell_c=2.0)
-    return save_parameters(Path(folder) / "params.json", params, "single_bouc_wen+backbone4+limits+maxwell")
-
-
 @pytest.fixture(scope="module")
 def derived_parameter_file(tmp_path_factory):
-    return write_derived_parameter_file(tmp_path_factory.mktemp("derived"))
+    return derived_parameter_file_in(tmp_path_factory.mktemp("derived"))
 
 
 @pytest.mark.parametrize("kind", ["pythonfmu", "native2", "native3"])
