@@ -127,7 +127,7 @@ def test_a_groups_state_travels_with_the_native_fmu_state_and_a_mismatch_is_refu
 
 SANITIZED_RUN = r'''
 import sys, zipfile, numpy as np
-sys.path.insert(0, sys.argv[2])
+sys.path[0:0] = sys.argv[2:]     # this test's folder and tests/ (its helpers)
 import test_fmu_directional_derivatives as derivatives
 path = sys.argv[1]
 cs = derivatives.Opened(path, "cs")
@@ -196,7 +196,8 @@ def test_a_sanitizer_build_of_the_coupled_groups_survives_runs_refusals_and_stat
     libasan = subprocess.run(["gcc", "-print-file-name=libasan.so"], capture_output=True, text=True).stdout.strip()
     environment = {"PATH": "/usr/bin:/bin", "LD_PRELOAD": libasan, "PYTHONPATH": str(Path(build_fmu.__file__).parent),
                    "ASAN_OPTIONS": "detect_leaks=0:abort_on_error=0", "UBSAN_OPTIONS": "print_stacktrace=1"}
-    result = subprocess.run([sys.executable, "-c", SANITIZED_RUN, str(sanitized), str(Path(__file__).resolve().parents[2])],
+    result = subprocess.run([sys.executable, "-c", SANITIZED_RUN, str(sanitized),
+                             str(Path(__file__).resolve().parent), str(Path(__file__).resolve().parents[2])],
                             capture_output=True, text=True, timeout=600, env=environment)
     assert result.returncode == 0, result.stderr[-4000:]
     assert "all checks passed" in result.stdout and "runtime error" not in result.stderr
