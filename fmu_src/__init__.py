@@ -14,7 +14,7 @@ the modules of ``models`` by name):
   dependencies, ``native``: the native FMU's generator and its C layer).
 
 Beside them, ``parameter_files``: the JSON and SSV parameter files and ensembles users hand to
-the FMUs.
+the FMUs; ``syntax_trees``: source parsed one thread at a time (every subpackage may import it).
 
 ``__version__`` is the project's version, in one place: pyproject.toml reads it, both command
 line tools print it (``--version``) and every FMU carries it in its modelDescription.

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import ast
 import builtins
+from ..syntax_trees import parse
 
 
 class GenerationError(RuntimeError):
@@ -59,7 +60,7 @@ def _free_names(function: ast.FunctionDef) -> set[str]:
 def unbound_names(source: str) -> list[tuple[str, int, str]]:
     """(function, line, name) of every name a top-level function of ``source`` reads that neither
     it nor the module's top level binds, nor the builtins."""
-    tree = ast.parse(source)
+    tree = parse(source)
     bound = _module_bindings(tree.body)
     if bound is None:
         return []

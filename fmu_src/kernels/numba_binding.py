@@ -56,6 +56,7 @@ from ..model import elements, integration
 from .generated_source import check_bound_names
 from ..model.definition import ModelContractError, check_step_kernels
 from .unrolling import unroll
+from ..syntax_trees import parse
 
 CACHE_ENVIRONMENT = "BUSHING_CACHE_DIR"
 _NUMBA_IMPORT = f"from {__package__}.jit import numba\n\n"
@@ -189,7 +190,7 @@ def kernel_source(module: types.ModuleType, machinery: str | None = None) -> str
     """The source of a kernel module as numba reads it: tuples and sums over a constant range
     written out (``unrolling``), its imports checked and made absolute (:func:`checked_imports`;
     ``machinery``: the compiled machinery's module, or None for the machinery itself)."""
-    tree = unroll(ast.parse(inspect.getsource(module)), module.__dict__, module.__name__)
+    tree = unroll(parse(inspect.getsource(module)), module.__dict__, module.__name__)
     return ast.unparse(checked_imports(tree, module.__name__, machinery, module.__package__))
 
 

@@ -81,6 +81,7 @@ from typing import Callable
 from . import kernel_language
 from .kernel_language import with_bodies
 from .vector_tangents import vectorize
+from ..syntax_trees import parse
 
 SLOPE_CAP = 1e100
 """Largest magnitude of the slope factor a^(b-1) of ``a ** b`` (and of d sqrt) near a = 0 (module docstring)."""
@@ -159,7 +160,7 @@ def zeros(a) -> ast.expr:
 
 
 def _copy(node):
-    return ast.parse(ast.unparse(node), mode="eval").body if isinstance(node, ast.expr) else node
+    return parse(ast.unparse(node), mode="eval").body if isinstance(node, ast.expr) else node
 
 
 

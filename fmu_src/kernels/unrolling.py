@@ -31,6 +31,7 @@ import builtins
 import inspect
 import textwrap
 from typing import Mapping
+from ..syntax_trees import parse
 
 
 class UnrollError(ValueError):
@@ -55,7 +56,7 @@ def kernel_definition(function) -> tuple[ast.FunctionDef, int]:
     UnrollError."""
     line_offset = function.__code__.co_firstlineno - 1
     source = textwrap.dedent(inspect.getsource(function))
-    tree = unroll(ast.parse(source), function.__globals__, f"{function.__module__}.{function.__name__}", line_offset)
+    tree = unroll(parse(source), function.__globals__, f"{function.__module__}.{function.__name__}", line_offset)
     return tree.body[0], line_offset
 
 
@@ -170,4 +171,4 @@ class _FoldInts(ast.NodeTransformer):
 
 
 def _copy(node: ast.AST) -> ast.AST:
-    return ast.parse(ast.unparse(node), mode="eval").body
+    return parse(ast.unparse(node), mode="eval").body

@@ -46,6 +46,7 @@ import copy
 import itertools
 
 from .kernel_language import with_bodies
+from ..syntax_trees import parse
 
 TANGENT_PREFIXES = ("d_", "_td")
 """The names the generated tangents hold their tangents in (``tangents`` reserves them)."""
@@ -276,7 +277,7 @@ def vectorize(source: str, lanes: int) -> str:
     statement it does not recognise."""
     if lanes < 1:
         raise ValueError(f"lanes = {lanes}: give 1 or more")
-    tree = ast.parse(source)
+    tree = parse(source)
     functions = [node for node in tree.body if isinstance(node, ast.FunctionDef)]
     values = {f.name: sum(1 for a in f.args.args if not a.arg.startswith("d_")) for f in functions}
     vectorizer = _Vectorizer(lanes, values)

@@ -17,6 +17,7 @@ import types
 
 from . import elements, integration
 from .definition import BushingModel, ModelContractError
+from ..syntax_trees import parse
 
 KERNELS = ("prepare", "initial_state", "jump", "integrate", "force", "derivatives", "switches")
 """The base's kernels a derived model wraps (``update`` and ``prepare_step`` too, where it has them)."""
@@ -26,7 +27,7 @@ def _reached(base: BushingModel, module: types.ModuleType) -> tuple[list[str], d
     """(the functions of the base's module its kernels reach, in source order; the numeric
     constants they read; the names they import from the machinery or the elements). Raises
     ModelContractError for a global of another kind."""
-    tree = ast.parse(inspect.getsource(module))
+    tree = parse(inspect.getsource(module))
     defined = {node.name: node for node in tree.body if isinstance(node, ast.FunctionDef)}
     roots = [getattr(base, name).__name__ for name in KERNELS]
     roots += [name for name in ("prepare_step",) if name in defined]
@@ -89,7 +90,7 @@ def base_source(base: BushingModel) -> tuple[str, set[str]]:
     shared names they import."""
     module = sys.modules[base.kernel_module]
     functions, constants, shared = _reached(base, module)
-    tree = ast.parse(inspect.getsource(module))
+    tree = parse(inspect.getsource(module))
     renamer = _Rename(set(functions) | set(constants))
     lines = [f"base_{name} = {value!r}" for name, value in sorted(constants.items())]
     for node in tree.body:
