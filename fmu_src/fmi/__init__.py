@@ -10,7 +10,8 @@
 - ``fmu_inputs``: a model and a parameter file read into what the builders take;
 - ``pythonfmu_package``: the pythonfmu FMU (the slave and ``fmu_src`` packed by pythonfmu);
 - ``release``: the release bundle (its README from ``release_readme.txt``);
-- ``native``: the native FMU (``generate``: the C generated from the kernels; ``build``;
+- ``native``: the native FMU (``generate``: the C generated from the kernels; ``messages_header``:
+  the messages' C header; ``build``;
   ``platforms``: its platforms and their toolchains; ``macho``: the universal macOS library;
   ``c/``: the hand-written FMI layer).
 

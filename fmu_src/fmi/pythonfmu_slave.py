@@ -212,7 +212,8 @@ class BushingSlave(Fmi2Slave):
                     a.group = group
         # The compiled step of all axes of a model in one call, where a model has two or more:
         # per model its step, axes and parameter rows (rebuilt on a change). For a single axis the
-        # arrays cost more than the two calls into numba they save (docs/benchmarks.md, "Figures behind the code's constants").
+        # arrays cost more than the two calls into numba they save (docs/benchmarks.md, "Figures
+        # behind the code's constants").
         groups = {}
         for a in self._axes:
             if a.group is None:

@@ -1,7 +1,7 @@
 """The FMUs' runtime policy in words: every message both runtimes log, defined once.
 
 The pythonfmu slave fills a message with :meth:`Message.text`; the native FMU's C calls the macro
-``BW_MESSAGE_<NAME>(inst, field, ...)`` that :func:`c_header` generates from the same template
+``BW_MESSAGE_<NAME>(inst, field, ...)`` that ``native.messages_header`` generates from the same template
 (``bushing_messages.h``, written beside the generated model), its arguments the template's fields
 in the order they first appear. A field is ``{name}`` (text: in C a ``const char *``, a number
 formatted as Python's ``repr`` by ``bw_format_double``), ``{name:d}`` (an ``int``) or
@@ -16,14 +16,12 @@ coupled groups' to ``parameter_files``' checks; they are taken from there, not w
 """
 from __future__ import annotations
 
-import json
 import string
 from dataclasses import dataclass
 
 from ..model.parameter_specs import (CONSTRAINT_BROKEN, CONSTRAINT_DOUBTFUL, NOT_FINITE, OUT_OF_RANGE)
 
-LEVELS = {"error": ("BW_ERROR", "logStatusError"), "warning": ("BW_WARNING", "logStatusWarning"),
-          "refusal": ("BW_DISCARD", "logStatusError")}
+LEVELS = ("error", "warning", "refusal")
 
 _CHECK_UNITS = "check the units of the inputs (the FMU takes metres and m/s)"
 _REFUSED_AT = "doStep at t = {time} s refused: "
@@ -143,29 +141,3 @@ MESSAGES = {
 
 INPUTS = "{displacement} = {x} {x_unit}, {velocity} = {v} {v_unit}"
 """One axis's inputs in a refusal or warning (``inputs``; a group's members joined by ', ')."""
-
-def c_string(text: str) -> str:
-    return json.dumps(text)      # a C string literal for ASCII text (json escapes as C does)
-
-
-def c_header() -> str:
-    """``bushing_messages.h``: each message a macro over ``bw_log`` (``bw_refuse`` for a refusal,
-    which returns ``BW_DISCARD``), the fixed words and the inputs' format as string constants."""
-    lines = ["/* Generated from fmu_src/fmi/runtime_messages.py: the runtime policy's words, defined once. */",
-             "#ifndef BUSHING_MESSAGES_H", "#define BUSHING_MESSAGES_H", ""]
-    for name, text in TEXTS.items():
-        lines.append(f"#define BW_TEXT_{name} {c_string(text)}")
-    inputs, order = Message("error", INPUTS).c_format()
-    lines += ["", f"/* arguments: {', '.join(order)} */", f"#define BW_TEXT_INPUTS {c_string(inputs)}", ""]
-    for name, message in MESSAGES.items():
-        format_, arguments = message.c_format()
-        parameters = ", ".join(("inst",) + message.fields)
-        passed = "".join(f", ({argument})" for argument in arguments)
-        if message.level == "refusal":
-            call = f"bw_refuse(inst, {c_string(format_)}{passed})"
-        else:
-            status, category = LEVELS[message.level]
-            call = f"bw_log(inst, {status}, {c_string(category)}, {c_string(format_)}{passed})"
-        lines.append(f"#define BW_MESSAGE_{name}({parameters}) {call}")
-    lines += ["", "#endif", ""]
-    return "\n".join(lines)

@@ -29,10 +29,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ...model.registry import DEFAULT_MODEL
-from .. import model_description, runtime_messages
+from .. import model_description
 from ..fmu_inputs import check_valid, fmu_axes, groups_of
 from . import macho, platforms as toolchains
 from .generate import model_source
+from .messages_header import c_header
 
 C_LAYER = Path(__file__).resolve().parent / "c"
 INSTANCE = ("log", "parameters", "life_cycle", "variables", "cosimulation", "model_exchange", "derivatives",
@@ -80,7 +81,7 @@ def write_sources(folder: Path, axis_models, identifier: str, fmi_version: int, 
     folder.mkdir(parents=True, exist_ok=True)
     generated = model_source(axis_models, identifier, groups)
     (folder / "bushing_model.c").write_text(generated.source)
-    (folder / "bushing_messages.h").write_text(runtime_messages.c_header())
+    (folder / "bushing_messages.h").write_text(c_header())
     functions = f"fmi{fmi_version}_functions.c"
     for name in (*HAND_WRITTEN, functions):
         shutil.copy2(C_LAYER / name, folder / name)
