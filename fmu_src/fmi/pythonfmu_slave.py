@@ -136,7 +136,6 @@ class _AxisState:
         self.v = 0.0                   # port velocity as set (m/s or rad/s)
         self.constants = None          # model.prepare of the parameters in force
         self.parameters_changed = True
-        self.state = tuple(0.0 for _ in model.states)
         self.state_x = 0.0             # kernel displacement the committed state belongs to
         self.x_now = -self.offset      # the model's displacement: x as last set less the offset, else x_k + v_k*h
         self.last_output = 0.0         # last finite output, port units (N or N.m)
@@ -146,43 +145,68 @@ class _AxisState:
         self.output_warned = False
         self.stale_output_logged = False   # the stale-output error is given once per episode
         self.last_errors = []          # the parameter errors of the last validation
-        self.step_one = None           # the compiled step of this axis's model, if compiled
-        self.params_row = None         # the parameters in force as an array (for step_one)
+        self.params_row = None         # the parameters in force as an array (a compiled step's)
         self.jump_history = 0          # bit i: the step i steps ago started with a jump (JUMP_*;
                                        # for an axis of a compiled batch: the batch's array)
-        self.group = None              # the coupled group it belongs to, if any
+        self.unit = None               # the unit it is stepped in (``_Unit``): itself alone or its group
 
 
 @dataclass(slots=True)
 class _Batch:
-    """The axes of one model stepped in one compiled call (``numba_binding._step_axes``)."""
+    """The single-axis units of one model stepped in one compiled call (``numba_binding._step_axes``)."""
     step: object                  # the compiled step of all the batch's axes
-    axes: list                    # their _AxisState
+    units: list                   # their _Unit
     params: object                # their parameter rows in force (an array), None: rebuilt at the next step
     histories: object             # each axis's jumping-input history (JUMP_*; an int64 array)
     next_histories: object        # the next step's, written by the compiled step (swapped when committed)
 
 
-class _GroupState:
-    """A coupled group of axes (``axes.Coupling``): one model's coupled form
-    (``definition.CoupledKernels``) on the vector of its members' displacements, padded with 0
-    to three components; its state is the group's, each member keeps its ports, parameters, mounting
-    and output. The members' parameters must be equal (checked at every change)."""
+class _AxisKernels:
+    """One axis's model kernels in the shape of a coupled form (``definition.CoupledKernels``):
+    displacements, velocities, jumps and forces as 1-tuples, so that a single axis is stepped as a
+    unit of one."""
 
-    def __init__(self, members, name):
+    def __init__(self, model):
+        self.model = model
+
+    def initial_state(self, constants, x):
+        return self.model.initial_state(constants, x[0])
+
+    def step(self, constants, state, state_x, x, v, h, max_substeps):
+        return self.model.step(constants, state, state_x[0], x[0], v[0], h, max_substeps)
+
+    def jump(self, constants, state, jump):
+        return integration.apply_displacement_jump(self.model, constants, state, jump[0]), integration.OK
+
+    def force(self, constants, state, x, v):
+        return (self.model.force(constants, state, x[0], v[0]),)
+
+
+class _Unit:
+    """The axes stepped as one: a single axis (its model's kernels on 1-vectors, ``_AxisKernels``)
+    or a coupled group (``axes.Coupling``: one model's coupled form, ``definition.CoupledKernels``,
+    on the vector of its members' displacements, padded with 0 to three components). The state is
+    the unit's; each member keeps its ports, parameters, mounting and output. A group's members'
+    parameters must be equal (checked at every change)."""
+
+    def __init__(self, members, kernels, width, state_size, label):
         self.members = members
         self.model = members[0].model
-        self.kernels = self.model.coupled
-        self.label = f"the {name} group ({', '.join(a.axis.name for a in members)}): "
-        self.state = tuple(0.0 for _ in range(self.kernels.size)) if self.kernels else ()
-        self.state_x = (0.0, 0.0, 0.0)    # kernel displacement (a 3-vector) the state belongs to
+        self.kernels = kernels
+        self.width = width                # components of its displacement vector: 1, or 3 for a group
+        self.label = label                # how messages name it ("axis rz: ", "the ... group (...): ")
+        self.state = tuple(0.0 for _ in range(state_size))
+        self.state_x = (0.0,) * width     # kernel displacement vector the state belongs to
         self.constants = None
         self.usable = False
         self.errors = []                  # why its members' parameters cannot make one set, if so
+        self.step_one = None              # a single axis's compiled step (STEP_AXES), if compiled
+        for a in members:
+            a.unit = self
 
     def inputs(self):
-        """The members' model displacements and velocities as 3-vectors [mm or rad, per s]."""
-        x, v = [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]
+        """The members' model displacements and velocities as vectors [mm or rad, per s]."""
+        x, v = [0.0] * self.width, [0.0] * self.width
         for c, a in enumerate(self.members):
             x[c], v[c] = a.x_now, a.v * a.to_kernel
         return tuple(x), tuple(v)
@@ -201,31 +225,32 @@ class BushingSlave(Fmi2Slave):
             raise RuntimeError("the bushing slave runs inside an FMU built by build_fmu.py")
         order_library_exit(self.resources, type(self).__name__)
         self._axes = [_AxisState(axis, model, defaults) for axis, model, defaults in AXES]
-        # coupled groups whose model has a coupled form (Kelvin-Voigt's is its axes as they are)
-        self._groups = []
-        for positions in GROUPS:
-            members = [self._axes[i] for i in positions]
-            if members[0].model.coupled is not None:
-                group = _GroupState(members, axes.group_name(tuple(a.axis.name for a in members)))
-                self._groups.append(group)
-                for a in members:
-                    a.group = group
-        # The compiled step of all axes of a model in one call, where a model has two or more:
-        # per model its step, axes and parameter rows (rebuilt on a change). For a single axis the
-        # arrays cost more than the two calls into numba they save (docs/benchmarks.md, "Figures
-        # behind the code's constants").
-        groups = {}
-        for a in self._axes:
-            if a.group is None:
-                groups.setdefault(a.model.name, []).append(a)
-        self._batches = [_Batch(STEP_AXES[name][0], group, None, np.zeros(len(group), dtype=np.int64),
-                                np.zeros(len(group), dtype=np.int64))
-                         for name, group in groups.items() if name in STEP_AXES and len(group) > 1]
-        for a in self._axes:
-            a.step_one = STEP_AXES[a.model.name][1] if a.model.name in STEP_AXES else None
-        batched = {id(a) for batch in self._batches for a in batch.axes}
-        self._unbatched = [a for a in self._axes if id(a) not in batched and a.group is None]
-        self._single = [a for a in self._axes if a.group is None]
+        # The units stepped: each coupled group whose model has a coupled form (Kelvin-Voigt's is
+        # its axes as they are) and every other axis alone, the single axes first.
+        groups = [[self._axes[i] for i in positions] for positions in GROUPS]
+        groups = [members for members in groups if members[0].model.coupled is not None]
+        grouped = {id(a) for members in groups for a in members}
+        self._units = [_Unit([a], _AxisKernels(a.model), 1, len(a.model.states), a.axis.label)
+                       for a in self._axes if id(a) not in grouped]
+        for unit in self._units:
+            unit.step_one = STEP_AXES[unit.model.name][1] if unit.model.name in STEP_AXES else None
+        for members in groups:
+            name = axes.group_name(tuple(a.axis.name for a in members))
+            self._units.append(_Unit(members, members[0].model.coupled, 3, members[0].model.coupled.size,
+                                     f"the {name} group ({', '.join(a.axis.name for a in members)}): "))
+        # The compiled step of all single axes of a model in one call, where a model has two or
+        # more: per model its step, units and parameter rows (rebuilt on a change). For a single
+        # axis the arrays cost more than the two calls into numba they save (docs/benchmarks.md,
+        # "Figures behind the code's constants").
+        by_model = {}
+        for unit in self._units:
+            if unit.step_one is not None:
+                by_model.setdefault(unit.model.name, []).append(unit)
+        self._batches = [_Batch(STEP_AXES[name][0], units, None, np.zeros(len(units), dtype=np.int64),
+                                np.zeros(len(units), dtype=np.int64))
+                         for name, units in by_model.items() if len(units) > 1]
+        batched = {id(unit) for batch in self._batches for unit in batch.units}
+        self._unbatched = [unit for unit in self._units if id(unit) not in batched]
         self._initial_state_pending = True  # set at exit of initialization, or first valid step
         self._parameters_changed = True     # some axis's parameters were set since the last check
         self._parameters_usable = False
@@ -251,12 +276,9 @@ class BushingSlave(Fmi2Slave):
             getter, setter = partial(getattr, a, "v"), partial(self._set_velocity, a)
         elif kind == "output":
             getter, setter = partial(self._output, a), None
-        elif a.group is not None:   # a state of its coupled group's (its component)
-            scale, group = variable.scale, a.group
-            getter, setter = (lambda: group.state[index] * scale), None
-        else:
-            scale = variable.scale
-            getter, setter = (lambda: a.state[index] * scale), None
+        else:                       # a state of its unit's (a coupled group's: a component of it)
+            scale, unit = variable.scale, a.unit
+            getter, setter = (lambda: unit.state[index] * scale), None
         self.register_variable(Real(name, causality=getattr(Fmi2Causality, variable.causality),
                                     variability=getattr(Fmi2Variability, variable.variability),
                                     description=variable.description, getter=getter, setter=setter))
@@ -266,7 +288,7 @@ class BushingSlave(Fmi2Slave):
     def _outputs_stale(a):
         """An input or parameter of axis ``a`` changed: its output, and every member's of its coupled
         group (the group's force vector turns with each member's displacement), is computed anew."""
-        for member in (a.group.members if a.group is not None else (a,)):
+        for member in a.unit.members:
             member.output_is_current = False
 
     @staticmethod
@@ -307,29 +329,31 @@ class BushingSlave(Fmi2Slave):
             self._say("INPUT_SET_NOT_FINITE", port=a.axis.velocity, value=value, unit=a.axis.velocity_unit)
 
     def _output(self, a):
-        """The axis's output at the current time and displacement. If the displacement was set
-        away from the one of the committed state, it includes the model's instantaneous
-        response to that jump."""
+        """The axis's output at the current time and displacement. If its unit's displacement was
+        set away from the one of the committed state, it includes the model's instantaneous
+        response to that jump (a coupled group's force vector: every member's output at once)."""
         if a.output_is_current:
             return a.last_output
-        if a.group is not None:
-            return self._group_output(a)
-        if self._refresh_parameters(a):
+        unit = a.unit
+        reason = TEXTS["PARAMETERS_INVALID"]
+        if self._refresh_unit(unit):
+            kernels = unit.kernels
+            x, v = unit.inputs()
             try:
-                state = a.state
-                if a.x_now != a.state_x:
-                    state = integration.apply_displacement_jump(a.model, a.constants, state, a.x_now - a.state_x)
-                output = a.model.force(a.constants, state, a.x_now, a.v * a.to_kernel) * a.from_kernel + a.preload_port
+                state, status = unit.state, integration.OK
+                if x != unit.state_x:
+                    state, status = kernels.jump(unit.constants, state, tuple(x[i] - unit.state_x[i]
+                                                                              for i in range(unit.width)))
+                forces = kernels.force(unit.constants, state, x, v)
             except (ArithmeticError, ValueError):
-                output = math.nan
-            if math.isfinite(output):
-                a.last_output = output
-                a.output_is_current = True
-                a.stale_output_logged = False
-                return output
+                status, forces = integration.NOT_FINITE, (math.nan,) * unit.width
+            if status == integration.OK and all(math.isfinite(f) for f in forces):
+                for c, member in enumerate(unit.members):
+                    member.last_output = forces[c] * member.from_kernel + member.preload_port
+                    member.output_is_current = True
+                    member.stale_output_logged = False
+                return a.last_output
             reason = TEXTS["NOT_FINITE_AT_INPUTS"]
-        else:
-            reason = TEXTS["PARAMETERS_INVALID"]
         return self._stale_output(a, reason)
 
     def _stale_output(self, a, reason):
@@ -341,50 +365,25 @@ class BushingSlave(Fmi2Slave):
                       unit=a.axis.output_unit)
         return a.last_output
 
-    def _group_output(self, a):
-        """A coupled group member's output (``_output``): the group's force vector at the members'
-        current inputs, through the displacement jump from the committed state."""
-        group = a.group
-        reason = TEXTS["PARAMETERS_INVALID"]
-        if self._refresh_group(group):
-            kernels = group.kernels
-            x, v = group.inputs()
-            try:
-                state, status = group.state, integration.OK
-                if x != group.state_x:
-                    state, status = kernels.jump(group.constants, state, tuple(x[i] - group.state_x[i]
-                                                                              for i in range(3)))
-                forces = kernels.force(group.constants, state, x, v)
-            except (ArithmeticError, ValueError):
-                status, forces = integration.NOT_FINITE, (math.nan,) * 3
-            if status == integration.OK and all(math.isfinite(f) for f in forces):
-                for c, member in enumerate(group.members):
-                    member.last_output = forces[c] * member.from_kernel + member.preload_port
-                    member.output_is_current = True
-                    member.stale_output_logged = False
-                return a.last_output
-            reason = TEXTS["NOT_FINITE_AT_INPUTS"]
-        return self._stale_output(a, reason)
-
-    def _refresh_group(self, group) -> bool:
+    def _refresh_unit(self, unit) -> bool:
         """Its members' parameters refreshed (``_refresh_parameters``) and equal: a group carries one
         parameter set (its members' offset and preload may differ); True if usable, else the
         difference is logged."""
-        changed = any(a.parameters_changed for a in group.members)
-        usable = all([self._refresh_parameters(a) for a in group.members])
-        if changed or group.constants is None:
-            first = group.members[0]
-            differing = [name for name in group.model.parameter_names
-                         if any(a.values[name] != first.values[name] for a in group.members[1:])]
-            group.errors = []
+        changed = any(a.parameters_changed for a in unit.members)
+        usable = all([self._refresh_parameters(a) for a in unit.members])
+        if changed or unit.constants is None:
+            first = unit.members[0]
+            differing = [name for name in unit.model.parameter_names
+                         if any(a.values[name] != first.values[name] for a in unit.members[1:])]
+            unit.errors = []
             if usable and differing:
-                values = "; ".join(", ".join(f"{a.axis.name}.{name} = {a.values[name]}" for a in group.members)
+                values = "; ".join(", ".join(f"{a.axis.name}.{name} = {a.values[name]}" for a in unit.members)
                                    + f" [{first.units[name]}]" for name in differing)
-                group.errors = [MESSAGES["GROUP_PARAMETERS_DIFFER"].text(label=group.label, values=values)]
-                self._error(group.errors[0])
-            group.usable = usable and not differing
-            group.constants = first.constants if group.usable else None
-        return group.usable
+                unit.errors = [MESSAGES["GROUP_PARAMETERS_DIFFER"].text(label=unit.label, values=values)]
+                self._error(unit.errors[0])
+            unit.usable = usable and not differing
+            unit.constants = first.constants if unit.usable else None
+        return unit.usable
 
     # ---------------------------------------------------------------- FMI life cycle
     def exit_initialization_mode(self):
@@ -393,7 +392,7 @@ class BushingSlave(Fmi2Slave):
         if not self._step_logged:
             self.log(STEP, Fmi2Status.ok, "logAll")
             self._step_logged = True
-        usable = [self._refresh_parameters(a) for a in self._single] + [self._refresh_group(g) for g in self._groups]
+        usable = [self._refresh_unit(unit) for unit in self._units]
         if all(usable) and all(math.isfinite(a.x_now) for a in self._axes):
             self._set_initial_state()
 
@@ -404,7 +403,7 @@ class BushingSlave(Fmi2Slave):
         step). fmi2Discard would not do: fmpy ends the run silently on it. pythonfmu passes log
         messages to the host only with debug logging on, so the reasons also go to stderr."""
         reasons = [a.axis.label + error for a in self._axes for error in a.last_errors] \
-            + [error for group in self._groups for error in group.errors] or [TEXTS["PARAMETERS_INVALID"]]
+            + [error for unit in self._units for error in unit.errors] or [TEXTS["PARAMETERS_INVALID"]]
         for message in reasons:
             print(f"{self.instance_name}: {message}", file=sys.stderr)
         self._say("CANNOT_START", reasons="; ".join(reasons))
@@ -418,16 +417,12 @@ class BushingSlave(Fmi2Slave):
         raise InitializationError("; ".join(reasons))
 
     def _set_initial_state(self):
-        """Each axis at relaxed equilibrium at its current displacement (its model's initial_state),
-        each coupled group at its members' displacement vector."""
-        for a in self._single:
-            a.state = a.model.initial_state(a.constants, a.x_now)
-            a.state_x = a.x_now
-            a.output_is_current = False
-        for group in self._groups:
-            x, _ = group.inputs()
-            group.state, group.state_x = group.kernels.initial_state(group.constants, x), x
-            for a in group.members:
+        """Each unit at relaxed equilibrium at its current displacement (its model's initial_state;
+        a coupled group's at its members' displacement vector)."""
+        for unit in self._units:
+            x, _ = unit.inputs()
+            unit.state, unit.state_x = unit.kernels.initial_state(unit.constants, x), x
+            for a in unit.members:
                 a.state_x = a.x_now
                 a.output_is_current = False
         self._initial_state_pending = False
@@ -437,8 +432,7 @@ class BushingSlave(Fmi2Slave):
             return self._say("STEP_SIZE_INVALID", value=step_size)
         if self._parameters_changed or not self._parameters_usable:
             self._parameters_changed = False
-            self._parameters_usable = all([self._refresh_parameters(a) for a in self._single]
-                                          + [self._refresh_group(group) for group in self._groups])
+            self._parameters_usable = all([self._refresh_unit(unit) for unit in self._units])
         if not self._parameters_usable:
             if self._initial_state_pending:   # never started: nothing a master can do in the run
                 self._fail_to_start()
@@ -453,87 +447,63 @@ class BushingSlave(Fmi2Slave):
                     return self._say("STEP_INPUT_NOT_FINITE", port=name, value=value, unit=unit)
         if self._initial_state_pending:  # the values at initialization could not be used
             self._set_initial_state()
-        # every axis first, then commit all: a refusal leaves every axis as it was
+        # every unit first, then commit all: a refusal leaves every axis as it was
         compiled = self._step_compiled(step_size) if self._batches else None
-        # None: no compiled call, or an axis failed in it: every axis one by one (for the message)
+        # None: no compiled call, or an axis failed in it: every unit one by one (for the message)
         steps, crossings = compiled if compiled is not None else ([], ())
-        for a in (self._unbatched if compiled is not None else self._single):
-            step = self._step_axis(a, current_time, step_size)
+        for unit in (self._unbatched if compiled is not None else self._units):
+            step = self._step_unit(unit, current_time, step_size)
             if step is None:
                 return False
             steps.append(step)
-        group_states = []
-        for group in self._groups:
-            step = self._step_group(group, current_time, step_size)
-            if step is None:
-                return False
-            group_states.append(step[0])
-            steps += step[1]
         for batch, crossed in crossings:   # the compiled step counted its axes' jumps: keep them
             batch.histories, batch.next_histories = batch.next_histories, batch.histories
             if crossed >= 0 and not self._jump_warned:
-                self._warn_jumping(batch.axes[crossed], current_time, step_size, int(batch.histories[crossed]))
-        for a, state, x_end, output, jumps_counted in steps:
-            if abs(output) > a.output_bound and not a.output_warned:
-                self._warn_implausible(a, output, current_time + step_size)
-            if not (jumps_counted or self._jump_warned):
-                jumped = integration.displacement_jumped(a.x_now, a.state_x, a.v * a.to_kernel, step_size)
-                a.jump_history = ((a.jump_history << 1) | jumped) & _JUMP_MASK
-                if jumped and a.jump_history.bit_count() > JUMP_COUNT:
-                    self._warn_jumping(a, current_time, step_size, a.jump_history)
-            if state is not None:     # a coupled group's member: the group's state is committed below
-                a.state = state
-            a.state_x = a.x_now = x_end
-            a.last_output = output
-            a.output_is_current = True
-        for group, (state, x_end) in zip(self._groups, group_states):
-            group.state, group.state_x = state, x_end
+                self._warn_jumping(batch.units[crossed].members[0], current_time, step_size,
+                                   int(batch.histories[crossed]))
+        for unit, state, x_end, outputs, jumps_counted in steps:
+            for a, x_a, output in zip(unit.members, x_end, outputs):
+                if abs(output) > a.output_bound and not a.output_warned:
+                    self._warn_implausible(a, output, current_time + step_size)
+                if not (jumps_counted or self._jump_warned):
+                    jumped = integration.displacement_jumped(a.x_now, a.state_x, a.v * a.to_kernel, step_size)
+                    a.jump_history = ((a.jump_history << 1) | jumped) & _JUMP_MASK
+                    if jumped and a.jump_history.bit_count() > JUMP_COUNT:
+                        self._warn_jumping(a, current_time, step_size, a.jump_history)
+                a.state_x = a.x_now = x_a
+                a.last_output = output
+                a.output_is_current = True
+            unit.state, unit.state_x = state, x_end
         return True
 
-    def _step_group(self, group, current_time, step_size):
-        """((the group's new state, its displacement vector at the end), [each member's entry as
-        ``_step_axis`` gives it, its state None]) of one coupled group's step, or None after logging
-        why it cannot be taken."""
-        x, v = group.inputs()
-        label, outputs = group.label, ()
-        try:
-            state, _, status = group.kernels.step(group.constants, group.state, group.state_x, x, v, step_size,
-                                                  integration.DEFAULT_MAX_SUBSTEPS)
-            x_end = tuple(x[i] + v[i] * step_size for i in range(3))
-            if status == integration.OK:
-                forces = group.kernels.force(group.constants, state, x_end, v)
-                outputs = [forces[c] * a.from_kernel + a.preload_port for c, a in enumerate(group.members)]
-        except (ArithmeticError, ValueError) as exc:
-            status, label = integration.NOT_FINITE, label + f"the step overflowed ({exc}); "
-        if self._step_refused(status, outputs, label, group.members, current_time, step_size):
-            return None
-        members = [(a, None, x_end[c], outputs[c], False) for c, a in enumerate(group.members)]
-        return (state, x_end), members
-
-    def _step_axis(self, a, current_time, step_size):
-        """(axis, new state, displacement at the end, output, False: its jumps not yet counted) of
-        one axis's step, or None after logging why it cannot be taken."""
-        x, v = a.x_now, a.v * a.to_kernel
-        if a.step_one is not None:   # compiled: one call (the same kernels as model.step and force)
-            state, output, x_end, status = a.step_one(a.params_row, a.state, a.state_x, x, v, step_size,
-                                                      integration.DEFAULT_MAX_SUBSTEPS)
+    def _step_unit(self, unit, current_time, step_size):
+        """(the unit, its new state, its displacement vector at the end, its members' outputs,
+        False: their jumps not yet counted) of one unit's step, or None after logging why it
+        cannot be taken."""
+        x, v = unit.inputs()
+        if unit.step_one is not None:   # a single axis compiled: one call (the same kernels as below)
+            a = unit.members[0]
+            state, output, x_end, status = unit.step_one(a.params_row, unit.state, a.state_x, x[0], v[0], step_size,
+                                                         integration.DEFAULT_MAX_SUBSTEPS)
             output = output * a.from_kernel + a.preload_port
             if status == integration.OK and math.isfinite(output):
-                return a, state, x_end, output, False
-        label, output, x_end = a.axis.label, math.nan, x + v * step_size
+                return unit, state, (x_end,), (output,), False
+        label, outputs = unit.label, ()
+        x_end = tuple(x[i] + v[i] * step_size for i in range(unit.width))
         try:
-            state, _, status = a.model.step(a.constants, a.state, a.state_x, x, v, step_size,
-                                            integration.DEFAULT_MAX_SUBSTEPS)
+            state, _, status = unit.kernels.step(unit.constants, unit.state, unit.state_x, x, v, step_size,
+                                                 integration.DEFAULT_MAX_SUBSTEPS)
             if status == integration.OK:
-                output = a.model.force(a.constants, state, x_end, v) * a.from_kernel + a.preload_port
+                forces = unit.kernels.force(unit.constants, state, x_end, v)
+                outputs = tuple(forces[c] * a.from_kernel + a.preload_port for c, a in enumerate(unit.members))
         except (ArithmeticError, ValueError) as exc:
             status, label = integration.NOT_FINITE, label + f"the step overflowed ({exc}); "
-        if self._step_refused(status, (output,), label, (a,), current_time, step_size):
+        if self._step_refused(status, outputs, label, unit.members, current_time, step_size):
             return None
-        return a, state, x_end, output, False
+        return unit, state, x_end, outputs, False
 
     def _step_refused(self, status, outputs, label, members, current_time, step_size) -> bool:
-        """Whether the step of ``members`` (one axis, or a coupled group's) failed (``status``, a
+        """Whether the step of a unit's ``members`` (one axis, or a coupled group's) failed (``status``, a
         kernel's, or an output not finite); if so, why is logged, naming the inputs."""
         if status == integration.OK and all(math.isfinite(output) for output in outputs):
             return False
@@ -550,23 +520,23 @@ class BushingSlave(Fmi2Slave):
         return True
 
     def _step_compiled(self, step_size):
-        """(steps, [(batch, the first axis whose jumps crossed JUMP_COUNT or -1)]): every axis's
-        step in one compiled call per model (``numba_binding._step_axes``, the same kernels and
-        arithmetic as :meth:`_step_axis`, and the same jump count as :meth:`do_step`'s); None if
-        any axis's step fails, so that the axis-by-axis step redoes it and words the refusal."""
+        """(steps, [(batch, the first axis whose jumps crossed JUMP_COUNT or -1)]): every batched
+        unit's step in one compiled call per model (``numba_binding._step_axes``, the same kernels
+        and arithmetic as :meth:`_step_unit`, and the same jump count as :meth:`do_step`'s); None
+        if any axis's step fails, so that the unit-by-unit step redoes it and words the refusal."""
         steps, crossings = [], []
         for batch in self._batches:
-            group = batch.axes
+            members = [unit.members[0] for unit in batch.units]
             if batch.params is None:
-                batch.params = np.array([a.model.values(a.values) for a in group])
-            rows = np.array([(a.x_now, a.v * a.to_kernel, a.state_x, *a.state) for a in group])
+                batch.params = np.array([a.model.values(a.values) for a in members])
+            rows = np.array([(a.x_now, a.v * a.to_kernel, a.state_x, *a.unit.state) for a in members])
             out, failures, crossed = batch.step(batch.params, rows, step_size, integration.DEFAULT_MAX_SUBSTEPS,
                                                 batch.histories, batch.next_histories)
             if failures:
                 return None
             crossings.append((batch, crossed))
-            for a, row in zip(group, out.tolist()):   # (*state, force, x + v*h)
-                steps.append((a, tuple(row[:-2]), row[-1], row[-2] * a.from_kernel + a.preload_port, True))
+            for unit, a, row in zip(batch.units, members, out.tolist()):   # (*state, force, x + v*h)
+                steps.append((unit, tuple(row[:-2]), (row[-1],), (row[-2] * a.from_kernel + a.preload_port,), True))
         return steps, crossings
 
     def _warn_jumping(self, a, current_time, step_size, history):
@@ -636,10 +606,9 @@ class BushingSlave(Fmi2Slave):
     # state, its reported displacement and its last output must travel with it too.
     def _get_fmu_state(self):
         return {
-            "axes": [{"parameters": dict(a.values), "x": a.x, "v": a.v, "state": list(a.state),
-                      "state_x": a.state_x, "x_now": a.x_now, "last_output": a.last_output}
-                     for a in self._axes],
-            "groups": [{"state": list(group.state), "state_x": list(group.state_x)} for group in self._groups],
+            "axes": [{"parameters": dict(a.values), "x": a.x, "v": a.v, "state_x": a.state_x, "x_now": a.x_now,
+                      "last_output": a.last_output} for a in self._axes],
+            "units": [{"state": list(unit.state), "state_x": list(unit.state_x)} for unit in self._units],
             "initial_state_pending": self._initial_state_pending,
         }
 
@@ -648,16 +617,14 @@ class BushingSlave(Fmi2Slave):
             a.values.update(saved["parameters"])
             a.offset = a.model.mounting(a.values)[0]
             a.x, a.v = saved["x"], saved["v"]
-            a.state = tuple(saved["state"])
             a.state_x, a.x_now = saved["state_x"], saved["x_now"]
             a.last_output = saved["last_output"]
             a.output_is_current = False
             a.parameters_changed = True
-            self._refresh_parameters(a)
-        for group, saved in zip(self._groups, state.get("groups", [])):
-            group.state, group.state_x = tuple(saved["state"]), tuple(saved["state_x"])
-            group.constants = None     # refreshed with its members' restored parameters
-            self._refresh_group(group)
+        for unit, saved in zip(self._units, state["units"]):
+            unit.state, unit.state_x = tuple(saved["state"]), tuple(saved["state_x"])
+            unit.constants = None     # refreshed with its members' restored parameters
+            self._refresh_unit(unit)
         self._parameters_changed = True
         self._initial_state_pending = state["initial_state_pending"]
 
