@@ -152,7 +152,8 @@ def checked_imports(tree: ast.Module, module: str, machinery: str | None, packag
     """``tree``, the source of the kernel module ``module`` of the package ``package``, with its
     relative imports made absolute: ``from ..model.integration import`` from ``machinery`` (the
     compiled machinery's module; None: the package's own), ``from ..model.<module> import`` from the
-    parent package's ``model``, ``from .<sibling> import`` from ``package``. Raises
+    parent package's ``model``, ``from .<sibling> import`` from ``package`` (the shared elements'
+    ``from .integration import`` from the compiled machinery). Raises
     ModelContractError for an import of any other form (:data:`ALLOWED_IMPORTS`) or anywhere but
     at the module's top. Changes ``tree`` in place."""
     def refuse(node, why: str):
@@ -177,6 +178,8 @@ def checked_imports(tree: ast.Module, module: str, machinery: str | None, packag
                                "model contract, and its names)")
         elif node.level == 2 and node.module == MACHINERY and machinery is not None:
             node.module, node.level = machinery, 0
+        elif node.level == 1 and f"model.{node.module}" == MACHINERY and module == elements.__name__:
+            node.module, node.level = integration_module(), 0    # the shared elements' own machinery
         elif node.level == 2 and node.module == ELEMENTS and machinery is not None:
             node.module, node.level = elements_module(), 0
         elif node.level == 2:

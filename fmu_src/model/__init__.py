@@ -6,10 +6,11 @@
   validation;
 - ``units``: a unit's SI form and its form on a rotational axis, read from its name;
 - ``search_coordinates``: the fit's coordinate kinds (map, inverse, bounds);
-- ``integration``: the shared integration machinery (the Bouc-Wen block, friction, Maxwell
-  elements, vector algebra) and the step protocol, written in the kernel language;
-- ``elements``: the elements the models share (free play, the softplus corner), in the kernel
-  language, compiled and translated as ``integration`` is;
+- ``integration``: the shared integration machinery (the Bouc-Wen block and its walk, vector
+  algebra) and the step protocol, written in the kernel language;
+- ``elements``: the elements the models share (free play, the softplus corner, travel limits, the
+  monotone cubic, the fluid column's substeps, Berg's friction, the Maxwell element), in the
+  kernel language, compiled and translated as ``integration`` is;
 - ``derived``: a model with options any model takes (a measured backbone, travel limits, a
   Maxwell element, the rig's offsets): their parameters, names, search box, the model;
 - ``derived_source``: that model's kernel module, written as source (the base's kernels renamed,

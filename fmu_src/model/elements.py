@@ -8,14 +8,24 @@
   curve's knots (scipy's PchipInterpolator), for a backbone;
 - ``track_substeps``: the substeps of a hydraulic mount's fluid column (its inertia track) over a
   step, which both hydraulic models take;
+- the rate-independent and viscoelastic elements of the filled-rubber models (``berg_model``,
+  ``fractional_model``) and the hydraulic mounts: Berg's friction (``friction_force``,
+  ``friction_turn``; ``vector_friction_*`` on a displacement vector), an algebraic law of the
+  travel since the last reversal, so exact whatever the step; and the Maxwell element (a spring
+  and a dashpot in series, ``maxwell_step``), linear and propagated exactly over a step with
+  constant velocity.
 
 Like ``integration``, this module is compiled by numba once for every model that imports it
 (``fmu_src/kernels/numba_binding.py``), translated into C with the kernels that call it, and
-differentiated with them (``fmu_src/kernels/tangents.py``). Units are the caller's (mm, N).
+differentiated with them (``fmu_src/kernels/tangents.py``); it takes the machinery's vector
+algebra and decay factors from ``integration`` (its compiled copy where compiled). Units are the
+caller's (mm, N).
 """
 from __future__ import annotations
 
 import math
+
+from .integration import decay_factors, vector_axpy, vector_dot, vector_norm, vector_scale
 
 SOFTPLUS_FLOOR = -37.0
 """Below it log(1 + exp(z)) < 8.6e-17, under half a unit of the last place of 1: :func:`softplus`
@@ -124,3 +134,112 @@ def track_substeps(kb, kc, mf, cf, ct, w, h):
     if not count < 1e9:         # inf or NaN (w not finite, mf vanishing): more than any budget
         return 1_000_000_000
     return max(1, int(math.ceil(count)))
+
+
+def friction_force(limit, half_travel, travel, reversal_force, direction):
+    """Berg's smooth rate-independent friction force [N] (Berg, Vehicle System Dynamics 30, 1998).
+
+    ``limit`` F_max [N] is the force it tends to far from a reversal, ``half_travel`` x2 [mm] the
+    travel from rest at which it reaches F_max/2; the state is the ``travel`` x - x_s [mm] since
+    the last reversal, the force F_s [N] there (``reversal_force``) and the ``direction`` of the
+    motion since (+1 up, -1 down, 0 not yet moved). With beta = F_s/F_max, moving up
+
+        F = F_s + (x - x_s)*(F_max - F_s)/(x2*(1 - beta) + (x - x_s)),
+
+    moving down F = F_s + (x - x_s)*(F_max + F_s)/(x2*(1 + beta) - (x - x_s)); from rest (F_s = 0)
+    both are F_max*x/(x2 + |x|). Every branch leaves its reversal with the slope F_max/x2 and tends
+    to +-F_max. Written times F_max in numerator and denominator, so F_max = 0 gives 0."""
+    if direction > 0.0 or (direction == 0.0 and travel >= 0.0):
+        room = limit - reversal_force
+        denominator = half_travel * room + travel * limit
+    else:
+        room = limit + reversal_force
+        denominator = half_travel * room - travel * limit
+    if denominator > 0.0:
+        return reversal_force + travel * room * limit / denominator
+    return reversal_force
+
+
+ROUNDING_JUMP_MM = 1e-12
+"""A displacement jump smaller than this [mm, or rad] is rounding, not motion, for the friction: a
+master that passes v = (x_k+1 - x_k)/h gives x_k + v*h = x_k+1 only to rounding (1e-16 of x), and
+a reversal there would restart the friction's branch at every step."""
+
+
+def friction_jump_turn(limit, half_travel, travel, reversal_force, direction, jump_mm):
+    """:func:`friction_turn` for a displacement jump: one of rounding size (ROUNDING_JUMP_MM) never
+    reverses the friction (the travel still takes it)."""
+    motion = jump_mm if abs(jump_mm) > ROUNDING_JUMP_MM else 0.0
+    return friction_turn(limit, half_travel, travel, reversal_force, direction, motion)
+
+
+def friction_turn(limit, half_travel, travel, reversal_force, direction, motion):
+    """The friction state (travel, reversal force, direction) once the displacement moves the way
+    of ``motion``'s sign (a velocity or a jump): where that is against ``direction``, a reversal
+    here (travel 0, the reversal force the force here); the first motion from rest only sets the
+    direction (the curve from rest is both branches at once); no motion changes nothing."""
+    if motion > 0.0:
+        heading = 1.0
+    elif motion < 0.0:
+        heading = -1.0
+    else:
+        return travel, reversal_force, direction
+    if heading == direction:
+        return travel, reversal_force, direction
+    if direction == 0.0 and travel * heading >= 0.0:
+        return travel, reversal_force, heading
+    return 0.0, friction_force(limit, half_travel, travel, reversal_force, direction), heading
+
+
+def vector_friction_force(limit, half_travel, travel, reversal_force):
+    """Berg's friction on a displacement vector [N, a 3-vector]: from the last reversal, with the
+    travel d = x - x_s (a 3-vector) and the force F_s there,
+
+        F = F_s + R*|d|*F_max/(x2*|R| + |d|*F_max),   R = F_max*d/|d| - F_s,
+
+    the force heads from F_s towards F_max in the direction of the travel, with Berg's law in the
+    travel's length. Along a line it is Berg's law (R = +-F_max - F_s, |R| = F_max -+ F_s: the
+    denominator x2*F_max*(1 -+ beta) + |d|*F_max of :func:`friction_force`); it depends on
+    positions only (rate-independent) and turns with them (rotation invariant); F = F_s at d = 0,
+    and F_max*x/(x2 + |x|) from rest (F_s = 0). Derivation: docs/models.md."""
+    r = vector_norm(travel)
+    if r == 0.0:
+        return reversal_force
+    room = vector_axpy(limit / r, travel, vector_scale(-1.0, reversal_force))
+    denominator = half_travel * vector_norm(room) + r * limit
+    if denominator > 0.0:
+        return vector_axpy(r * limit / denominator, room, reversal_force)
+    return reversal_force
+
+
+def vector_friction_turn(limit, half_travel, travel, reversal_force, motion):
+    """(travel, reversal force) once the displacement moves along ``motion`` (a velocity or a jump,
+    3-vectors): a reversal (travel 0, the reversal force the force here) where the motion shortens
+    the travel (d.motion < 0: the displacement turns back towards the last reversal), which along a
+    line is a motion against the direction (:func:`friction_turn`); else as they are."""
+    if vector_dot(travel, motion) < 0.0:
+        return (0.0, 0.0, 0.0), vector_friction_force(limit, half_travel, travel, reversal_force)
+    return travel, reversal_force
+
+
+def vector_friction_jump_turn(limit, half_travel, travel, reversal_force, jump):
+    """:func:`vector_friction_turn` for a displacement jump: one of rounding size
+    (ROUNDING_JUMP_MM) never reverses the friction."""
+    if vector_norm(jump) > ROUNDING_JUMP_MM:
+        return vector_friction_turn(limit, half_travel, travel, reversal_force, jump)
+    return travel, reversal_force
+
+
+def maxwell_decay(rate, h):
+    """(E, phi1) of a Maxwell element of ``rate`` = stiffness/damping [1/s] over h [s]:
+    exp(-rate*h) and (1 - E)/(rate*h) (``decay_factors``), what :func:`maxwell_step` takes; a
+    model may compute them once per step size (``prepare_step``)."""
+    E, phi1, _ = decay_factors(rate * h)
+    return E, phi1
+
+
+def maxwell_step(force, stiffness, decay, v, h):
+    """The force [N] of a Maxwell element (spring ``stiffness`` [N/mm] in series with a dashpot)
+    after h [s] at velocity v [mm/s]: df/dt = k*v - rate*f, solved exactly,
+    f(h) = f*E + k*v*h*phi1 with ``decay`` = (E, phi1) = :func:`maxwell_decay` (rate, h)."""
+    return force * decay[0] + stiffness * v * h * decay[1]

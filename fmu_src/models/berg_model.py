@@ -2,7 +2,7 @@
 spring, a smooth rate-independent friction and two Maxwell elements in parallel.
 
     F = k0*x + k3*x^3 + F_f + f1 + f2
-    F_f: Berg's friction (integration.friction_force), from the last reversal (x_s, F_s):
+    F_f: Berg's friction (elements.friction_force), from the last reversal (x_s, F_s):
          moving up   F_f = F_s + (x - x_s)*(Ff_max - F_s)/(x2*(1 - beta) + (x - x_s)),
          moving down F_f = F_s + (x - x_s)*(Ff_max + F_s)/(x2*(1 + beta) - (x - x_s)),
          beta = F_s/Ff_max; from rest F_f = Ff_max*x/(x2 + |x|)
@@ -28,9 +28,9 @@ from __future__ import annotations
 import math
 
 from ..model.parameter_specs import SPRING, ParameterSpec
-from ..model.integration import (NOT_FINITE, OK, friction_force, friction_jump_turn, friction_turn, maxwell_decay,
-                                 maxwell_step, vector_dot, vector_friction_force, vector_friction_jump_turn,
-                                 vector_friction_turn)
+from ..model.elements import (friction_force, friction_jump_turn, friction_turn, maxwell_decay, maxwell_step,
+                              vector_friction_force, vector_friction_jump_turn, vector_friction_turn)
+from ..model.integration import NOT_FINITE, OK, vector_dot
 from ..model.definition import BushingModel, CoupledKernels, SearchBox, SearchCoordinate, SlowLoop, StateSpec
 from ..model.search_coordinates import KIND
 
@@ -84,7 +84,7 @@ def update(m, state, x, v):
 
 def jump(m, state, jump_mm):
     """An instantaneous displacement jump: a reversal first if it runs against the motion (and is
-    more than rounding, ``integration.ROUNDING_JUMP_MM``), then
+    more than rounding, ``elements.ROUNDING_JUMP_MM``), then
     the friction travels it and the Maxwell springs take it (their dashpots cannot move in no time)."""
     k0, k3, limit, half_travel, k1, rate1, k2, rate2 = m
     travel, reversal, direction, f1, f2 = state
@@ -119,7 +119,7 @@ def switches(m, state, x, v):
 
 # ---------------------------------------------------------------------------- coupled kernels
 # On a displacement vector (3-vectors): the progressive spring is radial, (k0 + k3*|x|^2)*x; the
-# friction is integration.vector_friction_force, Berg's law along a line; the Maxwell elements act
+# friction is elements.vector_friction_force, Berg's law along a line; the Maxwell elements act
 # on each component. The state is (travel d, F_s, f1, f2), 3-vectors: a reversal needs no direction
 # of its own (where d = 0 the force is F_s whichever way the motion goes).
 def initial_state_coupled(m, x0):

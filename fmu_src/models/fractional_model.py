@@ -35,9 +35,9 @@ import math
 
 from .berg_model import COUPLED_STATES, CUBIC, FRICTION_LIMIT, HALF_TRAVEL
 from ..model.parameter_specs import SPRING, ParameterSpec
-from ..model.integration import (NOT_FINITE, OK, friction_force, friction_jump_turn, friction_turn, maxwell_decay,
-                                 maxwell_step, vector_dot, vector_friction_force, vector_friction_jump_turn,
-                                 vector_friction_turn)
+from ..model.elements import (friction_force, friction_jump_turn, friction_turn, maxwell_decay, maxwell_step,
+                              vector_friction_force, vector_friction_jump_turn, vector_friction_turn)
+from ..model.integration import NOT_FINITE, OK, vector_dot
 from ..model.definition import BushingModel, CoupledKernels, SearchBox, SearchCoordinate, SlowLoop, StateSpec
 from ..model.search_coordinates import KIND
 
@@ -104,7 +104,7 @@ def update(m, state, x, v):
 
 def jump(m, state, jump_mm):
     """An instantaneous displacement jump: a reversal first if it runs against the motion (and is
-    more than rounding, ``integration.ROUNDING_JUMP_MM``), then
+    more than rounding, ``elements.ROUNDING_JUMP_MM``), then
     the friction travels it and the Maxwell springs take it."""
     k0, k3, limit, half_travel, stiffness, rates, dashpot = m
     travel, reversal, direction = friction_jump_turn(limit, half_travel, state[0], state[1], state[2], jump_mm)
@@ -114,7 +114,7 @@ def jump(m, state, jump_mm):
 
 def prepare_step(m, h):
     """The step's constants: the model's constants and every Maxwell element's decay over h
-    (``integration.maxwell_decay``), which depend on h alone: a caller that steps many times with
+    (``elements.maxwell_decay``), which depend on h alone: a caller that steps many times with
     the same h computes them once (the fit's population loop), instead of ELEMENTS exponentials
     a step."""
     rates = m[5]

@@ -44,8 +44,8 @@ from __future__ import annotations
 import math
 
 from ..model.parameter_specs import SPRING, ParameterSpec
-from ..model.elements import dead_zone, track_substeps
-from ..model.integration import NOT_FINITE, OK, TOO_MANY_SUBSTEPS, maxwell_decay, maxwell_step
+from ..model.elements import dead_zone, maxwell_decay, maxwell_step, track_substeps
+from ..model.integration import NOT_FINITE, OK, TOO_MANY_SUBSTEPS
 from ..model.definition import BushingModel, SearchBox, SearchCoordinate, StateSpec, TrackStart
 from ..model.search_coordinates import KIND
 from .berg_model import CUBIC

@@ -34,7 +34,7 @@ complex stiffness
 
 Units N-mm-s; the state is ``(y, w, f1)``: the fluid column's displacement [mm] and velocity
 [mm/s] and the Maxwell force [N]. How it is stepped: the Maxwell element exactly
-(``integration.maxwell_step``); the fluid column by the classical Runge-Kutta method on
+(``elements.maxwell_step``); the fluid column by the classical Runge-Kutta method on
 substeps of at most ``elements.THETA_TRACK`` over its fastest rate (its natural frequency plus its damping
 rate), with x + v*t exact within each: the column's equations are not stiff (the decoupler is
 algebraic), so a 1 ms step at a 10 Hz track takes one substep.
@@ -48,8 +48,8 @@ from __future__ import annotations
 import math
 
 from ..model.parameter_specs import DAMPING, SPRING, ParameterSpec
-from ..model.elements import track_substeps
-from ..model.integration import NOT_FINITE, OK, TOO_MANY_SUBSTEPS, maxwell_decay, maxwell_step
+from ..model.elements import maxwell_decay, maxwell_step, track_substeps
+from ..model.integration import NOT_FINITE, OK, TOO_MANY_SUBSTEPS
 from ..model.definition import BushingModel, SearchBox, SearchCoordinate, StateSpec, TrackStart
 from ..model.search_coordinates import KIND
 

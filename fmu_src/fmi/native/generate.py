@@ -24,7 +24,7 @@ import json
 import uuid
 from dataclasses import dataclass
 
-from ...model import integration
+from ...model import elements, integration
 from ..axes import group_name as axis_group_name
 from ...kernels.tangents import tangent
 from ...model.definition import BushingModel
@@ -440,4 +440,4 @@ def _defines(identifier: str, token: str, axis_models, groups, models, variables
         f"#define BW_DISPLACEMENT_JUMPED {jump_test.name}\n"
         f"#define BW_JUMP_WINDOW {integration.JUMP_WINDOW}\n"
         f"#define BW_JUMP_COUNT {integration.JUMP_COUNT}\n"
-        f"#define BW_ROUNDING_JUMP {integration.ROUNDING_JUMP_MM!r}\n\n")
+        f"#define BW_ROUNDING_JUMP {elements.ROUNDING_JUMP_MM!r}\n\n")

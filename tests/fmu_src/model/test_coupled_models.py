@@ -14,7 +14,8 @@ import numpy as np
 import pytest
 
 from fmu_src.model.registry import MODELS, get_model
-from fmu_src.model.integration import DEFAULT_MAX_SUBSTEPS, OK, vector_friction_force, vector_gain
+from fmu_src.model.elements import vector_friction_force
+from fmu_src.model.integration import DEFAULT_MAX_SUBSTEPS, OK, vector_gain
 from fmu_src.parameter_files import read_parameter_set
 from python_core import run_coupled
 

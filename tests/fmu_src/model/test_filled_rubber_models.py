@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import build_fmu
-from fmu_src.model import integration
+from fmu_src.model import elements, integration
 from fmu_src.model.registry import MODELS
 from fmu_src.model.parameter_specs import ParameterError
 from fmu_src.parameter_files import load_parameters
@@ -34,25 +34,25 @@ def defaults(model):
 
 def test_friction_from_rest_is_half_its_limit_at_x2_and_every_branch_starts_with_slope_limit_over_x2():
     limit, x2 = 60.0, 0.08
-    assert integration.friction_force(limit, x2, x2, 0.0, 0.0) == pytest.approx(30.0, rel=1e-15)
-    assert integration.friction_force(limit, x2, -3 * x2, 0.0, 0.0) == pytest.approx(-45.0, rel=1e-15)
-    assert integration.friction_force(limit, x2, 1e6, 0.0, 1.0) == pytest.approx(limit, rel=1e-6)
+    assert elements.friction_force(limit, x2, x2, 0.0, 0.0) == pytest.approx(30.0, rel=1e-15)
+    assert elements.friction_force(limit, x2, -3 * x2, 0.0, 0.0) == pytest.approx(-45.0, rel=1e-15)
+    assert elements.friction_force(limit, x2, 1e6, 0.0, 1.0) == pytest.approx(limit, rel=1e-6)
     # after a reversal at F_s = 40 N, down: the slope is limit/x2 = 750 N/mm, the branch tends to -limit
     d = 1e-7
-    slope = (integration.friction_force(limit, x2, -d, 40.0, -1.0) - 40.0) / -d
+    slope = (elements.friction_force(limit, x2, -d, 40.0, -1.0) - 40.0) / -d
     assert slope == pytest.approx(limit / x2, rel=1e-5)
-    assert integration.friction_force(limit, x2, -1e6, 40.0, -1.0) == pytest.approx(-limit, rel=1e-5)
-    assert integration.friction_force(0.0, x2, 0.3, 0.0, 1.0) == 0.0     # no friction
+    assert elements.friction_force(limit, x2, -1e6, 40.0, -1.0) == pytest.approx(-limit, rel=1e-5)
+    assert elements.friction_force(0.0, x2, 0.3, 0.0, 1.0) == 0.0     # no friction
 
 
 def test_a_reversal_restarts_the_branch_and_rounding_size_jumps_do_not():
     limit, x2 = 60.0, 0.08
-    state = integration.friction_turn(limit, x2, 0.5, 0.0, 1.0, -3.0)      # moving up 0.5 mm, then down
-    assert state == (0.0, integration.friction_force(limit, x2, 0.5, 0.0, 1.0), -1.0)
-    assert integration.friction_turn(limit, x2, 0.5, 0.0, 0.0, 2.0) == (0.5, 0.0, 1.0)   # first motion from rest
-    assert integration.friction_turn(limit, x2, 0.5, 7.0, 1.0, 0.0) == (0.5, 7.0, 1.0)   # no motion
-    assert integration.friction_jump_turn(limit, x2, 0.5, 7.0, 1.0, -1e-15) == (0.5, 7.0, 1.0)
-    assert integration.friction_jump_turn(limit, x2, 0.5, 7.0, 1.0, -1e-9)[2] == -1.0
+    state = elements.friction_turn(limit, x2, 0.5, 0.0, 1.0, -3.0)      # moving up 0.5 mm, then down
+    assert state == (0.0, elements.friction_force(limit, x2, 0.5, 0.0, 1.0), -1.0)
+    assert elements.friction_turn(limit, x2, 0.5, 0.0, 0.0, 2.0) == (0.5, 0.0, 1.0)   # first motion from rest
+    assert elements.friction_turn(limit, x2, 0.5, 7.0, 1.0, 0.0) == (0.5, 7.0, 1.0)   # no motion
+    assert elements.friction_jump_turn(limit, x2, 0.5, 7.0, 1.0, -1e-15) == (0.5, 7.0, 1.0)
+    assert elements.friction_jump_turn(limit, x2, 0.5, 7.0, 1.0, -1e-9)[2] == -1.0
 
 
 def held_inputs(kind, duration_s=1.0):

@@ -26,7 +26,8 @@ from __future__ import annotations
 import math
 
 from ..model.definition import BushingModel, SearchBox, SearchCoordinate, StateSpec
-from ..model.integration import OK, maxwell_decay, maxwell_step
+from ..model.elements import maxwell_decay, maxwell_step
+from ..model.integration import OK
 from ..model.parameter_specs import DAMPING, SPRING, ParameterSpec
 from ..model.search_coordinates import KIND
 

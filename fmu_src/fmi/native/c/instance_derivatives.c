@@ -7,7 +7,7 @@
    In co-simulation the output is the one bw_output returns, the committed state taken through
    the displacement jump to x (which the dashpots carry): dF/dx includes the jump's derivative,
    also where x equals the committed state's displacement. There (a jump of 0, or of rounding
-   size: BW_ROUNDING_JUMP, integration.ROUNDING_JUMP_MM) F is not differentiable where the
+   size: BW_ROUNDING_JUMP, elements.ROUNDING_JUMP_MM) F is not differentiable where the
    motion could reverse (a Bouc-Wen walk's sgn, a friction element's turn), and the derivative
    is the one-sided one in the direction of the velocity set, the branch the motion continues
    on, taken at a jump of twice the rounding size that way (the kernels' own choice at exactly 0
