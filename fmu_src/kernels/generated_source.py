@@ -72,10 +72,11 @@ def unbound_names(source: str) -> list[tuple[str, int, str]]:
     return found
 
 
-def check_bound_names(source: str, module: str) -> None:
+def check_bound_names(source: str, module: str, injected=()) -> None:
     """Raise GenerationError naming each function of the generated module ``module`` that reads
-    a name the module does not bind (:func:`unbound_names`)."""
-    missing = unbound_names(source)
+    a name the module does not bind (:func:`unbound_names`) and that is not one of ``injected``
+    (bound in its namespace before it runs)."""
+    missing = [found for found in unbound_names(source) if found[2] not in injected]
     if missing:
         raise GenerationError(f"the generated module {module} cannot run: "
                               + "; ".join(f"{function} (line {line}) reads {name!r}, which it does not bind"

@@ -23,8 +23,11 @@ anything else):
   compiled copies), ``from ..model.<module> import names``
   (the contract: ``definition``, ``parameter_specs``, ``search_coordinates``) and
   ``from .<sibling> import names`` (another model's module): plain-Python values, such as specs,
-  constants and ``BushingModel``; a function imported from there stays uncompiled, and numba
-  refuses a kernel that calls it. Nothing else: ``from math import exp``, ``import numpy``,
+  constants and ``BushingModel``. The generated module keeps of these only the constants (numbers,
+  strings, tuples of them), written in as values (:func:`kernels_only`), so that its source
+  names no package and every FMU of a model shares it and numba's cache with the
+  identification; a kernel that reads anything else from there is refused when the module is
+  generated (``generated_source.GenerationError``). Nothing else: ``from math import exp``, ``import numpy``,
   ``from ..model import integration`` and imports inside functions are refused, not copied.
 - the step protocol (``integration.step`` and ``step_prepared``, appended to the generated module)
   calls the module's globals ``jump`` and ``integrate`` (and ``prepare_step``, where the module
@@ -44,6 +47,7 @@ import dataclasses
 import hashlib
 import importlib.util
 import inspect
+import math
 import ntpath
 import os
 import sys
@@ -59,8 +63,11 @@ from .unrolling import unroll
 from ..syntax_trees import parse
 
 CACHE_ENVIRONMENT = "BUSHING_CACHE_DIR"
-_NUMBA_IMPORT = f"from {__package__}.jit import numba\n\n"
-"""numba or its plain-Python stand-in (``jit``), from this package (``fmu_src`` or the FMU's packed copy)."""
+INJECTED = ("numba",)
+"""The names :func:`load_generated` binds in a generated module before running it: numba or its
+plain-Python stand-in (``jit``), of this package (``fmu_src`` or an FMU's packed copy). Bound,
+not imported, so that the source names no package: every FMU of a model and the identification
+share one generated module and numba's cache of it."""
 
 _JIT_KERNELS = (
     # every function this module defines; error_model="numpy": a division by zero gives inf/nan
@@ -100,9 +107,15 @@ def module_name(prefix: str, source: str) -> str:
     return f"{prefix}_{hashlib.sha256((compiler_versions() + chr(10) + source).encode()).hexdigest()[:16]}"
 
 
+def _numba():
+    from .jit import numba
+    return numba
+
+
 def load_generated(name: str, source: str, check: bool = True) -> types.ModuleType:
     """The module ``name`` with ``source``, written to the cache folder and imported (once per
-    process); in memory, uncached, if the folder cannot be written. Where it is generated (not
+    process), with :data:`INJECTED` bound; in memory, uncached, if the folder cannot be written.
+    Where it is generated (not
     yet in the folder, or in memory) and ``check``, every name its functions read must be bound
     (``generated_source.check_bound_names``: a GenerationError naming the function and the name);
     the shared machinery's module, whose step protocol is a template bound in each model's
@@ -115,7 +128,7 @@ def load_generated(name: str, source: str, check: bool = True) -> types.ModuleTy
         path = folder / f"{name}.py"
         if not path.is_file() or path.read_text() != source:
             if check:
-                check_bound_names(source, name)
+                check_bound_names(source, name, INJECTED)
             # Written whole and renamed: worker processes start at once and must never read half a file.
             partial = path.with_suffix(f".{os.getpid()}.tmp")
             partial.write_text(source)
@@ -124,14 +137,16 @@ def load_generated(name: str, source: str, check: bool = True) -> types.ModuleTy
         warnings.warn(f"cannot write the compiled model's cache in {cache_directory()} ({exc}); compiling "
                       f"in memory at every start (set {CACHE_ENVIRONMENT} to a writable folder)", stacklevel=4)
         if check:
-            check_bound_names(source, name)
+            check_bound_names(source, name, INJECTED)
         module = types.ModuleType(name)
+        module.numba = _numba()
         sys.modules[name] = module
         exec(compile(source.replace(", cache=True", "").replace("(cache=True)", "()"), f"<{name}>", "exec"),
              module.__dict__)
         return module
     spec = importlib.util.spec_from_file_location(name, path)
     module = importlib.util.module_from_spec(spec)
+    module.numba = _numba()
     sys.modules[name] = module
     spec.loader.exec_module(module)
     return module
@@ -192,9 +207,68 @@ def checked_imports(tree: ast.Module, module: str, machinery: str | None, packag
 def kernel_source(module: types.ModuleType, machinery: str | None = None) -> str:
     """The source of a kernel module as numba reads it: tuples and sums over a constant range
     written out (``unrolling``), its imports checked and made absolute (:func:`checked_imports`;
-    ``machinery``: the compiled machinery's module, or None for the machinery itself)."""
+    ``machinery``: the compiled machinery's module, or None for the machinery itself); a model's
+    module (``machinery`` given) cut to its kernels (:func:`kernels_only`)."""
     tree = unroll(parse(inspect.getsource(module)), module.__dict__, module.__name__)
-    return ast.unparse(checked_imports(tree, module.__name__, machinery, module.__package__))
+    tree = checked_imports(tree, module.__name__, machinery, module.__package__)
+    return ast.unparse(kernels_only(tree, module.__dict__, module.__package__) if machinery is not None else tree)
+
+
+def _literal(value) -> bool:
+    """Whether ``value`` is a number, string, None or a tuple of them: a constant a kernel may read."""
+    if isinstance(value, tuple):
+        return all(_literal(item) for item in value)
+    return value is None or isinstance(value, (bool, int, str)) or isinstance(value, float) and math.isfinite(value)
+
+
+def kernels_only(tree: ast.Module, values: dict, package: str) -> ast.Module:
+    """A model module's syntax tree (imports absolute, :func:`checked_imports`) cut to what its
+    compiled copy runs: its docstring, ``__future__``, ``math`` and the compiled machinery's and
+    elements' imports, its functions, and every module-level name (assigned, or imported from the
+    model contract or another model's module) whose value (``values``, the module's) is a
+    constant (:func:`_literal`), written as that value. Specs, the search box and ``MODEL`` go:
+    the generated source names no package (its imports of the package are not needed), and a
+    constant taken from another module is part of the source (and of the generated module's
+    hash)."""
+    root = package.rpartition(".")[0]
+    body = []
+    for index, node in enumerate(tree.body):
+        if isinstance(node, ast.FunctionDef) or (index == 0 and isinstance(node, ast.Expr)):
+            body.append(node)
+        elif isinstance(node, ast.Import) or (isinstance(node, ast.ImportFrom) and not node.module.startswith(root + ".")):
+            body.append(node)      # math, __future__, the compiled machinery and elements
+        elif isinstance(node, (ast.ImportFrom, ast.Assign, ast.AnnAssign)):
+            if isinstance(node, ast.ImportFrom):
+                names = [alias.asname or alias.name for alias in node.names]
+            else:
+                targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+                names = [n.id for target in targets for n in ast.walk(target) if isinstance(n, ast.Name)]
+            body += [ast.Assign([ast.Name(name, ast.Store())], ast.Constant(values[name]) if not
+                                isinstance(values[name], tuple) else parse(repr(values[name]), mode="eval").body,
+                                lineno=node.lineno)
+                     for name in names if _literal(values.get(name, ...))]
+    # a function that reads what went (a plain-Python helper of the specs) goes too, and so on
+    gone = set(values) - {name for node in body for name in _bound_by(node)}
+    while True:
+        helpers = {node.name for node in body if isinstance(node, ast.FunctionDef) and _reads(node) & gone}
+        if not helpers:
+            break
+        gone |= helpers
+        body = [node for node in body if not (isinstance(node, ast.FunctionDef) and node.name in helpers)]
+    tree.body = body
+    return ast.fix_missing_locations(tree)
+
+
+def _bound_by(node) -> list[str]:
+    if isinstance(node, ast.FunctionDef):
+        return [node.name]
+    if isinstance(node, (ast.Import, ast.ImportFrom)):
+        return [alias.asname or alias.name.split(".")[0] for alias in node.names]
+    return [n.id for n in ast.walk(node) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Store)]
+
+
+def _reads(function: ast.FunctionDef) -> set[str]:
+    return {n.id for n in ast.walk(function) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)}
 
 
 def integration_module() -> str:
@@ -211,7 +285,7 @@ def _shared_module(module: types.ModuleType, prefix: str) -> str:
     """The name of the compiled copy of a shared kernel module (generated and loaded): its source
     unchecked (the machinery's step protocol is a template bound in each model's module)."""
     source = (kernel_source(module, None) + "\n\n# ---- appended by fmu_src/kernels/numba_binding.py ----\n"
-              + _NUMBA_IMPORT + _JIT_KERNELS)
+              + _JIT_KERNELS)
     name = module_name(prefix, source)
     load_generated(name, source, check=False)
     return name
@@ -226,7 +300,7 @@ def model_source(model, machinery: str, appendix: str = "") -> str:
     module = sys.modules[model.kernel_module]
     check_step_kernels(model, module)
     source = kernel_source(module, machinery)
-    return (source + "\n\n# ---- appended by fmu_src/kernels/numba_binding.py ----\n" + _NUMBA_IMPORT + _JIT_KERNELS
+    return (source + "\n\n# ---- appended by fmu_src/kernels/numba_binding.py ----\n" + _JIT_KERNELS
             + f"\nif 'prepare_step' not in globals():\n    from {machinery} import unprepared_step as prepare_step\n"
             + "\n\n" + inspect.getsource(integration.step_prepared) + "\n\n" + inspect.getsource(integration.step)
             + "\n\nstep_prepared = numba.njit(error_model='numpy', cache=True)(step_prepared)"
