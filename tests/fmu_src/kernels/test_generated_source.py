@@ -1,5 +1,8 @@
 """Generated modules are checked when generated: a function reading a name the module does not
 bind is refused, naming the function and the name (fmu_src/kernels/generated_source.py)."""
+import ast
+import sys
+
 import pytest
 
 from fmu_src.kernels import numba_binding as compiled_kernels
@@ -46,3 +49,25 @@ def test_every_models_generated_modules_bind_every_name_they_read():
                          fit_jacobian._appendix(model, 2, machinery)):
             unbound = unbound_names(compiled_kernels.model_source(model, machinery, appendix))
             assert [found for found in unbound if found[2] not in compiled_kernels.INJECTED] == [], name
+
+
+def test_a_generated_module_names_no_package_so_every_fmu_shares_it():
+    """The source (and so the name and numba's cache) of a model's generated modules is the same
+    for fmu_src and for every FMU's packed copy: it imports nothing from the package and keeps of
+    the model's module its kernels and constants, the constants written in as values."""
+    from identification.forward import parameter_jacobian as fit_jacobian
+    machinery = compiled_kernels.integration_module()
+    for name in ("proposed", "fractional", "hydraulic_free_decoupler", "single_bouc_wen+backbone4+limits+rig"):
+        model = get_model(name)
+        for appendix in (compiled_core._population_appendix(model), compiled_kernels._fmu_appendix(model),
+                         fit_jacobian._appendix(model, 2, machinery)):
+            source = compiled_kernels.model_source(model, machinery, appendix)
+            imported = [node.module for node in ast.walk(ast.parse(source)) if isinstance(node, ast.ImportFrom)]
+            assert not [module for module in imported if module.startswith("fmu_src")], name
+            assert "ParameterSpec(" not in source and "MODEL =" not in source, name
+    # fractional reads berg_model's constants: there as values, not as an import of another module
+    tree = ast.parse(compiled_kernels.kernel_source(sys.modules[get_model("fractional").kernel_module], machinery))
+    assert not [node for node in ast.walk(tree) if isinstance(node, ast.ImportFrom) and "berg_model" in node.module]
+    # what stays at the top besides functions and imports: constants written in as values
+    values = [node.value for node in tree.body if isinstance(node, (ast.Assign, ast.AnnAssign))]
+    assert values and all(isinstance(value, (ast.Constant, ast.Tuple, ast.UnaryOp)) for value in values)
