@@ -155,7 +155,7 @@ class _AxisState:
 class _Batch:
     """The single-axis units of one model stepped in one compiled call (``numba_binding._step_axes``)."""
     step: object                  # the compiled step of all the batch's axes
-    units: list                   # their _Unit
+    members: list                 # their axes (_AxisState), each a unit of one
     params: object                # their parameter rows in force (an array), None: rebuilt at the next step
     histories: object             # each axis's jumping-input history (JUMP_*; an int64 array)
     next_histories: object        # the next step's, written by the compiled step (swapped when committed)
@@ -211,6 +211,69 @@ class _Unit:
             x[c], v[c] = a.x_now, a.v * a.to_kernel
         return tuple(x), tuple(v)
 
+    def advance(self, h):
+        """(new state, displacement vector at the end, the members' outputs [port units] there, or
+        () if the step failed, the step's status) of a step of h [s] from the committed state to
+        the members' current inputs, with the kernels (plain Python); raises ArithmeticError or
+        ValueError where it overflows."""
+        x, v = self.inputs()
+        state, _, status = self.kernels.step(self.constants, self.state, self.state_x, x, v, h,
+                                             integration.DEFAULT_MAX_SUBSTEPS)
+        x_end = tuple(x[i] + v[i] * h for i in range(self.width))
+        if status != integration.OK:
+            return state, x_end, (), status
+        return state, x_end, self.outputs(self.kernels.force(self.constants, state, x_end, v)), status
+
+    def outputs(self, forces):
+        """The members' outputs [port units] of the kernels' force vector."""
+        return tuple(forces[c] * a.from_kernel + a.preload_port for c, a in enumerate(self.members))
+
+    def record(self, stepped, steps, state, x_end, outputs):
+        """A step to commit: (unit, new state, displacement vector at the end) in ``stepped``, and
+        each member's (axis, displacement at the end, output, False: its jumps not yet counted,
+        None: its state is the unit's) in ``steps``."""
+        stepped.append((self, state, x_end))
+        steps += [(a, x_end[c], outputs[c], False, None) for c, a in enumerate(self.members)]
+
+
+class _AxisUnit(_Unit):
+    """A single axis as a unit of one: its model's kernels on 1-vectors (``_AxisKernels``), the
+    vectors written out (the FMU's most common unit, stepped every communication step)."""
+
+    def __init__(self, a):
+        self.axis_state = a
+        super().__init__([a], _AxisKernels(a.model), 1, len(a.model.states), a.axis.label)
+
+    @property
+    def state_x(self):
+        """(its axis's committed displacement,): kept on the axis alone."""
+        return (self.axis_state.state_x,)
+
+    @state_x.setter
+    def state_x(self, value):
+        self.axis_state.state_x = value[0]
+
+    def record(self, stepped, steps, state, x_end, outputs):
+        """The step in ``steps`` alone, its state with it (:meth:`_Unit.record`)."""
+        steps.append((self.axis_state, x_end[0], outputs[0], False, state))
+
+    def inputs(self):
+        a = self.axis_state
+        return (a.x_now,), (a.v * a.to_kernel,)
+
+    def advance(self, h):
+        a, model = self.axis_state, self.model    # the model's scalar kernels, called directly
+        x, v = a.x_now, a.v * a.to_kernel
+        state, _, status = model.step(self.constants, self.state, a.state_x, x, v, h, integration.DEFAULT_MAX_SUBSTEPS)
+        x_end = x + v * h
+        if status != integration.OK:
+            return state, (x_end,), (), status
+        return state, (x_end,), (model.force(self.constants, state, x_end, v) * a.from_kernel + a.preload_port,), status
+
+    def outputs(self, forces):
+        a = self.axis_state
+        return (forces[0] * a.from_kernel + a.preload_port,)
+
 
 class BushingSlave(Fmi2Slave):
     author = "Bouc-Wen bushing project"
@@ -230,8 +293,7 @@ class BushingSlave(Fmi2Slave):
         groups = [[self._axes[i] for i in positions] for positions in GROUPS]
         groups = [members for members in groups if members[0].model.coupled is not None]
         grouped = {id(a) for members in groups for a in members}
-        self._units = [_Unit([a], _AxisKernels(a.model), 1, len(a.model.states), a.axis.label)
-                       for a in self._axes if id(a) not in grouped]
+        self._units = [_AxisUnit(a) for a in self._axes if id(a) not in grouped]
         for unit in self._units:
             unit.step_one = STEP_AXES[unit.model.name][1] if unit.model.name in STEP_AXES else None
         for members in groups:
@@ -246,10 +308,10 @@ class BushingSlave(Fmi2Slave):
         for unit in self._units:
             if unit.step_one is not None:
                 by_model.setdefault(unit.model.name, []).append(unit)
-        self._batches = [_Batch(STEP_AXES[name][0], units, None, np.zeros(len(units), dtype=np.int64),
-                                np.zeros(len(units), dtype=np.int64))
+        self._batches = [_Batch(STEP_AXES[name][0], [unit.members[0] for unit in units], None,
+                                np.zeros(len(units), dtype=np.int64), np.zeros(len(units), dtype=np.int64))
                          for name, units in by_model.items() if len(units) > 1]
-        batched = {id(unit) for batch in self._batches for unit in batch.units}
+        batched = {id(a.unit) for batch in self._batches for a in batch.members}
         self._unbatched = [unit for unit in self._units if id(unit) not in batched]
         self._initial_state_pending = True  # set at exit of initialization, or first valid step
         self._parameters_changed = True     # some axis's parameters were set since the last check
@@ -348,8 +410,8 @@ class BushingSlave(Fmi2Slave):
             except (ArithmeticError, ValueError):
                 status, forces = integration.NOT_FINITE, (math.nan,) * unit.width
             if status == integration.OK and all(math.isfinite(f) for f in forces):
-                for c, member in enumerate(unit.members):
-                    member.last_output = forces[c] * member.from_kernel + member.preload_port
+                for member, output in zip(unit.members, unit.outputs(forces)):
+                    member.last_output = output
                     member.output_is_current = True
                     member.stale_output_logged = False
                 return a.last_output
@@ -450,57 +512,52 @@ class BushingSlave(Fmi2Slave):
         # every unit first, then commit all: a refusal leaves every axis as it was
         compiled = self._step_compiled(step_size) if self._batches else None
         # None: no compiled call, or an axis failed in it: every unit one by one (for the message)
-        steps, crossings = compiled if compiled is not None else ([], ())
+        stepped, steps, crossings = compiled if compiled is not None else ([], [], ())
         for unit in (self._unbatched if compiled is not None else self._units):
-            step = self._step_unit(unit, current_time, step_size)
-            if step is None:
+            if not self._step_unit(unit, current_time, step_size, stepped, steps):
                 return False
-            steps.append(step)
         for batch, crossed in crossings:   # the compiled step counted its axes' jumps: keep them
             batch.histories, batch.next_histories = batch.next_histories, batch.histories
             if crossed >= 0 and not self._jump_warned:
-                self._warn_jumping(batch.units[crossed].members[0], current_time, step_size,
-                                   int(batch.histories[crossed]))
-        for unit, state, x_end, outputs, jumps_counted in steps:
-            for a, x_a, output in zip(unit.members, x_end, outputs):
-                if abs(output) > a.output_bound and not a.output_warned:
-                    self._warn_implausible(a, output, current_time + step_size)
-                if not (jumps_counted or self._jump_warned):
-                    jumped = integration.displacement_jumped(a.x_now, a.state_x, a.v * a.to_kernel, step_size)
-                    a.jump_history = ((a.jump_history << 1) | jumped) & _JUMP_MASK
-                    if jumped and a.jump_history.bit_count() > JUMP_COUNT:
-                        self._warn_jumping(a, current_time, step_size, a.jump_history)
-                a.state_x = a.x_now = x_a
-                a.last_output = output
-                a.output_is_current = True
+                self._warn_jumping(batch.members[crossed], current_time, step_size, int(batch.histories[crossed]))
+        for a, x_end, output, jumps_counted, state in steps:
+            if abs(output) > a.output_bound and not a.output_warned:
+                self._warn_implausible(a, output, current_time + step_size)
+            if not (jumps_counted or self._jump_warned):
+                jumped = integration.displacement_jumped(a.x_now, a.state_x, a.v * a.to_kernel, step_size)
+                a.jump_history = ((a.jump_history << 1) | jumped) & _JUMP_MASK
+                if jumped and a.jump_history.bit_count() > JUMP_COUNT:
+                    self._warn_jumping(a, current_time, step_size, a.jump_history)
+            a.state_x = a.x_now = x_end
+            a.last_output = output
+            a.output_is_current = True
+            if state is not None:   # a unit of one's state (a group's is committed below)
+                a.unit.state = state
+        for unit, state, x_end in stepped:
             unit.state, unit.state_x = state, x_end
         return True
 
-    def _step_unit(self, unit, current_time, step_size):
-        """(the unit, its new state, its displacement vector at the end, its members' outputs,
-        False: their jumps not yet counted) of one unit's step, or None after logging why it
-        cannot be taken."""
-        x, v = unit.inputs()
+    def _step_unit(self, unit, current_time, step_size, stepped, steps) -> bool:
+        """One unit's step, recorded (``_Unit.record``) in ``stepped`` (a group's new state) and
+        ``steps`` (each member's displacement at the end and output, its jumps not yet counted);
+        False after logging why it cannot be taken."""
         if unit.step_one is not None:   # a single axis compiled: one call (the same kernels as below)
             a = unit.members[0]
-            state, output, x_end, status = unit.step_one(a.params_row, unit.state, a.state_x, x[0], v[0], step_size,
-                                                         integration.DEFAULT_MAX_SUBSTEPS)
+            state, output, x_end, status = unit.step_one(a.params_row, unit.state, a.state_x, a.x_now,
+                                                         a.v * a.to_kernel, step_size, integration.DEFAULT_MAX_SUBSTEPS)
             output = output * a.from_kernel + a.preload_port
             if status == integration.OK and math.isfinite(output):
-                return unit, state, (x_end,), (output,), False
-        label, outputs = unit.label, ()
-        x_end = tuple(x[i] + v[i] * step_size for i in range(unit.width))
+                steps.append((a, x_end, output, False, state))
+                return True
+        label = unit.label
         try:
-            state, _, status = unit.kernels.step(unit.constants, unit.state, unit.state_x, x, v, step_size,
-                                                 integration.DEFAULT_MAX_SUBSTEPS)
-            if status == integration.OK:
-                forces = unit.kernels.force(unit.constants, state, x_end, v)
-                outputs = tuple(forces[c] * a.from_kernel + a.preload_port for c, a in enumerate(unit.members))
+            state, x_end, outputs, status = unit.advance(step_size)
         except (ArithmeticError, ValueError) as exc:
-            status, label = integration.NOT_FINITE, label + f"the step overflowed ({exc}); "
+            status, outputs, label = integration.NOT_FINITE, (), label + f"the step overflowed ({exc}); "
         if self._step_refused(status, outputs, label, unit.members, current_time, step_size):
-            return None
-        return unit, state, x_end, outputs, False
+            return False
+        unit.record(stepped, steps, state, x_end, outputs)
+        return True
 
     def _step_refused(self, status, outputs, label, members, current_time, step_size) -> bool:
         """Whether the step of a unit's ``members`` (one axis, or a coupled group's) failed (``status``, a
@@ -520,13 +577,14 @@ class BushingSlave(Fmi2Slave):
         return True
 
     def _step_compiled(self, step_size):
-        """(steps, [(batch, the first axis whose jumps crossed JUMP_COUNT or -1)]): every batched
-        unit's step in one compiled call per model (``numba_binding._step_axes``, the same kernels
-        and arithmetic as :meth:`_step_unit`, and the same jump count as :meth:`do_step`'s); None
-        if any axis's step fails, so that the unit-by-unit step redoes it and words the refusal."""
-        steps, crossings = [], []
+        """(stepped, steps, [(batch, the first axis whose jumps crossed JUMP_COUNT or -1)]): every
+        batched unit's step (as :meth:`_step_unit` appends it, its jumps counted) in one compiled
+        call per model (``numba_binding._step_axes``, the same kernels and arithmetic as
+        :meth:`_step_unit`, and the same jump count as :meth:`do_step`'s); None if any axis's step
+        fails, so that the unit-by-unit step redoes it and words the refusal."""
+        stepped, steps, crossings = [], [], []
         for batch in self._batches:
-            members = [unit.members[0] for unit in batch.units]
+            members = batch.members
             if batch.params is None:
                 batch.params = np.array([a.model.values(a.values) for a in members])
             rows = np.array([(a.x_now, a.v * a.to_kernel, a.state_x, *a.unit.state) for a in members])
@@ -535,9 +593,9 @@ class BushingSlave(Fmi2Slave):
             if failures:
                 return None
             crossings.append((batch, crossed))
-            for unit, a, row in zip(batch.units, members, out.tolist()):   # (*state, force, x + v*h)
-                steps.append((unit, tuple(row[:-2]), (row[-1],), (row[-2] * a.from_kernel + a.preload_port,), True))
-        return steps, crossings
+            for a, row in zip(members, out.tolist()):   # (*state, force, x + v*h)
+                steps.append((a, row[-1], row[-2] * a.from_kernel + a.preload_port, True, tuple(row[:-2])))
+        return stepped, steps, crossings
 
     def _warn_jumping(self, a, current_time, step_size, history):
         """Warn, once per instance, that more than JUMP_COUNT of the axis's last JUMP_WINDOW steps
