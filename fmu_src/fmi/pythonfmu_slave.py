@@ -163,17 +163,14 @@ class _Batch:
 
 class _AxisKernels:
     """One axis's model kernels in the shape of a coupled form (``definition.CoupledKernels``):
-    displacements, velocities, jumps and forces as 1-tuples, so that a single axis is stepped as a
-    unit of one."""
+    displacements, velocities, jumps and forces as 1-tuples, so that a single axis's output and
+    initial state are a unit's (its step calls the scalar kernels: ``_AxisUnit.advance``)."""
 
     def __init__(self, model):
         self.model = model
 
     def initial_state(self, constants, x):
         return self.model.initial_state(constants, x[0])
-
-    def step(self, constants, state, state_x, x, v, h, max_substeps):
-        return self.model.step(constants, state, state_x[0], x[0], v[0], h, max_substeps)
 
     def jump(self, constants, state, jump):
         return integration.apply_displacement_jump(self.model, constants, state, jump[0]), integration.OK
