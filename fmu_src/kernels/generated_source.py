@@ -19,7 +19,7 @@ class GenerationError(RuntimeError):
     """A generated module that cannot work (the message names the module, the function and the name)."""
 
 
-def _module_bindings(statements) -> set[str] | None:
+def module_bindings(statements) -> set[str] | None:
     """The names the module's top level binds (functions, classes, assignments, imports, loop
     targets; into if/try/with/for bodies, not into functions), or None where a star import makes
     them unknowable."""
@@ -40,7 +40,7 @@ def _module_bindings(statements) -> set[str] | None:
         for field in ("body", "orelse", "finalbody", "handlers"):
             inner = getattr(node, field, None)
             if isinstance(inner, list) and inner and not isinstance(node, ast.ClassDef):
-                nested = _module_bindings([s for s in inner if isinstance(s, ast.stmt)]
+                nested = module_bindings([s for s in inner if isinstance(s, ast.stmt)]
                                           + [s for h in inner if isinstance(h, ast.ExceptHandler) for s in h.body])
                 if nested is None:
                     return None
@@ -48,7 +48,7 @@ def _module_bindings(statements) -> set[str] | None:
     return bound
 
 
-def _free_names(function: ast.FunctionDef) -> set[str]:
+def free_names(function: ast.FunctionDef) -> set[str]:
     """The names ``function`` reads that it (its arguments, assignments, comprehensions, nested
     functions) does not bind."""
     local = {a.arg for a in ast.walk(function) if isinstance(a, ast.arg)}
@@ -61,14 +61,14 @@ def unbound_names(source: str) -> list[tuple[str, int, str]]:
     """(function, line, name) of every name a top-level function of ``source`` reads that neither
     it nor the module's top level binds, nor the builtins."""
     tree = parse(source)
-    bound = _module_bindings(tree.body)
+    bound = module_bindings(tree.body)
     if bound is None:
         return []
     bound |= set(dir(builtins))
     found = []
     for node in tree.body:
         if isinstance(node, ast.FunctionDef):
-            found += [(node.name, node.lineno, name) for name in sorted(_free_names(node) - bound)]
+            found += [(node.name, node.lineno, name) for name in sorted(free_names(node) - bound)]
     return found
 
 

@@ -57,7 +57,7 @@ import warnings
 from pathlib import Path
 
 from ..model import elements, integration
-from .generated_source import check_bound_names
+from .generated_source import check_bound_names, free_names, module_bindings
 from ..model.definition import ModelContractError, check_step_kernels
 from .unrolling import unroll
 from ..syntax_trees import parse
@@ -243,32 +243,19 @@ def kernels_only(tree: ast.Module, values: dict, package: str) -> ast.Module:
             else:
                 targets = node.targets if isinstance(node, ast.Assign) else [node.target]
                 names = [n.id for target in targets for n in ast.walk(target) if isinstance(n, ast.Name)]
-            body += [ast.Assign([ast.Name(name, ast.Store())], ast.Constant(values[name]) if not
-                                isinstance(values[name], tuple) else parse(repr(values[name]), mode="eval").body,
+            body += [ast.Assign([ast.Name(name, ast.Store())], parse(repr(values[name]), mode="eval").body,
                                 lineno=node.lineno)
                      for name in names if _literal(values.get(name, ...))]
     # a function that reads what went (a plain-Python helper of the specs) goes too, and so on
-    gone = set(values) - {name for node in body for name in _bound_by(node)}
+    gone = set(values) - module_bindings(body)
     while True:
-        helpers = {node.name for node in body if isinstance(node, ast.FunctionDef) and _reads(node) & gone}
+        helpers = {node.name for node in body if isinstance(node, ast.FunctionDef) and free_names(node) & gone}
         if not helpers:
             break
         gone |= helpers
         body = [node for node in body if not (isinstance(node, ast.FunctionDef) and node.name in helpers)]
     tree.body = body
     return ast.fix_missing_locations(tree)
-
-
-def _bound_by(node) -> list[str]:
-    if isinstance(node, ast.FunctionDef):
-        return [node.name]
-    if isinstance(node, (ast.Import, ast.ImportFrom)):
-        return [alias.asname or alias.name.split(".")[0] for alias in node.names]
-    return [n.id for n in ast.walk(node) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Store)]
-
-
-def _reads(function: ast.FunctionDef) -> set[str]:
-    return {n.id for n in ast.walk(function) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)}
 
 
 def integration_module() -> str:
