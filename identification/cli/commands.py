@@ -167,11 +167,12 @@ def fit_command(args) -> int:
 def _plot_table_fit(result, table, folder: Path) -> list[Path]:
     """The fitted set's (and ensemble's) data sheet on the table's amplitudes and frequencies,
     the table's rows as crosses; in ``folder``/kdyn (one plot set per preload: the first's)."""
-    from identification.forward.dynamic_stiffness import characterise
+    from identification.forward.dynamic_stiffness import SteadyStateLoop, data_sheet
     from identification.analysis.plots import plot_dynamic_stiffness
     rows = table.subset(table.preload_mm == table.preload_mm[0])
-    sheet = characterise(result, np.unique(rows.amplitude_mm), np.unique(rows.frequency_hz),
-                         preload_mm=float(rows.preload_mm[0]))
+    # the fit's model and its checked sets, carried on: nothing to read or resolve again
+    sheet = data_sheet(result.parameters.model, result.ensemble, np.unique(rows.amplitude_mm),
+                       np.unique(rows.frequency_hz), float(rows.preload_mm[0]), SteadyStateLoop())
     (folder / "kdyn").mkdir(parents=True, exist_ok=True)
     return plot_dynamic_stiffness(sheet, folder / "kdyn", measured=rows)
 

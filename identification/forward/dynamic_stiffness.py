@@ -187,10 +187,18 @@ def characterise(parameters, amplitudes_mm: Sequence[float] = DEFAULT_AMPLITUDES
         A case that reaches ``max_cycles`` without a steady state.
     """
     # here, not at the top: the command line imports this module for its defaults
-    from identification.forward.population import parameter_matrix
     from identification.forward.parameter_sets import parameter_sets
     loop = SteadyStateLoop(**loop)
     bushing, sets = parameter_sets(parameters, model)
+    return data_sheet(bushing, sets, amplitudes_mm, frequencies_hz, preload_mm, loop)
+
+
+def data_sheet(bushing: BushingModel, sets: list[dict[str, float]], amplitudes_mm: Sequence[float],
+               frequencies_hz: Sequence[float], preload_mm: float, loop: SteadyStateLoop) -> DynamicStiffness:
+    """``characterise`` of parameter sets already read and checked (``parameter_sets``): the
+    model, its sets (paper's N-mm-s units, best first), the grid [mm], [Hz], the preload [mm]
+    and the loop's settings. For a caller that holds them, such as a fit."""
+    from identification.forward.population import parameter_matrix
     amplitudes = _grid_values(amplitudes_mm, "amplitude", "mm", PLAUSIBLE_AMPLITUDE_MM)
     frequencies = _grid_values(frequencies_hz, "frequency", "Hz", PLAUSIBLE_FREQUENCY_HZ)
     _check_loop(preload_mm, loop)
@@ -212,7 +220,7 @@ def characterise(parameters, amplitudes_mm: Sequence[float] = DEFAULT_AMPLITUDES
                      case_frequency, float(preload_mm)) for k in runs]
     if len(runs) < members:
         warnings.warn(f"{members - len(runs)} of the {members} ensemble members fail on some case (overflow or too many "
-                      "substeps) and are left out of the min/max columns", CharacterisationWarning, stacklevel=2)
+                      "substeps) and are left out of the min/max columns", CharacterisationWarning, stacklevel=3)
     best = tables[0]
     _warn_unsteady(tables, case_amplitude, case_frequency, loop.max_cycles, loop.tolerance)
     table = DynamicStiffness(case_amplitude, case_frequency, np.full(cases, float(preload_mm)),
@@ -246,11 +254,11 @@ def _warn_unsteady(tables, case_amplitude, case_frequency, max_cycles: int, tole
         listed = ", ".join(f"{case_amplitude[i]:g} mm/{case_frequency[i]:g} Hz" for i in np.flatnonzero(not_steady))
         warnings.warn(f"no steady state within {max_cycles} cycles for {listed}: the first harmonic still changes by "
                       f"more than {tolerance:g} per cycle; these rows are the last cycle's (raise max_cycles)",
-                      CharacterisationWarning, stacklevel=3)
+                      CharacterisationWarning, stacklevel=4)
     unsteady_members = sum(not t["converged"].all() for t in tables[1:])
     if unsteady_members:
         warnings.warn(f"{unsteady_members} ensemble member(s) reach no steady state within {max_cycles} cycles on some "
-                      "case; their last cycle is in the min/max columns", CharacterisationWarning, stacklevel=3)
+                      "case; their last cycle is in the min/max columns", CharacterisationWarning, stacklevel=4)
 
 
 def run_sines(matrix: np.ndarray, model: str | BushingModel, amplitude_mm: np.ndarray, frequency_hz: np.ndarray,
@@ -307,5 +315,5 @@ def _grid_values(values, what: str, unit: str, plausible: float) -> np.ndarray:
         raise IdentificationError(f"{what}s {array.tolist()} {unit}: a value is repeated")
     if np.any(array > plausible):
         warnings.warn(f"{what} {float(np.max(array)):g} {unit} is above {plausible:g} {unit}, outside what bushing "
-                      "tests use: check the unit", CharacterisationWarning, stacklevel=3)
+                      "tests use: check the unit", CharacterisationWarning, stacklevel=4)
     return array
