@@ -69,6 +69,12 @@ plain-Python stand-in (``jit``), of this package (``fmu_src`` or an FMU's packed
 not imported, so that the source names no package: every FMU of a model and the identification
 share one generated module and numba's cache of it."""
 
+INNER_JIT = "numba.njit(error_model='numpy', cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)"
+"""How a generated module compiles a function that only its compiled loops call (a row's tuple, a
+store, a loop's slot, a tangent): without the wrappers that would let Python or C call it, which
+numba otherwise writes for every function (a quarter of the compile time of the proposed model's
+exact Jacobian in 14 directions: 30.8 s -> 23.0 s, measured side by side on 2026-11-29)."""
+
 _JIT_KERNELS = (
     # every function this module defines; error_model="numpy": a division by zero gives inf/nan
     # (caught as NOT_FINITE) instead of an exception that would abort a whole population.
@@ -368,7 +374,7 @@ def _step_one(params, state, state_x, x, v, h, max_substeps):
 def row_tuple(name: str, size: int) -> str:
     """A compiled function ``name(row)``: the first ``size`` entries of an array row as a tuple."""
     values = "".join(f"row[{i}], " for i in range(size))
-    return f"@numba.njit(cache=True)\ndef {name}(row):\n    return ({values})\n\n\n"
+    return f"@{INNER_JIT}\ndef {name}(row):\n    return ({values})\n\n\n"
 
 
 def _fmu_appendix(model) -> str:
@@ -379,7 +385,7 @@ def _fmu_appendix(model) -> str:
             + " import OK as _OK, displacement_jumped as _displacement_jumped, "
             "JUMP_WINDOW as _JUMP_WINDOW, JUMP_COUNT as _JUMP_COUNT\n\n"
             + row_tuple("_VALUES", len(model.specs)) + row_tuple("_STATE", size)
-            + "@numba.njit(cache=True)\ndef _STORE(out, i, state):\n" + stores + "\n\n"
+            + f"@{INNER_JIT}\ndef _STORE(out, i, state):\n" + stores + "\n\n"
             + inspect.getsource(_step_axes)
             + "\n\n_step_axes = numba.njit(error_model='numpy', cache=True)(_step_axes)\n\n\n"
             + inspect.getsource(_step_one)

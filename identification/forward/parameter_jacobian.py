@@ -97,7 +97,7 @@ def _machinery_imports(model: BushingModel, source: str, machinery: str) -> str:
 def _tuple_of_lanes(values: int, lanes: int) -> str:
     """``_SEEDS(seeds, i)``: row i of a (P, values, lanes) array as a tuple of K-tuples."""
     rows = ", ".join("(" + "".join(f"seeds[i, {a}, {k}], " for k in range(lanes)) + ")" for a in range(values))
-    return f"@numba.njit(cache=True)\ndef _SEEDS(seeds, i):\n    return ({rows},)\n\n\n"
+    return f"@{_kernels.INNER_JIT}\ndef _SEEDS(seeds, i):\n    return ({rows},)\n\n\n"
 
 
 def _appendix(model: BushingModel, lanes: int, machinery: str) -> str:
@@ -113,11 +113,11 @@ def _appendix(model: BushingModel, lanes: int, machinery: str) -> str:
     return ("\n\nimport math\nimport numpy as np\nfrom " + machinery + " import OK as _OK\n"
             + _machinery_imports(model, source, machinery)
             + f"\nSLOPE_CAP = {tangents.SLOPE_CAP!r}\n\n\n" + helpers + "\n\n\n" + source + "\n\n\n"
-            + "".join(f"{name} = numba.njit(error_model='numpy', cache=True)({name})\n" for name in functions)
+            + "".join(f"{name} = {_kernels.INNER_JIT}({name})\n" for name in functions)
             + "".join(f"{alias} = {name}\n" for alias, name in loop_names.items())
             + "\n\n" + _kernels.row_tuple("_VALUES", len(model.specs))
             + _tuple_of_lanes(len(model.specs), lanes)
-            + f"@numba.njit(cache=True)\ndef _STORE(out, i, j, d):\n{stores}\n\n"
+            + f"@{_kernels.INNER_JIT}\ndef _STORE(out, i, j, d):\n{stores}\n\n"
             + inspect.getsource(_population_loop)
             # not parallel (its prange a range): the fit asks for one point's Jacobian at a time,
             # and numba's parallel loop over these tuple types costs a third of the compile time
@@ -143,7 +143,7 @@ _compile_locks: dict[tuple[str, int], threading.Lock] = {}
 _locks_lock = threading.Lock()
 _source_sizes: dict[tuple[str, int], int] = {}
 
-COMPILE_SECONDS_PER_KB = 0.17
+COMPILE_SECONDS_PER_KB = 0.11
 """numba's compile time of a generated sensitivity module per kB of its source, on the project's
 2-core VM, fitted to four models' modules (docs/benchmarks.md, "Figures behind the code's
 constants"). An estimate for the progress shown while it compiles."""

@@ -165,7 +165,7 @@ def _population_appendix(model) -> str:
     return ("\n\nimport math\nimport numpy as np\nfrom " + _kernels.integration_module() + " import OK as _OK\n\n"
             + _kernels.row_tuple("_VALUES", len(model.specs))
             + "".join(inspect.getsource(slot) + "\n\n" for slot in FORCES_ONLY)
-            + "".join(f"{slot.__name__} = numba.njit(error_model='numpy', cache=True)({slot.__name__})\n"
+            + "".join(f"{slot.__name__} = {_kernels.INNER_JIT}({slot.__name__})\n"
                       for slot in FORCES_ONLY)
             + "\n\n" + inspect.getsource(_population_loop)
             + "\n\n_simulate_population = numba.njit(error_model='numpy', parallel=True, cache=True)"
