@@ -6,8 +6,10 @@
   exponent and a damping that ramps in over a depth), as the multibody tools' bushing limits;
 - ``pchip_slope``, ``pchip_end_slope``, ``hermite``: the monotone cubic through a measured static
   curve's knots (scipy's PchipInterpolator), for a backbone;
-- ``track_substeps``: the substeps of a hydraulic mount's fluid column (its inertia track) over a
-  step, which both hydraulic models take;
+- the fluid column of a hydraulic mount (its inertia track), which both hydraulic models take:
+  its substeps over a step (``track_substeps``), its decoupler by law (``decoupler_travel``: a
+  membrane or a free plate in a cage), the force and acceleration it gives (``track_force``,
+  ``track_acceleration``) and its Runge-Kutta step (``track_step``);
 - the rate-independent and viscoelastic elements of the filled-rubber models (``berg_model``,
   ``fractional_model``) and the hydraulic mounts: Berg's friction (``friction_force``,
   ``friction_turn``; ``vector_friction_*`` on a displacement vector), an algebraic law of the
@@ -134,6 +136,72 @@ def track_substeps(kb, kc, mf, cf, ct, w, h):
     if not count < 1e9:         # inf or NaN (w not finite, mf vanishing): more than any budget
         return 1_000_000_000
     return max(1, int(math.ceil(count)))
+
+
+MEMBRANE = 0.0
+"""A decoupler law (:func:`decoupler_travel`): a membrane that engages its cage smoothly,
+``(MEMBRANE, gap, stiffness, 0.0, 0.0)``."""
+FREE_PLATE = 1.0
+"""A decoupler law (:func:`decoupler_travel`): a plate free within +-gap, then held by its cage,
+``(FREE_PLATE, K*gap, K*width, kcage/(K*(K + kcage)), 1/K)``."""
+
+
+def decoupler_travel(decoupler, pressure):
+    """u [mm], a hydraulic mount's decoupler travel under the chambers' pressure difference
+    ``pressure`` [N], by its law (``decoupler[0]``; a law is a value, as the kernel language
+    passes no functions):
+
+    - MEMBRANE (law, gap [mm], stiffness K [N/mm], 0, 0): u = gap*tanh(P/(K*gap)), 0 where gap = 0;
+      the tanh written with exp(-2|s|), which never overflows;
+    - FREE_PLATE (law, K*gap [N], K*width [N], kcage/(K*(K + kcage)) [mm/N], 1/K [mm/N]) with K
+      the plate's and the chambers' stiffness: u = P/K within the free travel, less what the
+      cage takes beyond it (:func:`dead_zone` of P, rounded over the width)."""
+    law, a, b, c, d = decoupler
+    if law == MEMBRANE:
+        if a <= 0.0:
+            return 0.0
+        s = pressure / (b * a)
+        e = math.exp(-2.0 * abs(s))
+        return math.copysign(a * (1.0 - e) / (1.0 + e), s)
+    return pressure * d - c * dead_zone(pressure, a, b)
+
+
+def track_force(kb, kc, decoupler, y, x):
+    """(the force kb*(x - y - u) a hydraulic mount's fluid path puts on the mount [N], the pressure
+    difference dp that drives its inertia track [N]) at mount displacement x and fluid displacement
+    y [mm]: bulge stiffness kb and chamber stiffness kc [N/mm], u the ``decoupler``'s travel."""
+    pressure = kb * (x - y) - kc * y
+    u = decoupler_travel(decoupler, pressure)
+    return kb * (x - y - u), pressure - (kb + kc) * u
+
+
+def track_acceleration(kb, kc, mf, cf, ct, decoupler, y, w, x):
+    """dw/dt [mm/s^2] of the fluid column (mass mf [N.s^2/mm], linear and turbulent damping cf
+    [N.s/mm], ct [N.s^2/mm^2]) at fluid displacement y [mm], velocity w [mm/s] and mount
+    displacement x [mm]."""
+    bulge, drive = track_force(kb, kc, decoupler, y, x)
+    return (drive - cf * w - ct * abs(w) * w) / mf
+
+
+def track_step(kb, kc, mf, cf, ct, decoupler, y, w, x, v, h, n):
+    """(y, w) of the fluid column after h [s] of mount travel x + v*t: the classical Runge-Kutta
+    method on ``n`` equal substeps (:func:`track_substeps`), x + v*t exact within each."""
+    s = h / n
+    for i in range(n):
+        x0 = x + v * (i * s)
+        a1 = track_acceleration(kb, kc, mf, cf, ct, decoupler, y, w, x0)
+        y2 = y + 0.5 * s * w
+        w2 = w + 0.5 * s * a1
+        a2 = track_acceleration(kb, kc, mf, cf, ct, decoupler, y2, w2, x0 + 0.5 * s * v)
+        y3 = y + 0.5 * s * w2
+        w3 = w + 0.5 * s * a2
+        a3 = track_acceleration(kb, kc, mf, cf, ct, decoupler, y3, w3, x0 + 0.5 * s * v)
+        y4 = y + s * w3
+        w4 = w + s * a3
+        a4 = track_acceleration(kb, kc, mf, cf, ct, decoupler, y4, w4, x0 + s * v)
+        y = y + s / 6.0 * (w + 2.0 * w2 + 2.0 * w3 + w4)
+        w = w + s / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
+    return y, w
 
 
 def friction_force(limit, half_travel, travel, reversal_force, direction):

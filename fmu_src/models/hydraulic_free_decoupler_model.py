@@ -31,7 +31,8 @@ they mark where the cage engages). The saturating membrane of ``hydraulic_model`
 decoupler kind; with gap = 0 this one is a linear membrane of stiffness kd + kcage.
 
 Units N-mm-s; the state is ``(y, w, f1)`` as in ``hydraulic_model`` (fluid displacement [mm] and
-velocity [mm/s] in the mount's coordinates, the Maxwell force [N]), stepped the same way: the
+velocity [mm/s] in the mount's coordinates, the Maxwell force [N]), stepped by the same kernels
+(``elements.track_step`` with the plate as its decoupler law, ``elements.FREE_PLATE``): the
 Maxwell element exactly, the fluid column by the classical Runge-Kutta method on substeps of at
 most ``elements.THETA_TRACK`` over its fastest rate, which bounds the engaged column's too
 (the plate only softens what the column feels).
@@ -44,7 +45,8 @@ from __future__ import annotations
 import math
 
 from ..model.parameter_specs import SPRING, ParameterSpec
-from ..model.elements import dead_zone, maxwell_decay, maxwell_step, track_substeps
+from ..model.elements import (FREE_PLATE, maxwell_decay, maxwell_step, track_acceleration, track_force,
+                               track_step, track_substeps)
 from ..model.integration import NOT_FINITE, OK, TOO_MANY_SUBSTEPS
 from ..model.definition import BushingModel, SearchBox, SearchCoordinate, StateSpec, TrackStart
 from ..model.search_coordinates import KIND
@@ -70,48 +72,34 @@ PARAMETER_SPECS = (
 
 # ---------------------------------------------------------------------------- kernels
 def prepare(p):
-    """(k0, k3, c0, k1, rate1 = k1/c1, kb, kc, mf, cf, ct, K*gap, W = K*width,
-    kcage/(K*(K + kcage)), 1/K) with K = kb + kc + kd, from the 14 values in ``PARAMETER_SPECS`` order."""
+    """(k0, k3, c0, k1, rate1 = k1/c1, kb, kc, mf, cf, ct, decoupler) from the 14 values in
+    ``PARAMETER_SPECS`` order; the decoupler a free plate (``elements.decoupler_travel``):
+    (FREE_PLATE, K*gap, K*width, kcage/(K*(K + kcage)), 1/K) with K = kb + kc + kd."""
     k0, k3, c0, k1, c1, kb, kc, mf, cf, ct, gap, width, kcage, kd = p
     stiffness = kb + kc + kd
-    return (k0, k3, c0, k1, k1 / c1, kb, kc, mf, cf, ct, stiffness * gap, stiffness * width,
-            kcage / (stiffness * (stiffness + kcage)), 1.0 / stiffness)
-
-
-def track_force(kb, kc, free, width, cage, compliance, y, x):
-    """(the force kb*(x - y - u) the fluid path puts on the mount [N], the pressure difference dp
-    that drives the track [N]) at mount displacement x and fluid displacement y [mm]; ``free``,
-    ``width``, ``cage`` and ``compliance`` are ``prepare``'s K*gap, K*width, kcage/(K*(K + kcage)) and 1/K."""
-    pressure = kb * (x - y) - kc * y
-    u = pressure * compliance - cage * dead_zone(pressure, free, width)
-    return kb * (x - y - u), pressure - (kb + kc) * u
-
-
-def track_acceleration(kb, kc, mf, cf, ct, free, width, cage, compliance, y, w, x):
-    """dw/dt [mm/s^2] of the fluid column at mount displacement x."""
-    bulge, drive = track_force(kb, kc, free, width, cage, compliance, y, x)
-    return (drive - cf * w - ct * abs(w) * w) / mf
+    return (k0, k3, c0, k1, k1 / c1, kb, kc, mf, cf, ct,
+            (FREE_PLATE, stiffness * gap, stiffness * width, kcage / (stiffness * (stiffness + kcage)), 1.0 / stiffness))
 
 
 def initial_state(m, x0):
     """At rest at x0 [mm]: the chambers' pressures equal (P = 0: y = kb*x0/(kb + kc), the plate
     centred), the fluid still, the Maxwell element relaxed."""
-    k0, k3, c0, k1, rate1, kb, kc, mf, cf, ct, free, width, cage, compliance = m
+    k0, k3, c0, k1, rate1, kb, kc, mf, cf, ct, decoupler = m
     return (kb * x0 / (kb + kc), 0.0, 0.0)
 
 
 def force(m, state, x, v):
     """F = k0*x + k3*x^3 + c0*v + f1 + kb*(x - y - u) [N], positive for positive x."""
-    k0, k3, c0, k1, rate1, kb, kc, mf, cf, ct, free, width, cage, compliance = m
+    k0, k3, c0, k1, rate1, kb, kc, mf, cf, ct, decoupler = m
     y, w, f1 = state
-    bulge, drive = track_force(kb, kc, free, width, cage, compliance, y, x)
+    bulge, drive = track_force(kb, kc, decoupler, y, x)
     return k0 * x + k3 * x * x * x + c0 * v + f1 + bulge
 
 
 def jump(m, state, jump_mm):
     """An instantaneous displacement jump: the fluid cannot move in no time (its mass) and the
     plate follows the pressure (it is massless); the Maxwell spring takes the jump."""
-    k0, k3, c0, k1, rate1, kb, kc, mf, cf, ct, free, width, cage, compliance = m
+    k0, k3, c0, k1, rate1, kb, kc, mf, cf, ct, decoupler = m
     y, w, f1 = state
     return (y, w, f1 + k1 * jump_mm), OK
 
@@ -119,26 +107,12 @@ def jump(m, state, jump_mm):
 def integrate(m, state, x, v, h, max_substeps):
     """Over the step x + v*t: the Maxwell force exactly, the fluid column by the classical
     Runge-Kutta method on equal substeps (module docstring); returns (state, substeps, status)."""
-    k0, k3, c0, k1, rate1, kb, kc, mf, cf, ct, free, width, cage, compliance = m
+    k0, k3, c0, k1, rate1, kb, kc, mf, cf, ct, decoupler = m
     y, w, f1 = state
     n = track_substeps(kb, kc, mf, cf, ct, w, h)
     if n > max_substeps:
         return state, n, TOO_MANY_SUBSTEPS
-    s = h / n
-    for i in range(n):
-        x0 = x + v * (i * s)
-        a1 = track_acceleration(kb, kc, mf, cf, ct, free, width, cage, compliance, y, w, x0)
-        y2 = y + 0.5 * s * w
-        w2 = w + 0.5 * s * a1
-        a2 = track_acceleration(kb, kc, mf, cf, ct, free, width, cage, compliance, y2, w2, x0 + 0.5 * s * v)
-        y3 = y + 0.5 * s * w2
-        w3 = w + 0.5 * s * a2
-        a3 = track_acceleration(kb, kc, mf, cf, ct, free, width, cage, compliance, y3, w3, x0 + 0.5 * s * v)
-        y4 = y + s * w3
-        w4 = w + s * a3
-        a4 = track_acceleration(kb, kc, mf, cf, ct, free, width, cage, compliance, y4, w4, x0 + s * v)
-        y = y + s / 6.0 * (w + 2.0 * w2 + 2.0 * w3 + w4)
-        w = w + s / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
+    y, w = track_step(kb, kc, mf, cf, ct, decoupler, y, w, x, v, h, n)
     new = (y, w, maxwell_step(f1, k1, maxwell_decay(rate1, h), v, h))
     if not (math.isfinite(new[0]) and math.isfinite(new[1]) and math.isfinite(new[2])):
         return new, n, NOT_FINITE
@@ -147,14 +121,15 @@ def integrate(m, state, x, v, h, max_substeps):
 
 def derivatives(m, state, x, v):
     """(dy/dt, dw/dt, df1/dt) [mm/s, mm/s^2, N/s] (model exchange)."""
-    k0, k3, c0, k1, rate1, kb, kc, mf, cf, ct, free, width, cage, compliance = m
+    k0, k3, c0, k1, rate1, kb, kc, mf, cf, ct, decoupler = m
     y, w, f1 = state
-    return (w, track_acceleration(kb, kc, mf, cf, ct, free, width, cage, compliance, y, w, x), k1 * v - rate1 * f1)
+    return (w, track_acceleration(kb, kc, mf, cf, ct, decoupler, y, w, x), k1 * v - rate1 * f1)
 
 
 def switches(m, state, x, v):
     """(P - K*gap, P + K*gap) [N]: where either changes sign the plate meets or leaves its cage."""
-    k0, k3, c0, k1, rate1, kb, kc, mf, cf, ct, free, width, cage, compliance = m
+    k0, k3, c0, k1, rate1, kb, kc, mf, cf, ct, decoupler = m
+    law, free, width, cage, compliance = decoupler
     y, w, f1 = state
     pressure = kb * (x - y) - kc * y
     return (pressure - free, pressure + free)

@@ -34,7 +34,8 @@ complex stiffness
 
 Units N-mm-s; the state is ``(y, w, f1)``: the fluid column's displacement [mm] and velocity
 [mm/s] and the Maxwell force [N]. How it is stepped: the Maxwell element exactly
-(``elements.maxwell_step``); the fluid column by the classical Runge-Kutta method on
+(``elements.maxwell_step``); the fluid column by the classical Runge-Kutta method
+(``elements.track_step``, which the free decoupler's model shares) on
 substeps of at most ``elements.THETA_TRACK`` over its fastest rate (its natural frequency plus its damping
 rate), with x + v*t exact within each: the column's equations are not stiff (the decoupler is
 algebraic), so a 1 ms step at a 10 Hz track takes one substep.
@@ -48,7 +49,8 @@ from __future__ import annotations
 import math
 
 from ..model.parameter_specs import DAMPING, SPRING, ParameterSpec
-from ..model.elements import maxwell_decay, maxwell_step, track_substeps
+from ..model.elements import (MEMBRANE, maxwell_decay, maxwell_step, track_acceleration, track_force, track_step,
+                               track_substeps)
 from ..model.integration import NOT_FINITE, OK, TOO_MANY_SUBSTEPS
 from ..model.definition import BushingModel, SearchBox, SearchCoordinate, StateSpec, TrackStart
 from ..model.search_coordinates import KIND
@@ -79,55 +81,32 @@ PARAMETER_SPECS = (
 
 # ---------------------------------------------------------------------------- kernels
 def prepare(p):
-    """(k0, c0, k1, rate1 = k1/c1, kb, kc, mf, cf, ct, gap, kd) from the 11 values in ``PARAMETER_SPECS`` order."""
+    """(k0, c0, k1, rate1 = k1/c1, kb, kc, mf, cf, ct, decoupler) from the 11 values in
+    ``PARAMETER_SPECS`` order; the decoupler a membrane (``elements.decoupler_travel``):
+    (MEMBRANE, gap, kb + kc + kd, 0, 0)."""
     k0, c0, k1, c1, kb, kc, mf, cf, ct, gap, kd = p
-    return (k0, c0, k1, k1 / c1, kb, kc, mf, cf, ct, gap, kd)
-
-
-def decoupler_travel(gap, stiffness, pressure):
-    """u = gap*tanh(pressure/(stiffness*gap)) [mm], the decoupler's travel under the chambers'
-    pressure difference [N] (``stiffness`` = kb + kc + kd [N/mm]); 0 where gap = 0. The tanh is
-    written with exp(-2|s|), which never overflows."""
-    if gap <= 0.0:
-        return 0.0
-    s = pressure / (stiffness * gap)
-    e = math.exp(-2.0 * abs(s))
-    return math.copysign(gap * (1.0 - e) / (1.0 + e), s)
-
-
-def track_force(kb, kc, gap, kd, y, x):
-    """(the force kb*(x - y - u) the fluid path puts on the mount [N], the pressure difference dp
-    that drives the track [N]) at mount displacement x and fluid displacement y [mm]."""
-    pressure = kb * (x - y) - kc * y
-    u = decoupler_travel(gap, kb + kc + kd, pressure)
-    return kb * (x - y - u), pressure - (kb + kc) * u
-
-
-def track_acceleration(kb, kc, mf, cf, ct, gap, kd, y, w, x):
-    """dw/dt [mm/s^2] of the fluid column at mount displacement x."""
-    bulge, drive = track_force(kb, kc, gap, kd, y, x)
-    return (drive - cf * w - ct * abs(w) * w) / mf
+    return (k0, c0, k1, k1 / c1, kb, kc, mf, cf, ct, (MEMBRANE, gap, kb + kc + kd, 0.0, 0.0))
 
 
 def initial_state(m, x0):
     """At rest at x0 [mm]: the chambers' pressures equal (P = 0: y = kb*x0/(kb + kc), the
     decoupler centred), the fluid still, the Maxwell element relaxed."""
-    k0, c0, k1, rate1, kb, kc, mf, cf, ct, gap, kd = m
+    k0, c0, k1, rate1, kb, kc, mf, cf, ct, decoupler = m
     return (kb * x0 / (kb + kc), 0.0, 0.0)
 
 
 def force(m, state, x, v):
     """F = k0*x + c0*v + f1 + kb*(x - y - u) [N], positive for positive x."""
-    k0, c0, k1, rate1, kb, kc, mf, cf, ct, gap, kd = m
+    k0, c0, k1, rate1, kb, kc, mf, cf, ct, decoupler = m
     y, w, f1 = state
-    bulge, drive = track_force(kb, kc, gap, kd, y, x)
+    bulge, drive = track_force(kb, kc, decoupler, y, x)
     return k0 * x + c0 * v + f1 + bulge
 
 
 def jump(m, state, jump_mm):
     """An instantaneous displacement jump: the fluid cannot move in no time (its mass) and the
     decoupler follows the pressure (it is algebraic); the Maxwell spring takes the jump."""
-    k0, c0, k1, rate1, kb, kc, mf, cf, ct, gap, kd = m
+    k0, c0, k1, rate1, kb, kc, mf, cf, ct, decoupler = m
     y, w, f1 = state
     return (y, w, f1 + k1 * jump_mm), OK
 
@@ -135,26 +114,12 @@ def jump(m, state, jump_mm):
 def integrate(m, state, x, v, h, max_substeps):
     """Over the step x + v*t: the Maxwell force exactly, the fluid column by the classical
     Runge-Kutta method on equal substeps (module docstring); returns (state, substeps, status)."""
-    k0, c0, k1, rate1, kb, kc, mf, cf, ct, gap, kd = m
+    k0, c0, k1, rate1, kb, kc, mf, cf, ct, decoupler = m
     y, w, f1 = state
     n = track_substeps(kb, kc, mf, cf, ct, w, h)
     if n > max_substeps:
         return state, n, TOO_MANY_SUBSTEPS
-    s = h / n
-    for i in range(n):
-        x0 = x + v * (i * s)
-        a1 = track_acceleration(kb, kc, mf, cf, ct, gap, kd, y, w, x0)
-        y2 = y + 0.5 * s * w
-        w2 = w + 0.5 * s * a1
-        a2 = track_acceleration(kb, kc, mf, cf, ct, gap, kd, y2, w2, x0 + 0.5 * s * v)
-        y3 = y + 0.5 * s * w2
-        w3 = w + 0.5 * s * a2
-        a3 = track_acceleration(kb, kc, mf, cf, ct, gap, kd, y3, w3, x0 + 0.5 * s * v)
-        y4 = y + s * w3
-        w4 = w + s * a3
-        a4 = track_acceleration(kb, kc, mf, cf, ct, gap, kd, y4, w4, x0 + s * v)
-        y = y + s / 6.0 * (w + 2.0 * w2 + 2.0 * w3 + w4)
-        w = w + s / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
+    y, w = track_step(kb, kc, mf, cf, ct, decoupler, y, w, x, v, h, n)
     new = (y, w, maxwell_step(f1, k1, maxwell_decay(rate1, h), v, h))
     if not (math.isfinite(new[0]) and math.isfinite(new[1]) and math.isfinite(new[2])):
         return new, n, NOT_FINITE
@@ -163,9 +128,9 @@ def integrate(m, state, x, v, h, max_substeps):
 
 def derivatives(m, state, x, v):
     """(dy/dt, dw/dt, df1/dt) [mm/s, mm/s^2, N/s] (model exchange)."""
-    k0, c0, k1, rate1, kb, kc, mf, cf, ct, gap, kd = m
+    k0, c0, k1, rate1, kb, kc, mf, cf, ct, decoupler = m
     y, w, f1 = state
-    return (w, track_acceleration(kb, kc, mf, cf, ct, gap, kd, y, w, x), k1 * v - rate1 * f1)
+    return (w, track_acceleration(kb, kc, mf, cf, ct, decoupler, y, w, x), k1 * v - rate1 * f1)
 
 
 def switches(m, state, x, v):

@@ -84,15 +84,15 @@ def test_the_rounded_cage_tends_to_the_hard_cage_solved_by_brentq():
     # the model's plate travel (its fluid-path force, read back) against the hard cage's balance
     # solved by brentq, over pressures inside and far beyond the free travel: the rounding moves the
     # plate by at most log(2)*kcage/(K + kcage)*width (where the softplus is log 2 off its corner)
-    from fmu_src.models.hydraulic_free_decoupler_model import track_force
+    from fmu_src.model.elements import track_force
     pressures = np.linspace(-400.0, 400.0, 801)
     hard = np.array([mount.plate_travel(HARD, pressure) for pressure in pressures])
     K = HARD["kb"] + HARD["kc"] + HARD["kd"]
     for width in (1e-2, 1e-3, 1e-5, 0.0):
         constants = MODELS[MODEL].constants(dict(HARD, width=width))
-        kb, kc, free, rounding, cage, compliance = constants[5], constants[6], *constants[10:]
+        kb, kc, decoupler = constants[5], constants[6], constants[10]
         x = pressures / kb                                    # y = 0: P = kb*x
-        travel = np.array([x_i - track_force(kb, kc, free, rounding, cage, compliance, 0.0, x_i)[0] / kb for x_i in x])
+        travel = np.array([x_i - track_force(kb, kc, decoupler, 0.0, x_i)[0] / kb for x_i in x])
         bound = np.log(2.0) * HARD["kcage"] / (K + HARD["kcage"]) * width
         assert np.max(np.abs(travel - hard)) <= bound * (1.0 + 1e-6) + 1e-13, width
 
