@@ -77,11 +77,10 @@ def test_compiled_forces_equal_the_python_kernels_bitwise_for_every_model(model)
 
 CACHE_PROBE = """
 import numpy as np
-from fmu_src.models.proposed_model import PARAMETER_NAMES
 from identification.forward import population as compiled_core
 t = np.linspace(0.0, 0.02, 21)
-compiled_core.simulate_population_held([dict(zip(PARAMETER_NAMES, [1.0] * 16))], t, t, np.ones_like(t))
-module = compiled_core.compiled_model("proposed")
+compiled_core.simulate_population_held([{"k": 1.0, "c": 1.0, "preload": 0.0}], t, t, np.ones_like(t), model="kelvin_voigt")
+module = compiled_core.compiled_model("kelvin_voigt")
 stats = module._simulate_population.stats
 print(module.__file__, len(stats.cache_hits), len(stats.cache_misses))
 """
