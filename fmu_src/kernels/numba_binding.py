@@ -50,6 +50,7 @@ import inspect
 import math
 import ntpath
 import os
+import re
 import sys
 import time
 import types
@@ -109,8 +110,10 @@ def module_name(prefix: str, source: str) -> str:
     """``prefix`` and a hash of ``source`` and the compiler versions: the one key of a generated
     module and of numba's cache of it (a changed model, machinery, template or compiler compiles
     afresh; anything else that changes no generated source, such as a docstring outside the
-    kernel modules, does not)."""
-    return f"{prefix}_{hashlib.sha256((compiler_versions() + chr(10) + source).encode()).hexdigest()[:16]}"
+    kernel modules, does not). An identifier (a derived model's "+" written "_"), so that another
+    generated module can import it by name."""
+    digest = hashlib.sha256((compiler_versions() + chr(10) + source).encode()).hexdigest()[:16]
+    return re.sub(r"\W", "_", f"{prefix}_{digest}")
 
 
 def _numba():
@@ -392,6 +395,13 @@ def _fmu_appendix(model) -> str:
             + "\n\n_step_one = numba.njit(error_model='numpy', cache=True)(_step_one)\n")
 
 
+def kernel_module(model) -> types.ModuleType:
+    """The model's compiled module: its kernels and the FMU's batched step (:func:`_fmu_appendix`),
+    loaded, each function compiled at its first call. The one compiled copy of a model's kernels:
+    the FMU runs it, and the identification's population loops import their kernels from it."""
+    return compiled_module(model, _fmu_appendix(model), prefix="bushing_kernels")
+
+
 def compiled_model(model):
     """({name: compiled kernel} for COMPILED_IN_FMU, "step_axes" and "step_one", seconds it took) —
     compiling now, or loading numba's cached machine code — or (None, why not) if numba cannot
@@ -402,7 +412,7 @@ def compiled_model(model):
         return None, f"numba is not importable here ({type(exc).__name__}: {exc})"
     import numpy as np
     started = time.perf_counter()
-    module = compiled_module(model, _fmu_appendix(model), prefix="bushing_fmu")
+    module = kernel_module(model)
     kernels = {name: getattr(module, name) for name in COMPILED_IN_FMU}
     kernels["step_axes"], kernels["step_one"] = module._step_axes, module._step_one
     # compile (or load) now, so that a first step does not wait: the constants and state the

@@ -2,8 +2,9 @@
 
 One definition. Each model's own source (``fmu_src/models/<name>_model.py``) is compiled by
 ``fmu_src/kernels/numba_binding.py`` (a generated module named after its content, in the cache
-folder, its kernels and the shared machinery compiled), with the population loop below
-appended. The FMU runs the same functions, as plain Python or compiled the same way;
+folder, its kernels and the shared machinery compiled: ``kernel_module``); the population loops
+below are compiled in a generated module of their own that imports the kernels from it. The FMU
+runs the same functions, as plain Python or compiled in that same module;
 ``tests/fmu_src/kernels/test_compiled_core.py`` checks the two agree bitwise for every model. Compilation
 takes a few seconds on a model's first use; numba caches the machine code on disk, so later
 processes load it.
@@ -41,14 +42,14 @@ def _population_loop(matrix, seeds, t, x, v, out_index, out_velocity, max_subste
     k has: the step's constants (``prepare_step``) are made once per candidate and step size
     (empty: at every step). A candidate that fails gets NaN from there on.
 
-    Written here, never called here: its source is compiled in each model's generated module,
-    where its slots are bound to what it carries. Each slot returns a value and its derivative:
+    Written here, never called here: its source is compiled in a generated module for each
+    model, where its slots are bound to what it carries. Each slot returns a value and its derivative:
     ``_PREPARE(values, d_values)``, ``_INITIAL(m, x0, d_m)``, ``_PREPARE_STEP(m, h, d_m)``,
     ``_STEP(m, ms, state, state_x, x, v, h, max_substeps, d_m, d_ms, d_state)`` (the step
     protocol, ``integration.step_prepared``), ``_FORCE(m, state, x, v, d_m, d_state)``;
     ``_VALUES(row)`` is the row as ``prepare``'s tuple, ``_SEEDS(seeds, i)`` row i's derivatives in
     the same layout and ``_STORE(out, i, j, d)`` stores a force's. The forces alone
-    (:func:`_population_appendix`) bind the model's kernels with empty derivatives; the
+    (:func:`_population_source`) bind the model's kernels with empty derivatives; the
     Jacobian's bind their generated tangents (``parameter_jacobian``). The forces are the same bits."""
     count, samples, outputs = matrix.shape[0], t.size, out_index.size
     forces = np.full((count, outputs), np.nan)
@@ -158,12 +159,21 @@ def _coupled_population_forces(matrix, t, x, v, out_index, out_velocity, max_sub
     return forces
 
 
-def _population_appendix(model) -> str:
-    """The population loops for ``model``: ``_VALUES(row)`` (the row's values as the tuple its
-    ``prepare`` takes), the forces-only slots, ``_simulate_population`` and ``_sine_steady_state``
-    (``identification.forward.steady_state``)."""
-    return ("\n\nimport math\nimport numpy as np\nfrom " + _kernels.integration_module() + " import OK as _OK\n\n"
-            + _kernels.row_tuple("_VALUES", len(model.specs))
+KERNELS = ("prepare", "initial_state", "prepare_step", "step_prepared", "force", "_VALUES")
+"""What the population loops take from a model's compiled module (``numba_binding.kernel_module``;
+``_VALUES(row)``: the row's values as the tuple ``prepare`` takes)."""
+COUPLED_KERNELS = ("initial_state_coupled", "step_coupled", "force_coupled")
+"""What the coupled population loop takes besides, from a coupled model's."""
+
+
+def _population_source(model) -> str:
+    """The population loops for ``model``, as the source of a module of their own: the forces-only
+    slots, ``_simulate_population``, ``_sine_steady_state`` (``identification.forward.steady_state``)
+    and for a coupled model ``_simulate_coupled_population``; the kernels imported from the model's
+    compiled module, which the FMU runs too (one compiled copy of them)."""
+    kernels = (*KERNELS, *(COUPLED_KERNELS if model.coupled is not None else ()))
+    return ("import math\nimport numpy as np\nfrom " + _kernels.integration_module() + " import OK as _OK\n"
+            + f"from {_kernels.kernel_module(model).__name__} import {', '.join(kernels)}\n\n\n"
             + "".join(inspect.getsource(slot) + "\n\n" for slot in FORCES_ONLY)
             + "".join(f"{slot.__name__} = {_kernels.INNER_JIT}({slot.__name__})\n"
                       for slot in FORCES_ONLY)
@@ -188,10 +198,12 @@ _compiled_models: dict[str, types.ModuleType] = {}
 
 
 def compiled_model(model: str | BushingModel = DEFAULT_MODEL) -> types.ModuleType:
-    """The generated, compiled module of ``model`` with the population loop (loaded on first use)."""
+    """The generated, compiled module of ``model``'s population loops (loaded on first use)."""
     bushing = resolve_model(model)
     if bushing.name not in _compiled_models:
-        _compiled_models[bushing.name] = _kernels.compiled_module(bushing, _population_appendix(bushing))
+        source = _population_source(bushing)
+        _compiled_models[bushing.name] = _kernels.load_generated(
+            _kernels.module_name(f"bushing_population_{bushing.name}", source), source)
     return _compiled_models[bushing.name]
 
 

@@ -30,10 +30,8 @@ def test_the_unbound_names_of_a_template_are_found_and_nothing_else():
 def test_a_generated_module_whose_template_reads_an_unbound_name_is_refused_at_generation(monkeypatch, tmp_path):
     monkeypatch.setenv(compiled_kernels.CACHE_ENVIRONMENT, str(tmp_path))
     model = get_model("single_bouc_wen")
-    machinery = compiled_kernels.integration_module()
-    appendix = compiled_core._population_appendix(model).replace("_STORE(sensitivities, i, 0, d_f)",
-                                                                  "_STORE_FORCE(sensitivities, i, 0, d_f)")
-    source = compiled_kernels.model_source(model, machinery, appendix)
+    source = compiled_core._population_source(model).replace("_STORE(sensitivities, i, 0, d_f)",
+                                                             "_STORE_FORCE(sensitivities, i, 0, d_f)")
     name = compiled_kernels.module_name("bushing_probe", source)
     with pytest.raises(GenerationError, match=r"_population_loop \(line \d+\) reads '_STORE_FORCE'"):
         compiled_kernels.load_generated(name, source)
@@ -45,9 +43,10 @@ def test_every_models_generated_modules_bind_every_name_they_read():
     machinery = compiled_kernels.integration_module()
     for name in ("proposed", "berg", "fractional", "kelvin_voigt"):
         model = get_model(name)
-        for appendix in (compiled_core._population_appendix(model), compiled_kernels._fmu_appendix(model),
-                         fit_jacobian._appendix(model, 2, machinery)):
-            unbound = unbound_names(compiled_kernels.model_source(model, machinery, appendix))
+        for source in (compiled_core._population_source(model),
+                       *(compiled_kernels.model_source(model, machinery, appendix)
+                         for appendix in (compiled_kernels._fmu_appendix(model), fit_jacobian._appendix(model, 2, machinery)))):
+            unbound = unbound_names(source)
             assert [found for found in unbound if found[2] not in compiled_kernels.INJECTED] == [], name
 
 
@@ -59,9 +58,9 @@ def test_a_generated_module_names_no_package_so_every_fmu_shares_it():
     machinery = compiled_kernels.integration_module()
     for name in ("proposed", "fractional", "hydraulic_free_decoupler", "single_bouc_wen+backbone4+limits+rig"):
         model = get_model(name)
-        for appendix in (compiled_core._population_appendix(model), compiled_kernels._fmu_appendix(model),
-                         fit_jacobian._appendix(model, 2, machinery)):
-            source = compiled_kernels.model_source(model, machinery, appendix)
+        for source in (compiled_core._population_source(model),
+                       *(compiled_kernels.model_source(model, machinery, appendix)
+                         for appendix in (compiled_kernels._fmu_appendix(model), fit_jacobian._appendix(model, 2, machinery)))):
             imported = [node.module for node in ast.walk(ast.parse(source)) if isinstance(node, ast.ImportFrom)]
             assert not [module for module in imported if module.startswith("fmu_src")], name
             assert "ParameterSpec(" not in source and "MODEL =" not in source, name
@@ -71,3 +70,13 @@ def test_a_generated_module_names_no_package_so_every_fmu_shares_it():
     # what stays at the top besides functions and imports: constants written in as values
     values = [node.value for node in tree.body if isinstance(node, (ast.Assign, ast.AnnAssign))]
     assert values and all(isinstance(value, (ast.Constant, ast.Tuple, ast.UnaryOp)) for value in values)
+
+
+def test_the_population_loops_take_the_kernels_the_fmu_runs():
+    """One compiled copy of a model's kernels: the population loops' module imports them from the
+    model's compiled module, which the FMU runs, instead of compiling them again."""
+    for name in ("kelvin_voigt", "single_bouc_wen+backbone4+limits+rig"):
+        model = get_model(name)
+        population, kernels = compiled_core.compiled_model(model), compiled_kernels.kernel_module(model)
+        for kernel in compiled_core.KERNELS:
+            assert getattr(population, kernel) is getattr(kernels, kernel), (name, kernel)
