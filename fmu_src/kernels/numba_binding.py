@@ -35,8 +35,10 @@ anything else):
   ``BushingModel`` runs when a model is defined).
 
 Users: the FMU (:func:`compiled_model`, when numba is importable in the host's Python; the slave
-falls back to the plain-Python kernels otherwise) and the identification
-(``identification/forward/population.py``, which appends its population loop). Numba is optional
+falls back to the plain-Python kernels otherwise) and the identification, whose population loops
+(``identification/forward/population.py``) live in a generated module of their own that imports
+the kernels from the FMU's (:func:`kernel_module`: one compiled copy of them); its exact
+Jacobian's tangents (``parameter_jacobian``) are appended to a model's module. Numba is optional
 here: nothing imports it until a model is compiled.
 """
 from __future__ import annotations
@@ -121,6 +123,10 @@ def _numba():
     return numba
 
 
+_UNWRITABLE_WARNED: set[str] = set()
+"""The cache folders this process has said it cannot write."""
+
+
 def load_generated(name: str, source: str, check: bool = True) -> types.ModuleType:
     """The module ``name`` with ``source``, written to the cache folder and imported (once per
     process), with :data:`INJECTED` bound; in memory, uncached, if the folder cannot be written.
@@ -143,8 +149,10 @@ def load_generated(name: str, source: str, check: bool = True) -> types.ModuleTy
             partial.write_text(source)
             os.replace(partial, path)
     except OSError as exc:
-        warnings.warn(f"cannot write the compiled model's cache in {cache_directory()} ({exc}); compiling "
-                      f"in memory at every start (set {CACHE_ENVIRONMENT} to a writable folder)", stacklevel=4)
+        if str(cache_directory()) not in _UNWRITABLE_WARNED:     # said once a process, not once a module
+            _UNWRITABLE_WARNED.add(str(cache_directory()))
+            warnings.warn(f"cannot write the compiled model's cache in {cache_directory()} ({exc}); compiling "
+                          f"in memory at every start (set {CACHE_ENVIRONMENT} to a writable folder)", stacklevel=4)
         if check:
             check_bound_names(source, name, INJECTED)
         module = types.ModuleType(name)
@@ -310,12 +318,6 @@ _COUPLED_STEP = ("\n\n" + inspect.getsource(integration.step_coupled)
 (``definition.CoupledKernels`` checks that they are the model's)."""
 
 
-def compiled_module(model, appendix: str = "", prefix: str = "bushing") -> types.ModuleType:
-    """The generated, compiled module of ``model`` with ``appendix`` (loaded once per process)."""
-    source = model_source(model, integration_module(), appendix)
-    return load_generated(module_name(f"{prefix}_{model.name}", source), source)
-
-
 COMPILED_IN_FMU = ("jump", "integrate")
 """The kernels an FMU runs compiled one axis at a time (the plain-Python step's fallback for the
 message of a failed step). force() is a few multiplications, which plain Python does faster than
@@ -399,7 +401,8 @@ def kernel_module(model) -> types.ModuleType:
     """The model's compiled module: its kernels and the FMU's batched step (:func:`_fmu_appendix`),
     loaded, each function compiled at its first call. The one compiled copy of a model's kernels:
     the FMU runs it, and the identification's population loops import their kernels from it."""
-    return compiled_module(model, _fmu_appendix(model), prefix="bushing_kernels")
+    source = model_source(model, integration_module(), _fmu_appendix(model))
+    return load_generated(module_name(f"bushing_kernels_{model.name}", source), source)
 
 
 def compiled_model(model):

@@ -190,17 +190,19 @@ def characterise(parameters, amplitudes_mm: Sequence[float] = DEFAULT_AMPLITUDES
     from identification.forward.parameter_sets import parameter_sets
     loop = SteadyStateLoop(**loop)
     bushing, sets = parameter_sets(parameters, model)
-    return data_sheet(bushing, sets, amplitudes_mm, frequencies_hz, preload_mm, loop)
+    return data_sheet(bushing, sets, amplitudes_mm, frequencies_hz, preload_mm, loop, stacklevel=3)
 
 
 def data_sheet(bushing: BushingModel, sets: list[dict[str, float]], amplitudes_mm: Sequence[float],
-               frequencies_hz: Sequence[float], preload_mm: float, loop: SteadyStateLoop) -> DynamicStiffness:
+               frequencies_hz: Sequence[float], preload_mm: float, loop: SteadyStateLoop,
+               stacklevel: int = 2) -> DynamicStiffness:
     """``characterise`` of parameter sets already read and checked (``parameter_sets``): the
     model, its sets (paper's N-mm-s units, best first), the grid [mm], [Hz], the preload [mm]
-    and the loop's settings. For a caller that holds them, such as a fit."""
+    and the loop's settings. For a caller that holds them, such as a fit. ``stacklevel``: the
+    frame its warnings name, as ``warnings.warn`` counts (2: the caller)."""
     from identification.forward.population import parameter_matrix
-    amplitudes = _grid_values(amplitudes_mm, "amplitude", "mm", PLAUSIBLE_AMPLITUDE_MM)
-    frequencies = _grid_values(frequencies_hz, "frequency", "Hz", PLAUSIBLE_FREQUENCY_HZ)
+    amplitudes = _grid_values(amplitudes_mm, "amplitude", "mm", PLAUSIBLE_AMPLITUDE_MM, stacklevel + 1)
+    frequencies = _grid_values(frequencies_hz, "frequency", "Hz", PLAUSIBLE_FREQUENCY_HZ, stacklevel + 1)
     _check_loop(preload_mm, loop)
     loop = SteadyStateLoop(int(loop.steps_per_cycle), int(loop.max_cycles), loop.tolerance, loop.max_substeps)
     case_amplitude = np.repeat(amplitudes, frequencies.size)
@@ -220,9 +222,9 @@ def data_sheet(bushing: BushingModel, sets: list[dict[str, float]], amplitudes_m
                      case_frequency, float(preload_mm)) for k in runs]
     if len(runs) < members:
         warnings.warn(f"{members - len(runs)} of the {members} ensemble members fail on some case (overflow or too many "
-                      "substeps) and are left out of the min/max columns", CharacterisationWarning, stacklevel=3)
+                      "substeps) and are left out of the min/max columns", CharacterisationWarning, stacklevel=stacklevel)
     best = tables[0]
-    _warn_unsteady(tables, case_amplitude, case_frequency, loop.max_cycles, loop.tolerance)
+    _warn_unsteady(tables, case_amplitude, case_frequency, loop, stacklevel + 1)
     table = DynamicStiffness(case_amplitude, case_frequency, np.full(cases, float(preload_mm)),
                              **{name: best[name] for name in RESULT_COLUMNS}, cycles=best["cycles"],
                              converged=best["converged"], loop_force_N=best["loop"], model=bushing.name,
@@ -246,19 +248,21 @@ def _check_loop(preload_mm: float, loop: SteadyStateLoop) -> None:
         raise IdentificationError(f"max_cycles = {max_cycles}: give an integer >= {MIN_CYCLES}")
 
 
-def _warn_unsteady(tables, case_amplitude, case_frequency, max_cycles: int, tolerance: float) -> None:
-    """A CharacterisationWarning, at ``characterise``'s caller, for the best set's cases and the
-    ensemble members that reached no steady state within ``max_cycles``."""
+def _warn_unsteady(tables, case_amplitude, case_frequency, loop: SteadyStateLoop, stacklevel: int) -> None:
+    """A CharacterisationWarning, at the frame ``stacklevel`` names, for the best set's cases and
+    the ensemble members that reached no steady state within the loop's ``max_cycles``."""
+    max_cycles, tolerance = loop.max_cycles, loop.tolerance
     not_steady = ~tables[0]["converged"]
     if not_steady.any():
         listed = ", ".join(f"{case_amplitude[i]:g} mm/{case_frequency[i]:g} Hz" for i in np.flatnonzero(not_steady))
         warnings.warn(f"no steady state within {max_cycles} cycles for {listed}: the first harmonic still changes by "
                       f"more than {tolerance:g} per cycle; these rows are the last cycle's (raise max_cycles)",
-                      CharacterisationWarning, stacklevel=4)
+                      CharacterisationWarning, stacklevel=stacklevel)
     unsteady_members = sum(not t["converged"].all() for t in tables[1:])
     if unsteady_members:
         warnings.warn(f"{unsteady_members} ensemble member(s) reach no steady state within {max_cycles} cycles on some "
-                      "case; their last cycle is in the min/max columns", CharacterisationWarning, stacklevel=4)
+                      "case; their last cycle is in the min/max columns", CharacterisationWarning,
+                      stacklevel=stacklevel)
 
 
 def run_sines(matrix: np.ndarray, model: str | BushingModel, amplitude_mm: np.ndarray, frequency_hz: np.ndarray,
@@ -304,7 +308,7 @@ def _table(result: np.ndarray, last: np.ndarray, amplitude: np.ndarray, frequenc
             "converged": result[:, 3] == 0, "loop": last.copy()}
 
 
-def _grid_values(values, what: str, unit: str, plausible: float) -> np.ndarray:
+def _grid_values(values, what: str, unit: str, plausible: float, stacklevel: int) -> np.ndarray:
     array = np.atleast_1d(np.asarray(values, dtype=float))
     if array.ndim != 1 or array.size == 0:
         raise IdentificationError(f"give at least one {what} [{unit}]")
@@ -315,5 +319,5 @@ def _grid_values(values, what: str, unit: str, plausible: float) -> np.ndarray:
         raise IdentificationError(f"{what}s {array.tolist()} {unit}: a value is repeated")
     if np.any(array > plausible):
         warnings.warn(f"{what} {float(np.max(array)):g} {unit} is above {plausible:g} {unit}, outside what bushing "
-                      "tests use: check the unit", CharacterisationWarning, stacklevel=4)
+                      "tests use: check the unit", CharacterisationWarning, stacklevel=stacklevel)
     return array

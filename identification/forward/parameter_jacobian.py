@@ -171,7 +171,7 @@ def _generated_module(model: BushingModel, lanes: int) -> types.ModuleType:
 def sensitivity_module(model: str | BushingModel, lanes: int) -> types.ModuleType:
     """The generated module of ``model`` with the forces' sensitivities in ``lanes`` directions,
     its population loop compiled (or loaded from numba's disk cache) by a first call on a
-    two-sample input: once per process. The first process on a machine compiles (about 90 s for
+    two-sample input: once per process. The first process on a machine compiles (about 25 s for
     the proposed model's 14 directions: every tangent statement is written 14 times); later ones
     generate the source again and load the machine code."""
     bushing = resolve_model(model)

@@ -1,9 +1,10 @@
 """The sine steady-state loop of the dynamic-stiffness characterisation, compiled per model.
 
 :func:`_sine_steady_state` is written here and never called here: like the population loop of
-``population``, its source is appended to each model's generated module, where ``prepare``,
-``prepare_step``, ``step_prepared`` (``fmu_src.model.integration``) and ``force`` are that model's
-compiled kernels and ``_VALUES(row)`` a parameter row's values; the step's constants are made once
+``population``, its source is compiled in each model's generated population module, where
+``prepare``, ``prepare_step``, ``step_prepared`` (``fmu_src.model.integration``) and ``force`` are
+that model's compiled kernels (imported from ``numba_binding.kernel_module``) and ``_VALUES(row)``
+a parameter row's values; the step's constants are made once
 per case, whose steps all have the same size.
 
 Per item (a parameter set and one sine x = P + X*sin(2*pi*f*t)): the bushing starts in relaxed

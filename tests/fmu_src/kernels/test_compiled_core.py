@@ -107,6 +107,37 @@ def test_the_compiled_model_is_cached_on_disk_for_the_next_process(tmp_path):
     assert run_cache_probe(tmp_path) == (path, 1, 0)   # ... the next one loads the machine code
 
 
+UNWRITABLE_PROBE = """
+import warnings
+import numpy as np
+from identification.forward import population as compiled_core
+t = np.linspace(0.0, 0.02, 21)
+with warnings.catch_warnings(record=True) as caught:
+    warnings.simplefilter("always")
+    forces = compiled_core.simulate_population_held([{"k": 2.0, "c": 0.0, "preload": 0.0}], t, t, np.ones_like(t),
+                                                    model="kelvin_voigt")
+print(repr(float(forces[0, -1])), len(caught), str(caught[0].message) if caught else "")
+"""
+
+
+def test_an_unwritable_cache_folder_compiles_in_memory_and_says_so_once(tmp_path):
+    # the folder under a file: the model's module and its population module are both compiled in
+    # memory, the population module importing the model's from there; one warning for the two
+    import os
+    import subprocess
+    import sys
+    from conftest import REPO
+    blocked = tmp_path / "a_file"
+    blocked.write_text("")
+    environment = dict(os.environ, BUSHING_CACHE_DIR=str(blocked / "cache"), PYTHONPATH=str(REPO))
+    result = subprocess.run([sys.executable, "-c", UNWRITABLE_PROBE], env=environment, capture_output=True,
+                            text=True, timeout=600, cwd=REPO)
+    assert result.returncode == 0, result.stderr[-3000:]
+    force, count, message = result.stdout.split(maxsplit=2)
+    assert float(force) == pytest.approx(2.0 * 0.02, rel=1e-12) and int(count) == 1   # F = k*x at 0.02 mm
+    assert str(blocked / "cache") in message and "BUSHING_CACHE_DIR" in message
+
+
 SPENCER_PROBE = """
 import numpy as np
 from identification.forward import population as compiled_core

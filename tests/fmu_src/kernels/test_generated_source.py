@@ -41,7 +41,7 @@ def test_a_generated_module_whose_template_reads_an_unbound_name_is_refused_at_g
 def test_every_models_generated_modules_bind_every_name_they_read():
     from identification.forward import parameter_jacobian as fit_jacobian
     machinery = compiled_kernels.integration_module()
-    for name in ("proposed", "berg", "fractional", "kelvin_voigt"):
+    for name in ("proposed", "berg", "fractional", "kelvin_voigt", "hydraulic", "hydraulic_free_decoupler"):
         model = get_model(name)
         for source in (compiled_core._population_source(model),
                        *(compiled_kernels.model_source(model, machinery, appendix)

@@ -142,9 +142,9 @@ def test_the_coupled_kernels_are_in_the_kernel_language_of_the_c_translation_and
 @pytest.mark.slow
 @pytest.mark.parametrize("name", COUPLED)
 def test_the_compiled_coupled_step_is_the_python_step_bit_for_bit(name):
-    from fmu_src.kernels.numba_binding import compiled_module
+    from fmu_src.kernels.numba_binding import kernel_module
     model = get_model(name)
-    module, kernels = compiled_module(model), model.coupled
+    module, kernels = kernel_module(model), model.coupled
     m = model.constants(default_parameters(model))
     path = np.column_stack([PLANE, np.zeros(len(PLANE))])
     state = compiled = kernels.initial_state(m, (0.0, 0.0, 0.0))

@@ -180,11 +180,18 @@ def test_bad_grid_is_refused(amplitudes, frequencies, message):
 
 
 def test_implausible_values_and_the_cycle_cap_warn():
-    with pytest.warns(CharacterisationWarning, match="frequency 600 Hz is above 500 Hz"):
+    # each warning names the line that asked: characterise's caller, or data_sheet's
+    from fmu_src.model.registry import get_model
+    from identification.forward.dynamic_stiffness import SteadyStateLoop, data_sheet
+    with pytest.warns(CharacterisationWarning, match="frequency 600 Hz is above 500 Hz") as caught:
         characterise({"k": 1.0, "c": 0.0, "preload": 0.0}, [1.0], [600.0], model="kelvin_voigt")
-    with pytest.warns(CharacterisationWarning, match="no steady state within 3 cycles for 2 mm/1 Hz"):
+    assert caught[0].filename == __file__
+    with pytest.warns(CharacterisationWarning, match="no steady state within 3 cycles for 2 mm/1 Hz") as caught:
         table = characterise(TABLE5, [2.0], [1.0], max_cycles=3)
-    assert not table.converged[0]
+    assert not table.converged[0] and caught[0].filename == __file__
+    with pytest.warns(CharacterisationWarning, match="no steady state within 3 cycles") as caught:
+        data_sheet(get_model("proposed"), [TABLE5], [2.0], [1.0], 0.0, SteadyStateLoop(max_cycles=3))
+    assert caught[0].filename == __file__
 
 
 def test_command_line(tmp_path, capsys):
