@@ -44,6 +44,7 @@ here: nothing imports it until a model is compiled.
 from __future__ import annotations
 
 import ast
+import contextlib
 import ctypes
 import dataclasses
 import hashlib
@@ -273,6 +274,24 @@ def kernels_only(tree: ast.Module, values: dict, package: str) -> ast.Module:
         body = [node for node in body if not (isinstance(node, ast.FunctionDef) and node.name in helpers)]
     tree.body = body
     return ast.fix_missing_locations(tree)
+
+
+@contextlib.contextmanager
+def compile_lock(name: str):
+    """Held while this process compiles the generated module ``name`` (or loads it): a second
+    process that asks for it meanwhile waits for the first's compile and then loads its machine
+    code from numba's cache, instead of compiling it beside it. An exclusive lock on
+    ``<cache folder>/<name>.lock``, released by the system if the process dies; no lock where
+    there is no fcntl (Windows) or the folder cannot be written."""
+    try:
+        import fcntl
+        handle = open(cache_directory() / f"{name}.lock", "w")
+    except (ImportError, OSError):
+        yield
+        return
+    with handle:
+        fcntl.flock(handle, fcntl.LOCK_EX)
+        yield
 
 
 def integration_module() -> str:

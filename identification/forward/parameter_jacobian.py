@@ -173,7 +173,8 @@ def sensitivity_module(model: str | BushingModel, lanes: int) -> types.ModuleTyp
     its population loop compiled (or loaded from numba's disk cache) by a first call on a
     two-sample input: once per process. The first process on a machine compiles (about 25 s for
     the proposed model's 14 directions: every tangent statement is written 14 times); later ones
-    generate the source again and load the machine code."""
+    generate the source again and load the machine code, and one that asks while another compiles
+    waits for it (``numba_binding.compile_lock``)."""
     bushing = resolve_model(model)
     key = (bushing.name, lanes)
     if key in _compiled:
@@ -185,8 +186,9 @@ def sensitivity_module(model: str | BushingModel, lanes: int) -> types.ModuleTyp
             module = _generated_module(bushing, lanes)
             values = np.array([bushing.values({spec.name: 1.0 for spec in bushing.specs})])
             two = np.array([0.0, 1e-3])
-            module._simulate_sensitivities(values, np.zeros(values.shape + (lanes,)), two, two, two,
-                                           np.arange(2, dtype=np.int64), two, 10, *_step_sizes(two))
+            with _kernels.compile_lock(module.__name__):      # and a second process too
+                module._simulate_sensitivities(values, np.zeros(values.shape + (lanes,)), two, two, two,
+                                               np.arange(2, dtype=np.int64), two, 10, *_step_sizes(two))
             _compiled[key] = module
     return _compiled[key]
 

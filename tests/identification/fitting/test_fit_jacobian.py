@@ -309,3 +309,27 @@ def test_the_sensitivities_check_their_output_points_as_the_forces_do():
     for index in (np.array([3, 2]), np.array([0, t.size])):
         with pytest.raises(ValueError, match="increasing indices into time_s"):
             population_sensitivities(values, seeds, CommunicationPoints(t, t, t, index, t[:2]), model=model)
+
+
+LOCK_PROBE = """
+from identification.forward import parameter_jacobian
+module = parameter_jacobian.sensitivity_module("single_bouc_wen", 2)
+stats = module._simulate_sensitivities.stats
+print(len(stats.cache_hits), len(stats.cache_misses))
+"""
+
+
+def test_two_processes_asking_for_a_sensitivity_module_at_once_compile_it_once(tmp_path):
+    # both start together on an empty cache: one compiles, the other waits for it
+    # (numba_binding.compile_lock) and loads the machine code instead of compiling it beside it
+    import os
+    import subprocess
+    import sys
+    from conftest import REPO
+    pytest.importorskip("fcntl")
+    environment = dict(os.environ, BUSHING_CACHE_DIR=str(tmp_path), PYTHONPATH=str(REPO))
+    runs = [subprocess.Popen([sys.executable, "-c", LOCK_PROBE], env=environment, stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True, cwd=REPO) for _ in range(2)]
+    outputs = [run.communicate(timeout=600) for run in runs]
+    assert all(run.returncode == 0 for run in runs), [error[-2000:] for _, error in outputs]
+    assert sorted(tuple(map(int, out.split())) for out, _ in outputs) == [(0, 1), (1, 0)]
