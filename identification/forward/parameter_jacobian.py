@@ -42,6 +42,7 @@ from fmu_src.kernels import numba_binding as _kernels, tangents
 from fmu_src.model import elements, integration
 from fmu_src.model.registry import BushingModel, DEFAULT_MODEL, resolve_model
 from fmu_src.kernels.jit import numba
+from fmu_src.syntax_trees import parse
 from identification.forward.population import (CommunicationPoints, _input_arrays, _population_loop, _step_sizes,
                                                output_points, parameter_matrix)
 
@@ -66,7 +67,7 @@ def _machinery_imports(model: BushingModel, source: str, machinery: str) -> str:
     the model's module does not have (the tangents of ``integration``'s and ``elements``'
     functions read their own module's globals)."""
     module = sys.modules[model.kernel_module]
-    tree = ast.parse(source)
+    tree = parse(source)
     defined = {node.name for node in tree.body if isinstance(node, ast.FunctionDef)}
     assigned, loaded = set(), set()
     for n in ast.walk(tree):        # one walk: the module is large (0.2 MB for 14 directions)
