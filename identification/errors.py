@@ -62,6 +62,11 @@ class FitNotConvergedWarning(UserWarning):
     (its text is ``FitResult.warning``; ``FitResult.converged`` is then False)."""
 
 
+class EnsembleWarning(UserWarning):
+    """Warned by a fit whose posterior cannot be sampled as set (``ensemble.SamplingFailed``): its
+    ensemble, and so its band, holds the prediction profiles' ends and the final starts only."""
+
+
 class CharacterisationWarning(UserWarning):
     """Warned by ``characterise`` when a case does not reach its steady state within the cycle
     cap (its numbers are then the last cycle's) or an ensemble member fails on a case; by

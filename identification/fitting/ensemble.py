@@ -27,8 +27,8 @@ Members, all within the threshold by their true misfit:
     reaches it, but a least-squares path along the valley does. With the fit's exact Jacobian
     (``multistart.Problem.jacobian``) its least squares take the exact Jacobian of the fit's
     residuals and the probe's exact gradient (:class:`ProbeMeasure`), else scipy's differences;
-(3) MEMBERS posterior draws (emcee, WALKERS walkers from a tiny ball around the best fit, STEPS
-    steps of which the first BURN_IN are discarded, differential-evolution and snooker moves as
+(3) MEMBERS posterior draws (emcee, WALKERS walkers, or 2*(d + 1) for d > 15 parameters, from a
+    tiny ball around the best fit, STEPS steps of which the first BURN_IN are discarded, differential-evolution and snooker moves as
     emcee recommends for curved posteriors; posterior exp(-chi^2/(2 s^2)), flat over the box),
     each pushed along the ray from the best fit to the farthest of PUSH times its distance
     still inside: draws sit at chi^2 about d above the best, and their envelope is a pointwise
@@ -53,7 +53,21 @@ DISTINCT = 1e-4
 WALKERS, STEPS, BURN_IN, MEMBERS = 32, 200, 100, 100
 """200 steps: the 100 kept are about five autocorrelation times (about 20 steps on the paper's
 tests); with 300 the sampler took 34 s of the 118 s fit of the reliability benchmark's most
-expensive bushing (random 1)."""
+expensive bushing (random 1). WALKERS is the least number of walkers: a model of more than 15
+free parameters takes more (:func:`walkers_for`)."""
+
+
+def walkers_for(dimensions: int) -> int:
+    """The walkers for ``dimensions`` free parameters: WALKERS, or 2*(d + 1) where that is more.
+    emcee's differential-evolution moves (red-blue moves) refuse fewer than twice the dimensions,
+    and its start check wants more walkers than dimensions; 32 covers up to 15 parameters, so the
+    smaller models sample as before."""
+    return max(WALKERS, 2 * (dimensions + 1))
+
+
+class SamplingFailed(RuntimeError):
+    """The posterior could not be sampled from its start (a degenerate ball of walkers, or emcee
+    refusing the moves): the ensemble keeps its profiles and start end points only."""
 PUSH = (1.0, 1.25, 1.5, 2.0, 2.5, 3.0, 4.0, 6.0)
 PROBES = (("sine", 4.0, 40.0, 0.25, "rms"), ("sine", 4.0, 5.0, 0.4, "rms"), ("step", 4.0, 0.05, 1.0, "rms"),
           ("sine", 2.0, 1.0, 1.0, "energy"))
@@ -152,11 +166,16 @@ def posterior_samples(problem, best: np.ndarray, seed: int, scale: float = 1.0):
 
     rng = np.random.default_rng(np.random.SeedSequence(seed).spawn(2)[1])
     span = bounds[:, 1] - bounds[:, 0]
-    start = np.clip(best + START_BALL * span * rng.standard_normal((WALKERS, len(best))), bounds[:, 0], bounds[:, 1])
+    walkers = walkers_for(len(best))
+    start = np.clip(best + START_BALL * span * rng.standard_normal((walkers, len(best))), bounds[:, 0], bounds[:, 1])
     moves = [(emcee.moves.DEMove(), 0.8), (emcee.moves.DESnookerMove(), 0.2)]
-    sampler = emcee.EnsembleSampler(WALKERS, len(best), log_probability, vectorize=True, moves=moves)
+    sampler = emcee.EnsembleSampler(walkers, len(best), log_probability, vectorize=True, moves=moves)
     sampler.random_state = np.random.RandomState(int(rng.integers(2 ** 31))).get_state()
-    sampler.run_mcmc(start, STEPS, progress=False)
+    try:
+        sampler.run_mcmc(start, STEPS, progress=False)
+    except (ValueError, RuntimeError) as error:     # emcee's start check and its moves' refusals
+        raise SamplingFailed(f"the posterior could not be sampled with {walkers} walkers in {len(best)} "
+                             f"dimensions from a ball around the best fit: {error}") from error
     chain = sampler.get_chain(discard=BURN_IN, flat=True)
     misfit = -2.0 * scale * sampler.get_log_prob(discard=BURN_IN, flat=True) / n
     chosen = np.sort(rng.choice(len(chain), size=min(MEMBERS, len(chain)), replace=False))

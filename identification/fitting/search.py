@@ -20,10 +20,10 @@ from fmu_src.model.registry import BushingModel
 from fmu_src.kernels.numba_binding import cache_directory
 from fmu_src.parameter_files import ParameterSet
 from identification.forward.population import parameter_matrix
-from identification.fitting.ensemble import (PROBES, PROFILE_EVALUATIONS, PROFILE_ROUNDS, PUSH, STEPS, WALKERS,
+from identification.fitting.ensemble import (PROBES, PROFILE_EVALUATIONS, PROFILE_ROUNDS, PUSH, STEPS, SamplingFailed,
                                              identifiability, misfit_threshold, posterior_samples, profile_extremes,
-                                             push_to_boundary, select_members, threshold_scale)
-from identification.errors import CharacterisationWarning
+                                             push_to_boundary, select_members, threshold_scale, walkers_for)
+from identification.errors import CharacterisationWarning, EnsembleWarning
 from identification.fitting.result import MIN_AGREEING, FitResult, RigTestFit, TableFit, agreeing_starts
 from identification.measured.kdyn_table import KdynTable
 from identification.fitting.loop_start import LOOP_STARTS, anchored_coordinates, slow_loop_start
@@ -404,11 +404,18 @@ class Search:
         extremes, extreme_misfits, failed_profiles = profile_extremes(problem, best.theta, best.misfit, ident, limit,
                                                                       self.engine)
         # here, not on a worker: the compiled kernel runs the walkers on every core of this process
-        draws, _, sampler = posterior_samples(problem, best.theta, self.request.seed,
-                                              threshold_scale(best.misfit, n, d))
-        pushed, pushed_misfits = push_to_boundary(problem, best.theta, draws, limit)
+        try:
+            draws, _, sampler = posterior_samples(problem, best.theta, self.request.seed,
+                                                  threshold_scale(best.misfit, n, d))
+            pushed, pushed_misfits = push_to_boundary(problem, best.theta, draws, limit)
+            sampled = walkers_for(d) * STEPS + len(draws) * len(PUSH)
+        except SamplingFailed as failure:
+            warnings.warn(f"{space.bushing.name}: {failure}; the band is the prediction profiles' and the final "
+                          "starts' alone (narrower than with the posterior's draws)", EnsembleWarning, stacklevel=2)
+            self.notes.append(f"note: {failure}; the ensemble holds the profiles' ends and the final starts only")
+            pushed, pushed_misfits, sampler, sampled = np.empty((0, d)), np.empty(0), None, 0
         per_jacobian = simulations_per_jacobian(problem, d, known=False)
-        self.evaluations += WALKERS * STEPS + len(draws) * len(PUSH) \
+        self.evaluations += sampled \
             + len(PROBES) * 2 * per_jacobian * (1 + PROFILE_ROUNDS * PROFILE_EVALUATIONS)
         members = select_members(best.theta, [(r.theta, r.misfit) for r in final],
                                  np.vstack([extremes, pushed]), np.concatenate([extreme_misfits, pushed_misfits]),
