@@ -225,11 +225,12 @@ def compare_models(models: Sequence[str | BushingModel], tests: Sequence[RigTest
     with make_engine(options.workers, options.scheduler) as engine, warnings.catch_warnings(), \
             threadpool_limits(limits=1):
         warnings.simplefilter("ignore", FitNotConvergedWarning)   # reported below, per model
-        results, stopped, searches = race_models(requests, engine, options.race, options.progress)
+        settled = _SettledWriter(out_dir, table, data)
+        results, stopped, searches = race_models(requests, engine, options.race, options.progress, settled)
         bushings = [b for b in bushings if b.name in results]
         models = [b.name for b in bushings]
         parameters = {model: results[model].parameters.parameters for model in models}
-        assessments = [_assessed(results[model], table) for model in models]
+        assessments = [settled.assessment(results[model]) for model in models]
         errors, predictions = _validation_errors(validation, bushings, parameters, assessments, training_names)
         recommendation = recommend(assessments)
         if options.ensemble:
@@ -238,8 +239,7 @@ def compare_models(models: Sequence[str | BushingModel], tests: Sequence[RigTest
                                                                   or m == recommendation.model)]:
                 print(f"sampling the ensemble of {model} (profiles, posterior) ...", file=sys.stderr)
                 results[model] = searches[model].with_ensemble()
-        for model in models:
-            results[model].save(out_dir / f"params_{model}.json", data=data)
+                results[model].save(out_dir / f"params_{model}.json", data=data)
     for m in validation:
         plot_comparison(m, predictions[Path(m.source).name], out_dir / f"compare_{measurement_name(m.source)}.png")
     if table is not None:
@@ -274,6 +274,29 @@ def _assessed(result: FitResult, table: KdynTable | None) -> Assessment:
     if table is not None:
         assessment.table = table_fit(table, result.parameters)
     return assessment
+
+
+class _SettledWriter:
+    """``race_models``' ``on_settled``: each model's parameter file as its fit finishes, and
+    comparison.csv again with the rows so far (the recommendation column empty until the end), so
+    that a crash, a signal or a full disk loses only the model in hand. Each model's assessment
+    is made once, here, and kept for the final tables (:meth:`assessment`)."""
+
+    def __init__(self, out_dir: Path, table: KdynTable | None, data: list[str]):
+        self.out_dir, self.table, self.data = out_dir, table, data
+        self.assessments: dict[str, Assessment] = {}
+
+    def assessment(self, result: FitResult) -> Assessment:
+        if result.model not in self.assessments:
+            self.assessments[result.model] = _assessed(result, self.table)
+        return self.assessments[result.model]
+
+    def __call__(self, results: Mapping[str, FitResult], stopped: Sequence[Stopped]) -> None:
+        for model, result in results.items():
+            if model not in self.assessments:
+                result.save(self.out_dir / f"params_{model}.json", data=self.data)
+                self.assessment(result)
+        _write_comparison(self.out_dir, list(self.assessments.values()), None, stopped)
 
 
 def _validation_errors(validation, bushings, parameters: dict, assessments: list[Assessment], training_names: set):
@@ -402,27 +425,7 @@ def format_table_errors(table: KdynTable, assessments: Sequence[Assessment]) -> 
 
 def _write_csvs(out_dir: Path, assessments, recommendation: Recommendation, errors: dict, table,
                 stopped: Sequence[Stopped] = ()) -> None:
-    best_bic = min(a.information_criterion for a in assessments)
-    with writing(out_dir / "comparison.csv") as temporary, open(temporary, "w", newline="") as handle:
-        writer = csv.writer(handle)
-        writer.writerow(["model", "free_parameters", "worst_nrmse_over_floor", "at_floor", "converged",
-                         "misfit_chi2_per_residual", "residuals", "bic", "delta_bic", "held_out_mean_nrmse",
-                         "table_error_over_uncertainty", "table_largest_kdyn_error", "table_largest_loss_angle_error_deg",
-                         "seconds", "recommended", "screened_misfit_chi2_per_residual",
-                         "first_stage_misfit_chi2_per_residual", "stopped_after_screening"])
-        for a in assessments:
-            kdyn = np.max(np.abs(a.table.kdyn_errors)) if a.table is not None else None
-            angle = np.max(np.abs(a.table.angle_errors_deg)) if a.table is not None else None
-            writer.writerow([a.model, a.free_parameters, _cell(a.training_ratio), a.at_floor, a.converged,
-                             _cell(a.misfit), a.residuals, _cell(a.information_criterion),
-                             _cell(a.information_criterion - best_bic), _cell(a.validation_error),
-                             _cell(a.table_error), _cell(kdyn), _cell(angle), f"{a.seconds:.1f}",
-                             a.model == recommendation.model, _cell(a.screened_misfit),
-                             _cell(a.first_stage_misfit), ""])
-        for s in stopped:
-            writer.writerow([s.model, s.free_parameters, "", False, False, "", "", "", "", "", "", "", "",
-                             f"{s.seconds:.1f}", False, _cell(s.screened_misfit), _cell(s.first_stage_misfit),
-                             s.reason])
+    _write_comparison(out_dir, assessments, recommendation, stopped)
     with writing(out_dir / "validation.csv") as temporary, open(temporary, "w", newline="") as handle:
         writer = csv.writer(handle)
         writer.writerow(["file", "model", "nrmse", "eq10_rms_level_error"])
@@ -440,6 +443,34 @@ def _write_csvs(out_dir: Path, assessments, recommendation: Recommendation, erro
                                                                  table.loss_angle_deg[kept])):
                     writer.writerow([a.model, f"{X:g}", f"{f:g}", f"{P:g}", f"{kdyn:.6g}", f"{angle:.6g}",
                                      f"{a.table.kdyn_errors[row]:.6g}", f"{a.table.angle_errors_deg[row]:.6g}"])
+
+
+def _write_comparison(out_dir: Path, assessments, recommendation: Recommendation | None,
+                      stopped: Sequence[Stopped] = ()) -> None:
+    """comparison.csv: a row per model (``recommended`` empty while the comparison runs,
+    ``recommendation`` None)."""
+    best_bic = min((a.information_criterion for a in assessments), default=math.nan)
+    with writing(out_dir / "comparison.csv") as temporary, open(temporary, "w", newline="") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(["model", "free_parameters", "worst_nrmse_over_floor", "at_floor", "converged",
+                         "misfit_chi2_per_residual", "residuals", "bic", "delta_bic", "held_out_mean_nrmse",
+                         "table_error_over_uncertainty", "table_largest_kdyn_error", "table_largest_loss_angle_error_deg",
+                         "seconds", "recommended", "screened_misfit_chi2_per_residual",
+                         "first_stage_misfit_chi2_per_residual", "stopped_after_screening"])
+        for a in assessments:
+            kdyn = np.max(np.abs(a.table.kdyn_errors)) if a.table is not None else None
+            angle = np.max(np.abs(a.table.angle_errors_deg)) if a.table is not None else None
+            writer.writerow([a.model, a.free_parameters, _cell(a.training_ratio), a.at_floor, a.converged,
+                             _cell(a.misfit), a.residuals, _cell(a.information_criterion),
+                             _cell(a.information_criterion - best_bic), _cell(a.validation_error),
+                             _cell(a.table_error), _cell(kdyn), _cell(angle), f"{a.seconds:.1f}",
+                             "" if recommendation is None else a.model == recommendation.model,
+                             _cell(a.screened_misfit),
+                             _cell(a.first_stage_misfit), ""])
+        for s in stopped:
+            writer.writerow([s.model, s.free_parameters, "", False, False, "", "", "", "", "", "", "", "",
+                             f"{s.seconds:.1f}", False, _cell(s.screened_misfit), _cell(s.first_stage_misfit),
+                             s.reason])
 
 
 def _cell(value) -> str:

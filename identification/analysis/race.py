@@ -141,14 +141,19 @@ def _jacobian_of(search: Search):
     return compile_jacobian
 
 
-def race_models(requests: list[SearchRequest], engine, race: bool = True,
-                progress: bool = True) -> tuple[dict[str, FitResult], list[Stopped], dict[str, Search]]:
+def race_models(requests: list[SearchRequest], engine, race: bool = True, progress: bool = True,
+                on_settled=None) -> tuple[dict[str, FitResult], list[Stopped], dict[str, Search]]:
     """Fit the models of ``requests`` (each with its ensemble left out) on ``engine``: a linear
     model outright, every other screened (the global phase, then the first least-squares stage),
     then, best first-stage misfit first, the stages of those still in the race (every one with
     ``race=False``), their modules compiled beside
     (:class:`ModulePipeline`). Returns (results by model, the models stopped, the finished
-    searches by model: ``Search.with_ensemble`` samples an ensemble later)."""
+    searches by model: ``Search.with_ensemble`` samples an ensemble later).
+
+    ``on_settled(results, stopped)``, if given, is called each time a model is settled (fitted
+    or stopped), with the results and the stopped models so far: ``compare`` writes its files
+    there, so that a crash or a signal loses only the model in hand."""
+    settled = on_settled if on_settled is not None else (lambda results, stopped: None)
     results: dict[str, FitResult] = {}
     searches: dict[str, Search] = {}
     for request in requests:
@@ -156,6 +161,7 @@ def race_models(requests: list[SearchRequest], engine, race: bool = True,
         if bushing.linear is not None:
             print(f"fitting {bushing.title} (linear least squares) ...", file=sys.stderr)
             results[bushing.name] = _reported(fit_linear(request, time.perf_counter()))
+            settled(results, [])
         else:
             searches[bushing.name] = begin(request, engine, progress, time.perf_counter())
             searches[bushing.name].prepare()
@@ -182,9 +188,11 @@ def race_models(requests: list[SearchRequest], engine, race: bool = True,
                                    search.seconds, reason))
             del searches[model]
             print(f"{search.request.model.title}: out of the race ({reason})", file=sys.stderr)
+            settled(results, stopped)
             continue
         print(f"fitting {search.request.model.title} ...", file=sys.stderr)
         results[model] = _reported(search.finish(ensemble=False))
+        settled(results, stopped)
     return results, stopped, searches
 
 

@@ -291,3 +291,40 @@ def test_a_signal_inside_compiled_code_is_the_same_stop(monkeypatch, capsys, tmp
     monkeypatch.setitem(cli.COMMANDS, "design", other_system_error)
     with pytest.raises(SystemError, match="a real one"):
         cli.main(["design", "--ensemble", str(tmp_path / "e.json")])
+
+
+def test_compare_stopped_after_its_third_fit_leaves_those_three_models_files(monkeypatch, capsys, tmp_path):
+    """compare writes each model's parameter file and its row as the model is settled: a SIGTERM
+    raised after the third fit (Kelvin-Voigt, then two searched models) leaves their three
+    files and comparison.csv with their three rows, and the one line names them."""
+    import csv
+
+    from identification.cli import arguments as cli
+    from identification.fitting.search import Search
+    from identification.interrupt import Interrupted
+
+    finished = []
+    finish = Search.finish
+
+    def finish_then_stop(self, *args, **kwargs):
+        result = finish(self, *args, **kwargs)
+        finished.append(result.model)
+        if len(finished) == 3:              # the fourth fit: the signal arrives while it runs
+            raise Interrupted(signal.SIGTERM)
+        return result
+    monkeypatch.setattr(Search, "finish", finish_then_stop)
+    out = tmp_path / "compare"
+    code = cli.main(["compare", "--sine", str(SINE), "--models", "kelvin_voigt,single_bouc_wen,spencer,berg",
+                     "--no-race", "--screening", "32", "--starts", "2", "--no-ensemble", "--quiet", "--workers", "1",
+                     "--out", str(out)])
+    assert code == 128 + signal.SIGTERM
+    settled = ["kelvin_voigt", *finished[:2]]
+    written = sorted(p.name for p in out.iterdir())
+    assert written == sorted(["comparison.csv", *(f"params_{model}.json" for model in settled)])
+    for model in settled:
+        assert json.loads((out / f"params_{model}.json").read_text())["parameters"]
+    with open(out / "comparison.csv") as handle:
+        rows = list(csv.DictReader(handle))
+    assert [row["model"] for row in rows] == settled and all(row["recommended"] == "" for row in rows)
+    last = capsys.readouterr().err.splitlines()[-1]
+    assert last.startswith("interrupted: wrote") and all(f"params_{model}.json" in last for model in settled)
