@@ -243,8 +243,8 @@ def _search(base: BushingModel, options: Options) -> SearchBox:
         coordinates += (SearchCoordinate("maxwell_k", KIND.stiffness, -4.0, 1.0),
                         SearchCoordinate("maxwell_c", KIND.time_constant, -math.inf, 4.0, over=("maxwell_k",)))
     if options.rig:
-        coordinates += (SearchCoordinate("rig_displacement_zero", KIND.offset_travel, -0.25, 0.25),
-                        SearchCoordinate("rig_force_zero", KIND.offset_force, -0.5, 0.5))
+        coordinates += (SearchCoordinate("rig_displacement_zero", KIND.rig_travel, -0.25, 0.25),
+                        SearchCoordinate("rig_force_zero", KIND.rig_force, -0.5, 0.5))
     loop = base.search.loop_start if base.search is not None and not options.knots else None
     if loop is not None:       # the friction alone: the options' neutral values too
         loop = replace(loop, friction_alone=loop.friction_alone + NEUTRAL[LIMITS] * options.limits

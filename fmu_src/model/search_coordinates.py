@@ -91,16 +91,22 @@ class Exponent(CoordinateKind):
 
 class Linear(CoordinateKind):
     """value/scale, scale the data's reference named ``scale`` (F_ref, x_ref): a signed offset
-    (a load cell's zero, a displacement zero, a backbone's force at its middle knot)."""
+    (a backbone's force at its middle knot). With ``centre``, the data's estimate of the value
+    named so (x_zero, F_zero: where the records' stroke and force are centred) is its origin:
+    (value - centre)/scale, a rig's zero searched about what the records show."""
 
-    def __init__(self, name: str, scale: str):
-        self.name, self.scale = name, scale
+    def __init__(self, name: str, scale: str, centre: str = ""):
+        self.name, self.scale, self.centre = name, scale, centre
+
+    def _origin(self, scales) -> float:
+        return getattr(scales, self.centre, 0.0) if self.centre else 0.0
 
     def to_parameter(self, c, u, values, scales):
-        return u * getattr(scales, self.scale)
+        origin = self._origin(scales)
+        return u * getattr(scales, self.scale) + origin if origin else u * getattr(scales, self.scale)
 
     def to_coordinate(self, c, value, params, scales):
-        return value / getattr(scales, self.scale)
+        return (value - self._origin(scales)) / getattr(scales, self.scale)
 
 
 class Segment(CoordinateKind):
@@ -278,8 +284,9 @@ KIND = _Kinds(
     LogScaled("damping", "c_ref"),        # log10(value/c_ref)
     LogScaled("force", "F_ref"),          # log10(value/F_ref): a friction force limit
     LogScaled("travel", "x_ref"),         # log10(value/x_ref): a friction's travel, x_ref the largest amplitude
-    Linear("offset_force", "F_ref"),      # value/F_ref: a signed force (a load cell's zero)
-    Linear("offset_travel", "x_ref"),     # value/x_ref: a signed displacement (a rig's displacement zero)
+    Linear("offset_force", "F_ref"),      # value/F_ref: a signed force (a backbone's at its middle knot)
+    Linear("rig_travel", "x_ref", "x_zero"),    # (value - x_zero)/x_ref: a rig's displacement zero
+    Linear("rig_force", "F_ref", "F_zero"),     # (value - F_zero)/F_ref: a load cell's zero
     Segment(), Gain(), Exponent(), Cubic(), TimeConstant(), Slower(), Shape(), ShapeSum(), PowerLaw(), Resonance(), DampingRatio(),
     QuadraticDamping())
 """Every kind of coordinate, by name: ``KIND.stiffness``, ``KIND.time_constant``, ..."""

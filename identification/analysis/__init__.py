@@ -6,6 +6,8 @@
 - ``parameter_sensitivity``: the force's sensitivity to each parameter (the paper's §4);
 - ``compare``: every model fitted on the same tests, weighed, one recommended;
 - ``race``: compare's race: every model screened, the stages only for those that can still win;
+- ``first_contact``: what compare assumes of a new device's tests before the fits (the rig's
+  offsets, a backbone, a Maxwell element, travel limits), and why;
 - ``paper_verification``: the paper's §5 error tables and force plots;
 - ``plots``: the figures (forces, loops, the multistart waterfall, data sheets).
 

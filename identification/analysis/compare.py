@@ -38,7 +38,7 @@ import csv
 import math
 import sys
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Mapping, Sequence
 
@@ -185,6 +185,15 @@ class CompareOptions:
     table: KdynTable | None = None
     multiaxis: Any = ()
     couplings: Sequence[str] = ()
+    fixed_by_model: Mapping[str, Mapping[str, float]] | None = None
+    """Parameters a model holds, by the model's name, in place of ``fixed`` (a backbone read off a
+    static test is pinned at 0 in a model with the rig's offsets, not in one without)."""
+    alternatives: Mapping[str, Sequence[tuple[BushingModel, Mapping[str, float]]]] | None = None
+    """By a model's name, the variants (model, the parameters it holds) it is weighed against if
+    it is recommended: ``first_contact``'s options assumed, each left out in turn. They are fitted
+    after the race and join it; the recommendation is made again over all."""
+    first_contact: Any = None
+    """What was assumed before the fits (``first_contact.FirstContact``): said in the summary."""
 
     def training(self) -> FitOptions:
         """Each model's fit (its ensemble, if any, sampled later for the recommended one)."""
@@ -218,7 +227,12 @@ def compare_models(models: Sequence[str | BushingModel], tests: Sequence[RigTest
     validation = [load_measurement(path) for path in validation_files]
     training_names = {Path(t.measurement.source).name for t in tests}
     training = options.training()
-    requests = [training_request(tests, bushing, training) for bushing in bushings]
+    by_model = options.fixed_by_model or {}
+
+    def request(bushing, fixed=None):
+        held = fixed if fixed is not None else by_model.get(bushing.name, options.fixed)
+        return training_request(tests, bushing, replace(training, fixed=held))
+    requests = [request(bushing) for bushing in bushings]
     table, training_table = options.table, options.training_table
     data = [t.measurement.source for t in tests] + ([training_table.source] if training_table is not None else [])
     # one BLAS thread, as fit() runs its searches
@@ -227,12 +241,29 @@ def compare_models(models: Sequence[str | BushingModel], tests: Sequence[RigTest
         warnings.simplefilter("ignore", FitNotConvergedWarning)   # reported below, per model
         settled = _SettledWriter(out_dir, table, data)
         results, stopped, searches = race_models(requests, engine, options.race, options.progress, settled)
-        bushings = [b for b in bushings if b.name in results]
-        models = [b.name for b in bushings]
-        parameters = {model: results[model].parameters.parameters for model in models}
-        assessments = [settled.assessment(results[model]) for model in models]
-        errors, predictions = _validation_errors(validation, bushings, parameters, assessments, training_names)
-        recommendation = recommend(assessments)
+        recommendation = None
+        pending = (options.alternatives or {})
+        while True:
+            bushings = [b for b in bushings if b.name in results]
+            models = [b.name for b in bushings]
+            parameters = {model: results[model].parameters.parameters for model in models}
+            assessments = [settled.assessment(results[model]) for model in models]
+            errors, predictions = _validation_errors(validation, bushings, parameters, assessments, training_names)
+            recommendation = recommend(assessments)
+            variants = [(b, f) for b, f in pending.get(recommendation.model, ()) if b.name not in results
+                        and b.name not in {s.model for s in stopped}]
+            pending = {}
+            if not variants:
+                break
+            print(f"weighing {recommendation.model} without each option assumed: "
+                  f"{', '.join(b.name for b, _ in variants)} ...", file=sys.stderr)
+            more, more_stopped, more_searches = race_models([request(b, dict(f)) for b, f in variants], engine, False,
+                                                            options.progress,
+                                                            lambda r, s: settled({**results, **r}, stopped + s))
+            results.update(more)
+            searches.update(more_searches)
+            stopped = stopped + more_stopped
+            bushings = bushings + [b for b, _ in variants]
         if options.ensemble:
             # the ensemble keeps the best fit: the assessments and the recommendation stand
             for model in [m for m in models if m in searches and (options.every_ensemble
@@ -247,6 +278,8 @@ def compare_models(models: Sequence[str | BushingModel], tests: Sequence[RigTest
     coupling = (weigh_couplings(parameters, bushings, options.multiaxis, options.couplings, recommendation.model)
                 if options.couplings else None)
 
+    if options.first_contact is not None:
+        print(options.first_contact.format())
     print(format_assessments(assessments, recommendation, stopped))
     if validation:
         print(format_comparison(errors, models, [Path(m.source).name for m in validation], training_names))

@@ -346,14 +346,16 @@ def _add_model_option_arguments(parser) -> None:
     group.add_argument("--options", metavar="LIST",
                        help="options every model gets, comma-separated: backbone<K> (a static curve of K knots), "
                             "limits (a travel limit each side), maxwell (a Maxwell element in parallel), rig (the "
-                            "rig's displacement and load-cell zeros, fitted and kept out of the FMU)")
+                            "rig's displacement and load-cell zeros, fitted and kept out of the FMU); none: no "
+                            "option (compare, given no --options, assumes the ones its training tests show and says "
+                            "which and why; named options, or none, turn that off)")
     group.add_argument("--backbone-knots", type=number_list, metavar="LIST",
                        help="the backbone's knot positions [mm], increasing (held; their forces are fitted, or read "
                             "off --static)")
     group.add_argument("--static", type=str, metavar="FILE",
                        help="a quasi-static test (a slow triangle or ramp): the backbone read off it (the mean of its "
-                            "loading and unloading branches) at --backbone-knots or 9 knots, and held; a training "
-                            "test too")
+                            "loading and unloading branches) at --backbone-knots or 9 knots (compare without "
+                            "--options: 9 or 17, as the curve needs), and held; a training test too")
     group.add_argument("--fix", action="append", default=[], metavar="NAME=VALUE",
                        help="hold a parameter at a value (the model's units); repeatable")
 

@@ -18,7 +18,7 @@ import numpy as np
 
 from fmu_src.model.parameter_specs import ParameterError
 from fmu_src.model.registry import DEFAULT_MODEL, MODEL_NAMES, get_model
-from identification.cli.model_options import model_options_of
+from identification.cli.model_options import build_model_options, fixed_values, model_options_of
 from fmu_src.parameter_files import read_parameter_set
 from identification.errors import FitNotConvergedWarning, UsageError
 from identification.measured.measurements import load_measurement, measurement_name
@@ -389,7 +389,9 @@ def fit_many_command(args) -> int:
 
 
 def compare_command(args) -> int:
+    from fmu_src.model.derived import Options
     from identification.analysis.compare import compare_models
+    from identification.analysis.first_contact import first_contact
     if args.multiaxis:
         raise UsageError("--multiaxis: compare fits on one-axis tests and weighs the couplings on held-out multi-axis "
                          "files (--coupling none,radial --validate-multiaxis FILE); fit a model to multi-axis tests "
@@ -402,6 +404,17 @@ def compare_command(args) -> int:
     training_table = load_kdyn_table(args.kdyn) if args.kdyn is not None else None
     tests, _ = training_tests_of(args)
     options = model_options_of(args)
+    contact, variants = None, []
+    if args.options is None:        # a new device's first contact: the options its tests ask for
+        contact = first_contact(tests, options.static_test)
+        static = contact.static_test.measurement if contact.static_test is not None else None
+
+        def options_of(tokens):
+            tokens = [t for t in tokens if not (args.backbone_knots and t.startswith("backbone"))]
+            return build_model_options(Options.parse(tokens), fixed_values(args.fix), static, args.backbone_knots)
+        options = options_of(contact.tokens)
+        variants = [options_of([t for t in contact.tokens if t != token]) for token in contact.tokens]
+        print(contact.format(), file=sys.stderr)
     tests = options.training(tests)
     models = [name.strip() for name in args.models.split(",") if name.strip()]
     unknown = []
@@ -413,10 +426,10 @@ def compare_command(args) -> int:
     if unknown:
         raise UsageError(f"unknown models {unknown}; choose from {', '.join(MODEL_NAMES)}, with options where wanted "
                          "(berg+limits)")
-    models = [options.model(name) for name in models]          # resolved once, passed on
-    fixed = {}
-    for bushing in models:
-        fixed = options.fixed_for(bushing)
+    named, models = models, [options.model(name) for name in models]          # resolved once, passed on
+    fixed = {bushing.name: options.fixed_for(bushing) for bushing in models}
+    alternatives = {bushing.name: [(variant.model(name), variant.fixed_for(variant.model(name)))
+                                   for variant in variants] for name, bushing in zip(named, models)}
     if options.curve is not None:
         print(options.describe(), file=sys.stderr)
     couplings = couplings_of(args.coupling, args.validate_multiaxis)
@@ -432,7 +445,7 @@ def compare_command(args) -> int:
     validation = args.validate or [Path(t.measurement.source) for t in tests]
     compare_models(models, tests, validation, args.out, table=table, multiaxis=multiaxis, couplings=couplings,
                    training_table=training_table, race=not args.no_race, every_ensemble=args.every_ensemble,
-                   fixed=fixed, **search_settings(args))
+                   fixed_by_model=fixed, alternatives=alternatives, first_contact=contact, **search_settings(args))
     return 0
 
 

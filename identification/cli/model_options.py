@@ -4,7 +4,8 @@ They turn a model's name into the model a fit or ``compare`` runs (``fmu_src.mod
 model with a backbone, travel limits or the rig's offsets) and the parameters it holds:
 
 - ``--options backbone9,limits,maxwell,rig``: the options every model gets (``fit --model berg+limits``
-  names them too);
+  names them too); ``--options none``: none (``compare`` assumes none either:
+  ``identification.analysis.first_contact``);
 - ``--backbone-knots -4,-2,0,2,4`` [mm]: the backbone's knots, held (its forces fitted), which
   gives the models a backbone of that many knots;
 - ``--static FILE``: a quasi-static test (a slow triangle or ramp); the backbone's forces are read
@@ -27,6 +28,9 @@ from identification.errors import UsageError
 from identification.measured.measurements import load_measurement
 from identification.measured.rig_tests import RigTest
 from identification.measured.static_curve import DEFAULT_KNOTS, StaticCurve, read_static_curve
+
+NONE = "none"
+"""``--options none``: no option, and nothing assumed (``compare``'s first contact off)."""
 
 
 @dataclass(frozen=True)
@@ -71,19 +75,27 @@ class ModelOptions:
 
 
 def model_options_of(args) -> ModelOptions:
-    """The model options of the parsed ``args`` (module docstring)."""
+    """The model options of the parsed ``args`` (module docstring); ``--options none`` is no option."""
+    text = (args.options or "").strip()
     try:
-        options = Options.parse(part for part in (args.options or "").split(",") if part.strip())
+        options = Options() if text.lower() == NONE else Options.parse(part for part in text.split(",") if part.strip())
     except ParameterError as exc:
         raise UsageError(f"--options {args.options}: {exc}") from None
-    fixed = fixed_values(args.fix)
-    knots = args.backbone_knots
+    static = load_measurement(args.static) if args.static is not None else None
+    return build_model_options(options, fixed_values(args.fix), static, args.backbone_knots)
+
+
+def build_model_options(options: Options, fixed: dict, static=None, knots=None) -> ModelOptions:
+    """The model options for ``options``, the parameters held by ``--fix`` (``fixed``), a
+    quasi-static test's ``Measurement`` (``static``, or None) and the backbone's knot positions
+    [mm] (``knots``, or None): the static curve read at the knots, or at as many as the options'
+    backbone has (9 without one), and held."""
+    fixed = dict(fixed)
     curve = static_test = None
-    if args.static is not None:
-        measurement = load_measurement(args.static)
-        curve = read_static_curve(measurement, knots, len(knots) if knots is not None else options.knots or DEFAULT_KNOTS)
+    if static is not None:
+        curve = read_static_curve(static, knots, len(knots) if knots is not None else options.knots or DEFAULT_KNOTS)
         knots = list(curve.knots_mm)
-        static_test = RigTest(measurement)
+        static_test = RigTest(static)
     if knots is not None:
         if len(knots) < 2 or any(b <= a for a, b in zip(knots, knots[1:])):
             raise UsageError(f"--backbone-knots {','.join(f'{k:g}' for k in knots)}: give 2 or more knot positions "

@@ -28,7 +28,7 @@ each parameter moved by +-50 %, lie inside with a margin.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Mapping, Sequence
 
 import numpy as np
@@ -71,6 +71,16 @@ class KelvinVoigtFit:
         return self.k * np.asarray(displacement_mm) + self.c * np.asarray(velocity_mm_s)
 
 
+def _rig_zeros(measurements, steps, model: BushingModel, fixed: dict) -> tuple[float, float]:
+    """(x_zero [mm], F_zero [N]): where the records are centred (``offsets.rig_zeros``), for a model
+    with the rig's offsets (a held displacement zero is its own centre); (0, 0) for any other."""
+    if model.options is None or not model.options.rig:
+        return 0.0, 0.0
+    from identification.measured.offsets import record_offsets, rig_zeros
+    x_zero, F_zero = rig_zeros([record_offsets(m) for m in measurements], steps)
+    return float(fixed.get("rig_displacement_zero", x_zero)), F_zero
+
+
 @dataclass(frozen=True)
 class SearchSpace:
     """The box of one model scaled by the data. ``model``: the model's name, or the model (a
@@ -85,6 +95,10 @@ class SearchSpace:
     fixed: tuple[tuple[str, float], ...] = ()
     """Parameters held at given values instead of searched ((name, value) pairs in the model's
     units: a backbone's stated knot positions, a value the user knows)."""
+    x_zero: float = 0.0           # mm: where the records' stroke is centred (a model with the rig's offsets)
+    F_zero: float = 0.0           # N: where their force is centred
+    """The origin of the rig's offsets' box (``search_coordinates``' rig kinds): what the records
+    show (``offsets.rig_zeros``) for a model with the rig's offsets, else 0."""
 
     def __post_init__(self):
         bushing = resolve_model(self.model)
@@ -132,6 +146,10 @@ class SearchSpace:
                                                                  for m in measurements])
                 return cls(from_table.k_ref, from_table.c_ref, peak, interval, model, from_table.x_ref, fixed)
         scaling = scaling or list(measurements)
+        x_zero, F_zero = _rig_zeros(measurements, steps, model, dict(fixed))
+        if x_zero or F_zero:    # the scales of the records about their centres, where the rig's offsets put the model
+            scaling = [replace(m, displacement_mm=m.displacement_mm - x_zero, force_N=m.force_N - F_zero)
+                       for m in scaling]
         kelvin_voigt = KelvinVoigtFit.fit(scaling)
         peak = max(float(np.max(np.abs(m.force_N))) for m in scaling)
         amplitude = max(float(np.max(np.abs(m.displacement_mm))) for m in scaling)
@@ -146,7 +164,7 @@ class SearchSpace:
         interval = min(float(np.median(np.diff(m.time_s))) for m in measurements)
         if table is not None:
             interval = min(interval, from_table.sample_interval_s)
-        return cls(k_ref, c_ref, peak, interval, model, amplitude, fixed)
+        return cls(k_ref, c_ref, peak, interval, model, amplitude, fixed, x_zero, F_zero)
 
     @classmethod
     def from_table(cls, table, model: str | BushingModel = DEFAULT_MODEL) -> "SearchSpace":

@@ -8,6 +8,8 @@
 - ``noise``: each test's force-noise level, from the data alone;
 - ``static_curve``: a quasi-static test's backbone (the mean of its loading and unloading branches);
 - ``repeatability``: what a sine test's device repeats from cycle to cycle (the floor beside the noise);
+- ``offsets``: the zeros a record shows before any fit (its stroke's centre, its force at rest,
+  its cycles' mean force, whether it is quasi-static);
 - ``signals``: the paper's test signals (sine, step, random) as sampled displacement and velocity.
 
 May import: ``identification.errors`` and ``fmu_src`` (a model's names and units); nothing else

@@ -35,7 +35,8 @@ COORDINATES = {
     "damping_ratio": SearchCoordinate("p", KIND.damping_ratio, -3.0, 0.5, over=("k1", "k2"), partner="mf"),
     "quadratic_damping": SearchCoordinate("p", KIND.quadratic_damping, -6.0, 1.0),
     "offset_force": SearchCoordinate("p", KIND.offset_force, -0.5, 0.5),
-    "offset_travel": SearchCoordinate("p", KIND.offset_travel, -0.25, 0.25),
+    "rig_travel": SearchCoordinate("p", KIND.rig_travel, -0.25, 0.25),
+    "rig_force": SearchCoordinate("p", KIND.rig_force, -0.5, 0.5),
     # a backbone's knot 4 from its neighbour 3, 2.5 mm apart
     "segment": SearchCoordinate("p", KIND.segment, -4.0, 2.0, over=("backbone_x4", "backbone_x3"),
                                 partner="backbone_F3"),
@@ -46,6 +47,7 @@ class Scales:
     """SearchSpace's scales, with the partner dashpot c1 over k1 for ``slower``."""
     k_ref, c_ref, F_ref, x_ref = SPACE.k_ref, SPACE.c_ref, SPACE.F_ref, SPACE.x_ref
     tau_ref, shortest_time_constant_s = SPACE.tau_ref, SPACE.shortest_time_constant_s
+    x_zero, F_zero = 1.5, 120.0         # the records' centres, the rig's zeros' origin
 
     @staticmethod
     def time_constant(values, dashpot):

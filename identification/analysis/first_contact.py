@@ -1,0 +1,195 @@
+"""A new device's first contact: what ``compare`` assumes about the training tests before it fits
+any model, why, and how to turn it off.
+
+A user who has never fitted this device names no option. Three things in the records say that
+the models need one, and each is recognised here from the data alone:
+
+- **the rig's offsets** (``rig``): a stroke that is not centred on 0 (a sine's centre beyond
+  ``ONE_SIDED`` of its half range: a damper pushed from 0 to 25 mm), a force held at rest before
+  the test starts, or a sine whose whole cycles average a force (each beyond ``OFFSET_FORCE`` of
+  the record's force half range and ``NOISE_LEVELS`` of its noise). No model of zero mean says
+  any of them; the rig's zeros, fitted as nuisance parameters (``models.md#options``), do;
+- **a backbone** (``backbone<K>``): a quasi-static test (``--static``, or a training test of at
+  most ``offsets.QUASI_STATIC_HZ``): its loading and unloading branches' mean is the static
+  curve, held as every model's backbone. K is 9 where the monotone cubic through 9 knots reads
+  the curve at 17 within ``KNOT_TOLERANCE`` of its force range, else 17 (a void's corner, a stop);
+- **a rate-dependent element** (``maxwell``): a dynamic test stiffer than that static curve over
+  its stroke (the least-squares slope of its force on the displacement, beside the velocity and a
+  constant, beyond ``1 + RATE_STIFFENING`` times the static curve's on the same samples): the
+  rubber's rate dependence, which a static backbone leaves to the rest of the model;
+- **travel limits** (``limits``): without a quasi-static test, where the mean of the largest
+  sine's loading and unloading branches stiffens towards its ends (the end segments'
+  slope beyond ``END_STIFFENING`` times the middle's): a stop each side.
+
+``compare`` races every model with what was assumed and then weighs the recommended model
+without each assumed option in turn (``compare.CompareOptions.alternatives``): an option that
+does not earn its parameters is dropped there. ``--options none`` turns every assumption off;
+naming any option (``--options rig``) takes those instead.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Sequence
+
+import numpy as np
+
+from identification.measured.noise import estimate_noise
+from identification.measured.offsets import RecordOffsets, record_offsets
+from identification.measured.rig_tests import RigTest
+
+ONE_SIDED = 0.2
+"""A sine whose stroke is centred beyond this fraction of its half range is one-sided."""
+OFFSET_FORCE = 0.02
+"""A force at rest, or a cycles' mean force, beyond this fraction of the force's half range..."""
+NOISE_LEVELS = 5.0
+"""...and beyond this many noise levels is an offset no model of zero mean says."""
+KNOT_TOLERANCE = 0.01
+"""A backbone of 9 knots reads the static curve well enough where it is within this fraction of
+its force range at the 17 knots' positions."""
+RATE_STIFFENING = 0.1
+"""Dynamic tests stiffer than the static curve by more than this fraction are rate-dependent."""
+END_STIFFENING = 3.0
+"""A static curve whose end segments are this much stiffer than its middle has stops."""
+KNOT_COUNTS = (9, 17)
+
+
+@dataclass(frozen=True)
+class Assumption:
+    """One option assumed: its token (``derived.Options``' names: rig, backbone17, maxwell,
+    limits) and why."""
+    option: str
+    reason: str
+
+
+@dataclass(frozen=True)
+class FirstContact:
+    """What ``compare`` assumes (:func:`first_contact`): the options, each with its reason, and
+    the quasi-static test the backbone is read off (None without one)."""
+    assumptions: tuple[Assumption, ...]
+    static_test: RigTest | None = None
+
+    @property
+    def tokens(self) -> tuple[str, ...]:
+        return tuple(a.option for a in self.assumptions)
+
+    def format(self) -> str:
+        """The summary's lines: what was assumed, why, and how to turn it off."""
+        if not self.assumptions:
+            return "assumed: no option (the records show no offset, no quasi-static test and no stop)"
+        lines = [f"assumed: {a.option}: {a.reason}" for a in self.assumptions]
+        lines.append("  (each option assumed was weighed against the recommended model without it; turn them off "
+                     "with --options none, or name the ones you want with --options)")
+        return "\n".join(lines)
+
+
+def _offset_reasons(offsets: RecordOffsets, test: RigTest) -> list[str]:
+    """Why one record needs the rig's offsets (empty: it does not)."""
+    reasons = []
+    name = test.name
+    if test.kind == "sine" and offsets.one_sided > ONE_SIDED:
+        reasons.append(f"the stroke of {name} is one-sided (centred at {offsets.centre_mm:+.3g} mm, "
+                       f"{offsets.half_range_mm:.3g} mm each way about it)")
+    try:
+        noise = estimate_noise(test.measurement.force_N).sigma_N
+    except ValueError:
+        noise = 0.0
+    floor = max(OFFSET_FORCE * offsets.force_half_range_N, NOISE_LEVELS * noise)
+    if math.isfinite(offsets.rest_force_N) and abs(offsets.rest_force_N) > floor:
+        reasons.append(f"{name} holds {offsets.rest_force_N:+.4g} N at rest before it moves "
+                       f"({offsets.rest_s:.3g} s at {offsets.start_mm:+.3g} mm)")
+    if test.kind == "sine" and math.isfinite(offsets.cycle_mean_force_N) and abs(offsets.cycle_mean_force_N) > floor:
+        reasons.append(f"the whole cycles of {name} average {offsets.cycle_mean_force_N:+.4g} N "
+                       f"({abs(offsets.cycle_mean_force_N) / offsets.force_half_range_N:.1%} of its force half range)")
+    return reasons
+
+
+def _knot_count(measurement) -> tuple[int, str]:
+    """The backbone's knots for a quasi-static test and why (module docstring)."""
+    from scipy.interpolate import PchipInterpolator
+
+    from identification.measured.static_curve import read_static_curve
+    coarse, fine = (read_static_curve(measurement, count=count) for count in KNOT_COUNTS)
+    between = PchipInterpolator(coarse.knots_mm, coarse.forces_N)(fine.knots_mm)
+    miss = float(np.max(np.abs(between - fine.forces_N)))
+    span = float(np.ptp(fine.forces_N))
+    if miss <= KNOT_TOLERANCE * span:
+        return KNOT_COUNTS[0], (f"{KNOT_COUNTS[0]} knots read the curve to {miss:.3g} N between them "
+                                f"({miss / span:.2%} of its range)")
+    return KNOT_COUNTS[1], (f"{KNOT_COUNTS[0]} knots miss the curve by {miss:.3g} N between them "
+                            f"({miss / span:.2%} of its range, more than {KNOT_TOLERANCE:.0%})")
+
+
+def _rate_stiffening(static_test: RigTest, dynamic: Sequence[RigTest]) -> str:
+    """Why a rate-dependent element is tried beside the static curve ("": it is not): the dynamic
+    test whose force is stiffest against the static curve's on the same samples (least-squares
+    slopes on the displacement, the velocity and a constant)."""
+    from scipy.interpolate import PchipInterpolator
+
+    from identification.measured.static_curve import read_static_curve
+    curve = read_static_curve(static_test.measurement, count=KNOT_COUNTS[1])
+    backbone = PchipInterpolator(curve.knots_mm, curve.forces_N)
+    worst, words = 0.0, ""
+    for test in dynamic:
+        m = test.measurement
+        inside = (m.displacement_mm >= curve.knots_mm[0]) & (m.displacement_mm <= curve.knots_mm[-1])
+        if np.count_nonzero(inside) < 10:
+            continue
+        x = m.displacement_mm[inside]
+        design = np.column_stack([x - np.mean(x), m.velocity_mm_s[inside], np.ones(x.size)])
+        (static, _, _), (stiffness, _, _) = (np.linalg.lstsq(design, force, rcond=None)[0]
+                                             for force in (backbone(x), m.force_N[inside]))
+        if static > 0 and stiffness / static - 1.0 > worst:
+            worst = stiffness / static - 1.0
+            words = (f"{test.name} is {worst:.0%} stiffer ({stiffness:.4g} N/mm) than the static curve "
+                     f"({static:.4g} N/mm) over its stroke")
+    return words if worst > RATE_STIFFENING else ""
+
+
+def _stops(test: RigTest) -> str:
+    """Why travel limits are tried for the largest sine ("": they are not)."""
+    from identification.errors import MeasurementError
+    from identification.measured.static_curve import read_static_curve
+    try:
+        curve = read_static_curve(test.measurement, count=KNOT_COUNTS[0])
+    except MeasurementError:
+        return ""
+    slopes = np.diff(curve.forces_N) / np.diff(curve.knots_mm)
+    middle = float(np.median(np.abs(slopes[1:-1]))) if slopes.size > 2 else 0.0
+    ends = max(abs(float(slopes[0])), abs(float(slopes[-1])))
+    if middle > 0 and ends > END_STIFFENING * middle:
+        return (f"the mean of {test.name}'s loading and unloading branches stiffens towards its ends "
+                f"({ends:.4g} N/mm against {middle:.4g} N/mm in the middle)")
+    return ""
+
+
+def first_contact(tests: Sequence[RigTest], static_test: RigTest | None = None) -> FirstContact:
+    """What the training ``tests`` (and a quasi-static ``static_test``, if given) ask the models
+    to have (module docstring). A quasi-static training test is taken as the static test where none
+    is given."""
+    tests = list(tests)
+    offsets = [record_offsets(t.measurement) for t in tests]
+    if static_test is None:
+        slow = [t for t, o in zip(tests, offsets) if t.kind != "step" and o.quasi_static]
+        static_test = slow[0] if slow else None
+    assumptions = []
+    reasons = [reason for t, o in zip(tests, offsets) for reason in _offset_reasons(o, t)]
+    if reasons:
+        assumptions.append(Assumption("rig", "; ".join(reasons) + ": no model of zero mean says that, the rig's "
+                                             "zeros fitted beside it do"))
+    if static_test is not None:
+        knots, why = _knot_count(static_test.measurement)
+        assumptions.append(Assumption(f"backbone{knots}", f"{static_test.name} is quasi-static: its branches' mean "
+                                                          f"is every model's static curve ({why})"))
+        dynamic = [t for t in tests if t.kind != "step" and t.name != static_test.name]
+        stiffening = _rate_stiffening(static_test, dynamic)
+        if stiffening:
+            assumptions.append(Assumption("maxwell", stiffening + ": a rate-dependent element beside the backbone"))
+    else:
+        sines = [t for t in tests if t.kind == "sine"]
+        if sines:
+            largest = max(sines, key=lambda t: float(np.ptp(t.measurement.displacement_mm)))
+            stops = _stops(largest)
+            if stops:
+                assumptions.append(Assumption("limits", stops + ": a travel limit each side"))
+    return FirstContact(tuple(assumptions), static_test)

@@ -1,0 +1,142 @@
+"""A new device's first contact (identification.analysis.first_contact, measured.offsets): what
+the records show before any fit, the options compare assumes from it, and compare weighing the
+recommended model without each of them.
+
+The records are made here with a known centre, rest force and mean force (analytic), or are the
+shipped synthetic files shifted by a known stroke and load-cell zero."""
+import csv
+import math
+
+import numpy as np
+import pytest
+
+from conftest import DATA
+from identification.__main__ import main
+from identification.analysis.first_contact import first_contact
+from identification.measured.measurements import Measurement, load_measurement, write_measurement
+from identification.measured.offsets import record_offsets, rig_zeros
+from identification.measured.rig_tests import RigTest
+
+TABLE5_SINE = DATA / "synthetic_table5_sine_2mm_10Hz.csv"
+TABLE5_STEP = DATA / "synthetic_table5_step_2mm_rise0.4s.csv"
+VOIDED = {name: DATA / f"synthetic_voided_{name}.csv" for name in ("sine_2mm_5Hz", "sine_3.5mm_1Hz",
+                                                                   "triangle_4.2mm_0.05Hz")}
+STROKE_MM, LOAD_CELL_N = 2.0, 100.0
+
+
+def shifted(path, folder):
+    """The file read through a one-sided stroke (+2 mm) and a load cell off by +100 N."""
+    m = load_measurement(path)
+    out = folder / f"{path.stem}_shifted.csv"
+    write_measurement(out, m.time_s, m.displacement_mm + STROKE_MM, m.force_N + LOAD_CELL_N)
+    return out
+
+
+def resting_sine(rest_s=0.5, centre=3.0, amplitude=2.0, rest_force=-250.0, mean_force=40.0):
+    """A 5 Hz sine about ``centre`` [mm] after ``rest_s`` at rest at its start value, its force
+    ``rest_force`` [N] at rest and a sine about ``mean_force`` after: every offset known."""
+    t = np.arange(0.0, rest_s + 2.0, 1e-3)
+    moving = t >= rest_s
+    phase = 2 * np.pi * 5.0 * (t - rest_s)
+    x = np.where(moving, centre - amplitude * np.cos(phase), centre - amplitude)
+    force = np.where(moving, mean_force - 500.0 * np.cos(phase), rest_force)
+    return Measurement(t, x, force, np.gradient(x, t), source="resting_sine.csv")
+
+
+def test_a_record_shows_its_stroke_centre_rest_force_and_mean_force():
+    offsets = record_offsets(resting_sine())
+    assert offsets.centre_mm == pytest.approx(3.0, abs=1e-9)
+    assert offsets.half_range_mm == pytest.approx(2.0, abs=1e-9)
+    assert offsets.one_sided == pytest.approx(1.5, abs=1e-9)
+    assert offsets.rest_force_N == pytest.approx(-250.0) and offsets.rest_s == pytest.approx(0.5, abs=5e-3)
+    assert offsets.cycle_mean_force_N == pytest.approx(40.0, abs=0.5)   # whole cycles only
+    assert offsets.frequency_hz == pytest.approx(5.0, rel=1e-3) and not offsets.quasi_static
+
+
+def test_a_record_that_starts_moving_has_no_rest_force():
+    assert math.isnan(record_offsets(resting_sine(rest_s=0.0)).rest_force_N)
+
+
+def test_the_rig_zeros_are_the_periodic_records_centres_else_the_rests():
+    sine = record_offsets(resting_sine())
+    assert rig_zeros([sine]) == pytest.approx((3.0, 40.0), abs=0.5)
+    step = record_offsets(resting_sine(rest_s=1.0, rest_force=75.0))
+    assert rig_zeros([step], steps=[True]) == pytest.approx((1.0, 75.0))
+    assert rig_zeros([]) == (0.0, 0.0)
+
+
+def test_centred_tests_assume_nothing():
+    tests = [RigTest(load_measurement(TABLE5_SINE), "sine"), RigTest(load_measurement(TABLE5_STEP), "step", 0.4)]
+    assert first_contact(tests).assumptions == ()
+
+
+def test_a_one_sided_stroke_and_a_load_cell_zero_assume_the_rig(tmp_path):
+    tests = [RigTest(load_measurement(shifted(TABLE5_SINE, tmp_path)), "sine"),
+             RigTest(load_measurement(shifted(TABLE5_STEP, tmp_path)), "step", 0.4)]
+    contact = first_contact(tests)
+    assert contact.tokens == ("rig",)
+    assert "one-sided" in contact.assumptions[0].reason and "+2 mm" in contact.assumptions[0].reason
+    assert "--options none" in contact.format()
+
+
+def test_a_force_at_rest_assumes_the_rig():
+    contact = first_contact([RigTest(resting_sine(centre=0.0, amplitude=2.0, mean_force=0.0), "sine")])
+    assert contact.tokens == ("rig",) and "holds -250 N at rest" in contact.assumptions[0].reason
+
+
+def test_the_voided_bushing_with_its_slow_triangle_assumes_a_backbone_a_maxwell_element_and_the_rig():
+    # the options its benchmark named by hand (docs/benchmarks.md, voided bushing): the 9-knot cubic
+    # misses its void's corner and stop, and its 5 Hz sine is stiffer than the static curve
+    tests = [RigTest(load_measurement(VOIDED[name]), "sine") for name in ("sine_2mm_5Hz", "sine_3.5mm_1Hz")]
+    triangle = RigTest(load_measurement(VOIDED["triangle_4.2mm_0.05Hz"]))
+    assert sorted(first_contact(tests, triangle).tokens) == ["backbone17", "maxwell", "rig"]
+    # the same when the triangle is a training test: it is recognised as quasi-static
+    contact = first_contact([*tests, triangle])
+    assert sorted(contact.tokens) == ["backbone17", "maxwell", "rig"] and contact.static_test.name == triangle.name
+
+
+def test_compare_says_what_it_assumed_and_weighs_the_model_without_it(tmp_path, capsys):
+    sine = shifted(TABLE5_SINE, tmp_path)
+    out = tmp_path / "compare"
+    assert main(["compare", "--sine", str(sine), "--models", "single_bouc_wen", "--screening", "32", "--starts", "2",
+                 "--no-ensemble", "--quiet", "--workers", "1", "--out", str(out)]) == 0
+    printed = capsys.readouterr()
+    assert "assumed: rig: the stroke of" in printed.out and "assumed: rig" in printed.err
+    with open(out / "comparison.csv") as handle:
+        rows = {row["model"]: row for row in csv.DictReader(handle)}
+    assert set(rows) == {"single_bouc_wen+rig", "single_bouc_wen"}
+    assert (out / "params_single_bouc_wen+rig.json").is_file() and (out / "params_single_bouc_wen.json").is_file()
+    assert sum(row["recommended"] == "True" for row in rows.values()) == 1
+
+
+def test_compare_with_options_none_assumes_nothing(tmp_path, capsys):
+    sine = shifted(TABLE5_SINE, tmp_path)
+    out = tmp_path / "compare"
+    assert main(["compare", "--sine", str(sine), "--models", "kelvin_voigt", "--options", "none", "--no-ensemble",
+                 "--quiet", "--out", str(out)]) == 0
+    assert "assumed" not in capsys.readouterr().out
+    with open(out / "comparison.csv") as handle:
+        assert [row["model"] for row in csv.DictReader(handle)] == ["kelvin_voigt"]
+
+
+def test_the_rig_zeros_are_searched_about_the_records_centre_on_the_centred_scales(tmp_path):
+    # the box of proposed+rig on the shifted files is the box of the proposed model on the
+    # original ones, its rig's zeros searched about (+2 mm, +100 N)
+    from fmu_src.model.registry import get_model
+    from identification.fitting.search_space import SearchSpace
+    original = [load_measurement(TABLE5_SINE), load_measurement(TABLE5_STEP)]
+    moved = [load_measurement(shifted(path, tmp_path)) for path in (TABLE5_SINE, TABLE5_STEP)]
+    plain = SearchSpace.from_measurements(original, "proposed", steps=[False, True])
+    rig = SearchSpace.from_measurements(moved, get_model("proposed+rig"), steps=[False, True])
+    assert rig.x_zero == pytest.approx(STROKE_MM, abs=1e-3)
+    # the centred sine's whole cycles average -18 N (its long relaxation from rest): an estimate, a box's centre
+    assert rig.F_zero == pytest.approx(LOAD_CELL_N, abs=0.01 * rig.F_ref)
+    for scale in ("k_ref", "c_ref", "F_ref", "x_ref"):
+        assert getattr(rig, scale) == pytest.approx(getattr(plain, scale), rel=0.02), scale
+    names = list(rig.names)
+    centre = np.zeros((1, len(names)))
+    values = rig.to_model_parameters(centre)[0]
+    parameters = dict(zip(rig.bushing.parameter_names, values))
+    assert parameters["rig_displacement_zero"] == pytest.approx(rig.x_zero)
+    assert parameters["rig_force_zero"] == pytest.approx(rig.F_zero)
+    assert SearchSpace.from_measurements(original, "proposed", steps=[False, True]).x_zero == 0.0
