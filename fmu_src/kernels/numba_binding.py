@@ -328,7 +328,16 @@ def model_source(model, machinery: str, appendix: str = "") -> str:
             + "\n\n" + inspect.getsource(integration.step_prepared) + "\n\n" + inspect.getsource(integration.step)
             + "\n\nstep_prepared = numba.njit(error_model='numpy', cache=True)(step_prepared)"
             + "\nstep = numba.njit(error_model='numpy', cache=True)(step)\n"
+            + start_source(model)
             + (_COUPLED_STEP if model.coupled is not None else "") + appendix)
+
+
+def start_source(model) -> str:
+    """``integration.start_state`` as ``start_state``, bound to the model's ``resting_state`` (or
+    ``start_relaxed`` under that name, for a model without one), compiled."""
+    start = integration.start_state if model.resting_state is not None else integration.start_relaxed
+    return ("\n\n" + inspect.getsource(start).replace(f"def {start.__name__}(", "def start_state(", 1)
+            + "\n\nstart_state = numba.njit(error_model='numpy', cache=True)(start_state)\n")
 
 
 _COUPLED_STEP = ("\n\n" + inspect.getsource(integration.step_coupled)
@@ -424,8 +433,15 @@ def kernel_module(model) -> types.ModuleType:
     return load_generated(module_name(f"bushing_kernels_{model.name}", source), source)
 
 
+def compiled_in_fmu(model) -> tuple[str, ...]:
+    """The kernels an FMU of ``model`` takes compiled: COMPILED_IN_FMU, and for a model with a
+    resting state the two that its start (``integration.start_state``, bound to the module's
+    globals) calls, so that the model's kernels are its compiled module's."""
+    return COMPILED_IN_FMU + (("initial_state", "resting_state") if model.resting_state is not None else ())
+
+
 def compiled_model(model):
-    """({name: compiled kernel} for COMPILED_IN_FMU, "step_axes" and "step_one", seconds it took) —
+    """({name: compiled kernel} for ``compiled_in_fmu``, "step_axes" and "step_one", seconds it took) —
     compiling now, or loading numba's cached machine code — or (None, why not) if numba cannot
     be imported."""
     try:
@@ -435,7 +451,7 @@ def compiled_model(model):
     import numpy as np
     started = time.perf_counter()
     module = kernel_module(model)
-    kernels = {name: getattr(module, name) for name in COMPILED_IN_FMU}
+    kernels = {name: getattr(module, name) for name in compiled_in_fmu(model)}
     kernels["step_axes"], kernels["step_one"] = module._step_axes, module._step_one
     # compile (or load) now, so that a first step does not wait: the constants and state the
     # plain-Python kernels make are what the FMU passes
@@ -556,7 +572,7 @@ def compile_axes(axes) -> tuple[list, dict, str]:
                 compiled[model.name], seconds = kernels, seconds + info
     except Exception as exc:   # a broken numba or an unwritable cache must not stop the FMU
         return list(axes), {}, f"pure-Python step: compiling the kernels failed ({type(exc).__name__}: {exc})"
-    out = [(axis, dataclasses.replace(model, **{name: compiled[model.name][name] for name in COMPILED_IN_FMU}),
+    out = [(axis, dataclasses.replace(model, **{name: compiled[model.name][name] for name in compiled_in_fmu(model)}),
             parameters) for axis, model, parameters in axes]
     batched = {name: (kernels["step_axes"], kernels["step_one"]) for name, kernels in compiled.items()}
     why = f"{STEP_ENVIRONMENT}=compiled" if choice == "compiled" else "a Python interpreter"

@@ -14,6 +14,7 @@ value's range, its default parameter file, and its equations as five kernels:
     derivatives(constants, state, x, v) -> d(state)/dt
     switches(constants, state, x, v) -> the quantities whose sign selects the equations' branch
     update(constants, state, x, v) -> state     (optional) the state after an event
+    resting_state(constants, x0, force) -> state   (optional) at rest at x0 [mm] holding force [N]
 
 A state is a tuple of floats (the kernels' order; ``states`` names them for the FMU; empty
 for a model without state). Over a step the displacement is x + v*t [mm] for 0 <= t <= h [s]
@@ -71,7 +72,9 @@ class ModelContractError(ValueError):
 
 STEP_KERNELS = ("jump", "integrate")
 """The model kernels ``integration.step`` and ``step_prepared`` call by their global names (their
-``prepare_step`` is the module's own or the machinery's ``unprepared_step``, by construction)."""
+``prepare_step`` is the module's own or the machinery's ``unprepared_step``, by construction);
+``integration.start_state`` calls ``resting_state`` and ``initial_state`` so, for a model with a
+resting state."""
 
 
 def check_step_kernels(model, module: types.ModuleType) -> None:
@@ -79,13 +82,14 @@ def check_step_kernels(model, module: types.ModuleType) -> None:
     (:data:`STEP_KERNELS`) are ``model``'s kernels of those names: the protocol is bound to the
     module's globals by name, so a model whose ``jump`` is another function would step with the
     wrong one."""
-    for name in STEP_KERNELS:
+    names = STEP_KERNELS + (("resting_state", "initial_state") if model.resting_state is not None else ())
+    for name in names:
         if vars(module).get(name) is not getattr(model, name):
             raise ModelContractError(
                 f"{module.__name__}: the step protocol calls its global {name!r}, which is "
                 f"{vars(module).get(name)!r}, not the model {model.name!r}'s {name} kernel "
-                f"{getattr(model, name)!r}; name the kernels jump and integrate in the module "
-                "that defines them")
+                f"{getattr(model, name)!r}; name the kernels jump, integrate (and resting_state, "
+                "initial_state) in the module that defines them")
 
 
 @dataclass(frozen=True)
@@ -298,9 +302,19 @@ class BushingModel:
     """A derived model's base (``derived``: the model with options); None for a registered model."""
     options: object = None
     """A derived model's ``derived.Options``; None for a registered model."""
+    resting_state: Callable | None = None
+    """resting_state(constants, x0, force) -> state: the state at rest at displacement x0 [mm]
+    that holds ``force`` [N] (a friction element stuck, its slider deflected: the force a test
+    before left in the device), for a model whose elements can hold a force at rest; the nearest
+    it can hold where it cannot hold that much. None: it holds none (a run starts relaxed).
+    ``start_state`` chooses between it and ``initial_state``."""
     step: Callable = field(init=False, repr=False, compare=False)
     """step(constants, state, state_x, x, v, h, max_substeps) -> (state, substeps, status): the
     step protocol of ``integration.step`` bound to this model's ``jump`` and ``integrate``."""
+    start_state: Callable = field(init=False, repr=False, compare=False)
+    """start_state(constants, x0, rest_force) -> state: ``integration.start_state`` bound to this
+    model's ``resting_state`` and ``initial_state`` (``start_relaxed`` without a resting state):
+    at rest holding ``rest_force`` [N], NaN relaxed."""
 
     def __post_init__(self):
         # integration.step's code with the globals of the module that defines the kernels in use
@@ -311,6 +325,8 @@ class BushingModel:
         namespace.setdefault("prepare_step", integration.unprepared_step)
         namespace["step_prepared"] = types.FunctionType(integration.step_prepared.__code__, namespace, "step_prepared")
         object.__setattr__(self, "step", types.FunctionType(integration.step.__code__, namespace, "step"))
+        start = integration.start_state if self.resting_state is not None else integration.start_relaxed
+        object.__setattr__(self, "start_state", types.FunctionType(start.__code__, namespace, start.__name__))
 
     @property
     def prepare_step(self) -> Callable:

@@ -31,6 +31,8 @@ def _reached(base: BushingModel, module: types.ModuleType) -> tuple[list[str], d
     defined = {node.name: node for node in tree.body if isinstance(node, ast.FunctionDef)}
     roots = [getattr(base, name).__name__ for name in KERNELS]
     roots += [name for name in ("prepare_step",) if name in defined]
+    if base.resting_state is not None:
+        roots.append(base.resting_state.__name__)
     if base.update is not None:
         roots.append(base.update.__name__)
     seen, constants, shared, pending = set(), {}, set(), list(roots)
@@ -173,6 +175,15 @@ def wrapper_source(base: BushingModel, options) -> tuple[str, set[str]]:
     force += [f"    f = f + state[{n}]"] if mx is not None else []
     force += [f"    f = f + m[{slot['rig']}][1]"] if options.rig else []
     source.append("def force(m, state, x, v):\n" + "\n".join(force) + "\n    return f\n")
+    if base.resting_state is not None:
+        # the options' forces at rest (a Maxwell element holds none) taken off what the base holds
+        rest = [f"    u = x0{zero}", "    f = force"]
+        rest += [f"    f = f - backbone_force(m[{slot['backbone']}], u)"] if options.knots else []
+        rest += [f"    f = f - limits_force(m[{slot['limits']}], u, 0.0)"] if options.limits else []
+        rest += [f"    f = f - m[{slot['rig']}][1]"] if options.rig else []
+        held = "base_resting_state(m[0], u, f)"
+        rest += [f"    return {held}"] if mx is None else [f"    s = {held}", f"    return {out('s').format('0.0')}"]
+        source.append("def resting_state(m, x0, force):\n" + "\n".join(rest) + "\n")
     switches = [f"s[{i}]" for i in range(len(base.switch_specs))]
     if options.limits:
         switches += [f"u - m[{slot['limits']}][0]", f"u + m[{slot['limits']}][5]"]

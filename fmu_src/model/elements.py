@@ -58,6 +58,50 @@ def dead_zone(e, gap, width):
     return width * (softplus((e - gap) / width) - softplus((-e - gap) / width))
 
 
+def logistic(y):
+    """1/(1 + exp(-y)), the softplus's slope, written so that exp never overflows."""
+    if y >= 0.0:
+        return 1.0 / (1.0 + math.exp(-y))
+    e = math.exp(y)
+    return e / (1.0 + e)
+
+
+DEAD_ZONE_BISECTIONS = 60
+"""Halvings of the bracket of :func:`inverse_dead_zone` (60: the bracket shrinks below rounding)."""
+
+
+def inverse_dead_zone(d, gap, width):
+    """The e whose ``dead_zone(e, gap, width)`` is d (same units): d + gap, d - gap or 0 with hard
+    corners; with rounded ones, the root of the monotone softplus form, bracketed in
+    [0, d + gap + width] (or its mirror: there D(e) > d), halved DEAD_ZONE_BISECTIONS times, then
+    one Newton step, whose derivative with respect to d, gap and width is the root's own (what the
+    fit's tangents of a bisection alone would not give)."""
+    if width <= 0.0:
+        if d > 0.0:
+            return d + gap
+        if d < 0.0:
+            return d - gap
+        return 0.0
+    if d == 0.0:
+        return 0.0
+    low = 0.0
+    high = d + gap + width
+    if d < 0.0:
+        low = d - gap - width
+        high = 0.0
+    for i in range(DEAD_ZONE_BISECTIONS):
+        middle = 0.5 * (low + high)
+        if dead_zone(middle, gap, width) < d:
+            low = middle
+        else:
+            high = middle
+    e = 0.5 * (low + high)
+    slope = logistic((e - gap) / width) + logistic((-e - gap) / width)
+    if slope > 0.0:
+        e = e - (dead_zone(e, gap, width) - d) / slope
+    return e
+
+
 def ramp(d, width):
     """max(d, 0) with its corner rounded over ``width`` (width*softplus(d/width)); the hard corner
     where ``width`` = 0. Same unit as d."""

@@ -486,6 +486,24 @@ def vector_substeps_needed(u, z, T, a, blk, limit, view):
     return turn if turn > count else count
 
 
+# ---------------------------------------------------------------------------- the start
+def start_state(m, x0, rest_force):
+    """The state a run starts from at displacement ``x0`` [mm]: at rest holding ``rest_force``
+    [N] (the model's ``resting_state``: a friction element stuck with its slider deflected, the
+    force a test before left in the device) where that is a number, else relaxed
+    (``initial_state``; NaN asks for it). Bound to each model's kernels as :func:`step` is, for
+    a model with a ``resting_state``; never called in this module."""
+    if rest_force == rest_force:
+        return resting_state(m, x0, rest_force)  # noqa: F821 (the model's, where bound)
+    return initial_state(m, x0)  # noqa: F821
+
+
+def start_relaxed(m, x0, rest_force):
+    """:func:`start_state` of a model that holds no force at rest (it has no ``resting_state``):
+    relaxed at ``x0`` whatever ``rest_force`` is."""
+    return initial_state(m, x0)  # noqa: F821
+
+
 # ---------------------------------------------------------------------------- the step
 def unprepared_step(m, h):
     """``prepare_step`` of a model without constants of its own per step size: its constants."""

@@ -27,14 +27,15 @@ elsewhere.
 
 Units N-mm-s: z, zp, zn in N, A and k0 in N/mm, c0 in N.s/mm, gap, width and delta in mm, n, eps
 and q dimensionless. The state is ``(e, q)``: the element's deflection [mm] and the breakaway
-memory [1]; at rest e = 0 (the play's centre) and q = 1.
+memory [1]; at rest e = 0 (the play's centre) and q = 1, or, holding a force at rest (a friction
+force the test before left in the device: ``resting_state``), stuck at the e that gives it.
 """
 from __future__ import annotations
 
 import math
 
 from ..model.parameter_specs import DAMPING, SPRING, ParameterSpec
-from ..model.elements import dead_zone
+from ..model.elements import dead_zone, inverse_dead_zone
 from ..model.integration import DEFAULT_MAX_SUBSTEPS, NOT_FINITE, OK, THETA, TOO_MANY_SUBSTEPS
 from ..model.definition import BushingModel, SearchBox, SearchCoordinate, StateSpec
 from ..model.search_coordinates import KIND
@@ -144,6 +145,19 @@ def initial_state(m, x0):
     return (0.0, 1.0)
 
 
+def resting_state(m, x0, force):
+    """At rest at x0 [mm] holding ``force`` [N]: the element stuck (q = 1) at the deflection whose
+    force A*D(e) is force - k0*x0, the nearest its yield allows each way ((1 + eps) times zp or
+    zn, where it starts to slide)."""
+    c0, k0, A, zp, zn, n, gap, width, eps, rate, longest = m
+    z = force - k0 * x0
+    if z > zp * (1.0 + eps):
+        z = zp * (1.0 + eps)
+    if z < -zn * (1.0 + eps):
+        z = -zn * (1.0 + eps)
+    return (inverse_dead_zone(z / A, gap, width), 1.0)
+
+
 def force(m, state, x, v):
     """F = c0*v + k0*x + A*D(e) [N]."""
     c0, k0, A, zp, zn, n, gap, width, eps, rate, longest = m
@@ -198,7 +212,7 @@ MODEL = BushingModel(
                   StateSpec("z", 1, "N", "the element's force"),
                   StateSpec("play_upper", 2, "m", "e - gap: the play's upper corner"),
                   StateSpec("play_lower", 3, "m", "e + gap: the play's lower corner")),
-    search=SEARCH, plot_style=("C8", "-"), rank=25,
+    search=SEARCH, plot_style=("C8", "-"), rank=25, resting_state=resting_state,
     description="A Bouc-Wen element whose yield differs by direction, with free play and breakaway, in "
                 "parallel with a spring and a dashpot (inputs x [m], v [m/s]; output F [N]).",
     static_spring=("k0",))

@@ -43,6 +43,23 @@ def initial_state(m, x0):
     return (0.0,)
 
 
+def resting_state(m, x0, force):
+    """At rest at x0 [mm] holding ``force`` [N]: z = (force - k0*x0)/alpha, the nearest the
+    element holds to it (within its ultimate force (A/(beta + gamma))^(1/n) where beta + gamma > 0;
+    z = 0 where alpha = 0)."""
+    c0, k0, alpha, A, beta, gamma, n = m
+    if alpha == 0.0:
+        return (0.0,)
+    z = (force - k0 * x0) / alpha
+    if beta + gamma > 0.0:
+        ultimate = (A / (beta + gamma)) ** (1.0 / n)
+        if z > ultimate:
+            z = ultimate
+        if z < -ultimate:
+            z = -ultimate
+    return (z,)
+
+
 def force(m, state, x, v):
     """F = c0*v + k0*x + alpha*z [N]."""
     c0, k0, alpha, A, beta, gamma, n = m
@@ -134,7 +151,7 @@ MODEL = BushingModel(
     derivatives, switches, constraints=SINGLE_BLOCK_CONSTRAINTS,
     switch_specs=(StateSpec("v", 0, "m/s", "the velocity input, which drives the element"),
                   StateSpec("z", 1, "N", "hysteretic force")),
-    search=SEARCH, plot_style=("C1", ":"), rank=20,
+    search=SEARCH, plot_style=("C1", ":"), rank=20, resting_state=resting_state,
     coupled=CoupledKernels((StateSpec("z", 0, "N", "hysteretic force"),), initial_state_coupled,
                            jump_coupled, integrate_coupled, force_coupled, derivatives_coupled, switches_coupled,
                            (StateSpec("zv", 0, "N.m/s", "z.v: the element's branch"),)),

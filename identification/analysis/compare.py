@@ -55,6 +55,7 @@ from identification.fitting.search import table_fit
 from identification.interrupt import writing
 from identification.measured.kdyn_table import KDYN_UNCERTAINTY, LOSS_ANGLE_UNCERTAINTY_DEG, KdynTable
 from identification.measured.measurements import load_measurement, measurement_name
+from identification.measured.offsets import held_force
 from identification.fitting.objectives import nrmse, rms_level_error
 from identification.analysis.plots import plot_comparison, plot_table_comparison
 from identification.measured.rig_tests import RigTest
@@ -338,8 +339,9 @@ def _validation_errors(validation, bushings, parameters: dict, assessments: list
     errors, predictions = {}, {}
     for m in validation:
         name = Path(m.source).name
+        rest = held_force(m)
         predictions[name] = {bushing.name: simulate(parameters[bushing.name], m.time_s, m.displacement_mm,
-                                                    m.measured_velocity_mm_s, model=bushing)
+                                                    m.measured_velocity_mm_s, model=bushing, rest_force_N=rest)
                              for bushing in bushings}
         for assessment in assessments:
             predicted = predictions[name][assessment.model]

@@ -6,8 +6,8 @@ the models need one, and each is recognised here from the data alone:
 
 - **the rig's offsets** (``rig``): a stroke that is not centred on 0 (a sine's centre beyond
   ``ONE_SIDED`` of its half range: a damper pushed from 0 to 25 mm), a force held at rest before
-  the test starts, or a sine whose whole cycles average a force (each beyond ``OFFSET_FORCE`` of
-  the record's force half range and ``NOISE_LEVELS`` of its noise). No model of zero mean says
+  the test starts, or a sine whose whole cycles average a force (each beyond ``offsets.OFFSET_FORCE`` of
+  the record's force half range and ``offsets.NOISE_LEVELS`` of its noise). No model of zero mean says
   any of them; the rig's zeros, fitted as nuisance parameters (``models.md#options``), do;
 - **a backbone** (``backbone<K>``): a quasi-static test (``--static``, or a training test of at
   most ``offsets.QUASI_STATIC_HZ``): its loading and unloading branches' mean is the static
@@ -34,16 +34,11 @@ from typing import Sequence
 
 import numpy as np
 
-from identification.measured.noise import estimate_noise
-from identification.measured.offsets import RecordOffsets, record_offsets
+from identification.measured.offsets import RecordOffsets, offset_floor, record_offsets
 from identification.measured.rig_tests import RigTest
 
 ONE_SIDED = 0.2
 """A sine whose stroke is centred beyond this fraction of its half range is one-sided."""
-OFFSET_FORCE = 0.02
-"""A force at rest, or a cycles' mean force, beyond this fraction of the force's half range..."""
-NOISE_LEVELS = 5.0
-"""...and beyond this many noise levels is an offset no model of zero mean says."""
 KNOT_TOLERANCE = 0.01
 """A backbone of 9 knots reads the static curve well enough where it is within this fraction of
 its force range at the 17 knots' positions."""
@@ -90,11 +85,7 @@ def _offset_reasons(offsets: RecordOffsets, test: RigTest) -> list[str]:
     if test.kind == "sine" and offsets.one_sided > ONE_SIDED:
         reasons.append(f"the stroke of {name} is one-sided (centred at {offsets.centre_mm:+.3g} mm, "
                        f"{offsets.half_range_mm:.3g} mm each way about it)")
-    try:
-        noise = estimate_noise(test.measurement.force_N).sigma_N
-    except ValueError:
-        noise = 0.0
-    floor = max(OFFSET_FORCE * offsets.force_half_range_N, NOISE_LEVELS * noise)
+    floor = offset_floor(test.measurement, offsets)
     if math.isfinite(offsets.rest_force_N) and abs(offsets.rest_force_N) > floor:
         reasons.append(f"{name} holds {offsets.rest_force_N:+.4g} N at rest before it moves "
                        f"({offsets.rest_s:.3g} s at {offsets.start_mm:+.3g} mm)")

@@ -14,6 +14,7 @@ mappings, best first).
 from __future__ import annotations
 
 import csv
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -73,7 +74,7 @@ class Prediction:
 
 
 def predict(parameters, time_s, displacement_mm, velocity_mm_s=None,
-            model: str | BushingModel | None = None) -> Prediction:
+            model: str | BushingModel | None = None, rest_force_N: float = math.nan) -> Prediction:
     """Predict a test: the best set's force and the ensemble's band at every sample.
 
     Parameters
@@ -86,6 +87,9 @@ def predict(parameters, time_s, displacement_mm, velocity_mm_s=None,
         Measured velocity [mm/s] at the samples.
     model : str or BushingModel, optional
         The model the parameters must be for (or its name).
+    rest_force_N : float, optional
+        The force [N] the test holds at rest before it moves (``measured.offsets.held_force``):
+        a model that can hold a force at rest starts holding it; NaN (default): relaxed.
 
     Returns
     -------
@@ -100,8 +104,8 @@ def predict(parameters, time_s, displacement_mm, velocity_mm_s=None,
     """
     bushing, sets = parameter_sets(parameters, model)
     x = np.asarray(displacement_mm, dtype=float)
-    forces = _mounted_population(bushing, sets, lambda matrix, offset: simulate_driven(
-        matrix, prepare_input(time_s, x - offset, velocity_mm_s), model=bushing))
+    forces = _mounted_population(bushing, sets, lambda matrix, offset, preload: simulate_driven(
+        matrix, prepare_input(time_s, x - offset, velocity_mm_s, rest_force_N=rest_force_N - preload), model=bushing))
     _refuse_failed(forces[0], time_s)
     return Prediction(np.asarray(time_s, dtype=float), x, forces[0], np.nanmin(forces, axis=0),
                       np.nanmax(forces, axis=0), len(sets))
@@ -160,7 +164,7 @@ def predict_multiaxis(parameters, time_s, displacement_mm, coupling: str, veloci
         raise IdentificationError(f"a multi-axis path has 2 or 3 displacement columns, one row per time: got "
                                   f"{x.shape} for {t.size} times")
     coupled = coupled_axes(coupling, x.shape[1])
-    forces = _mounted_population(bushing, sets, lambda matrix, offset: simulate_driven_vector(
+    forces = _mounted_population(bushing, sets, lambda matrix, offset, preload: simulate_driven_vector(
         matrix, prepare_vector_input(t, x - offset, velocity_mm_s), model=bushing, coupled_axes=coupled))
     _refuse_failed(forces[0], t)
     return MultiAxisPrediction(t, x, forces[0], np.nanmin(forces, axis=0), np.nanmax(forces, axis=0), len(sets),
@@ -169,13 +173,13 @@ def predict_multiaxis(parameters, time_s, displacement_mm, coupling: str, veloci
 
 def _mounted_population(bushing: BushingModel, sets, simulate_at) -> np.ndarray:
     """Forces (P, ...) of the parameter sets, each with its mounting (F = model(x - offset) +
-    preload, ``BushingModel.mounting``): ``simulate_at(matrix, offset)`` once for each mounting
+    preload, ``BushingModel.mounting``): ``simulate_at(matrix, offset, preload)`` once for each mounting
     the sets carry (a fit's members share one)."""
     mountings = [bushing.mounting(values) for values in sets]
     forces = [None] * len(sets)
     for offset, preload in dict.fromkeys(mountings):
         members = [i for i, mounting in enumerate(mountings) if mounting == (offset, preload)]
-        result = simulate_at(parameter_matrix([sets[i] for i in members], bushing), offset) + preload
+        result = simulate_at(parameter_matrix([sets[i] for i in members], bushing), offset, preload) + preload
         for row, i in zip(result, members):
             forces[i] = row
     return np.array(forces)

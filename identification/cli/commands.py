@@ -8,6 +8,7 @@ rescued into the working or the temporary directory (``_save_or_rescue``).
 """
 from __future__ import annotations
 
+import math
 import os
 import sys
 import tempfile
@@ -253,7 +254,9 @@ def predict_command(args) -> int:
         raise UsageError(f"--coupling {args.coupling}: {args.data} is a one-axis test (time_s, displacement_*); a "
                          "coupling says how the model runs on a multi-axis path (dx_mm, dy_mm[, dz_mm])")
     m = load_measurement(args.data, force_optional=True)
-    prediction = predict(ensemble, m.time_s, m.displacement_mm, m.measured_velocity_mm_s)
+    from identification.measured.offsets import held_force
+    prediction = predict(ensemble, m.time_s, m.displacement_mm, m.measured_velocity_mm_s,
+                         rest_force_N=held_force(m) if m.has_force else math.nan)
     prediction.write_csv(args.out)
     written = [args.out]
     if args.plot:

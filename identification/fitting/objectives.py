@@ -36,6 +36,7 @@ from identification.measured.kdyn_table import (FIT_CYCLES, FIT_STEPS_PER_CYCLE,
                                                 SEARCH_CYCLES, SEARCH_STEPS_PER_CYCLE, KdynTable)
 from identification.measured.multiaxis import MultiAxisMeasurement, coupled_axes
 from identification.measured.noise import NoiseEstimate, estimate_noise
+from identification.measured.offsets import held_force
 from identification.measured.rig_tests import RigTest
 from identification.forward.simulate import simulate_driven, simulate_driven_vector
 
@@ -168,7 +169,9 @@ class Objective:
         (``bushing``; ``model`` is its name); a worker receives the name and resolves it once.
         ``multiaxis``: multi-axis tests (``MultiAxisTests``), each axis's force a residual in that
         axis's noise units, the model run on them with their coupling; their steps per sample are
-        the signal's (the refinement does not change them)."""
+        the signal's (the refinement does not change them). A model that can hold a force at rest
+        starts each test holding the force the test holds before it moves (``offsets.held_force``;
+        ``rest_forces``, NaN where none)."""
         if not tests and table is None and not multiaxis.measurements:
             raise ValueError("the objective needs at least one training test, multi-axis test or dynamic-stiffness "
                              "table")
@@ -178,14 +181,15 @@ class Objective:
         steps = list(steps) if steps is not None else [None] * len(tests)
         if len(steps) != len(tests):
             raise ValueError(f"{len(steps)} step counts for {len(tests)} tests")
+        self.rest_forces = [held_force(t.measurement) for t in tests]
         self.noise = noise
         self.bushing = resolve_model(model)
         self.model = model if isinstance(model, str) else self.bushing.name
         self.tests: list[PreparedTest] = []
-        for test, level, m_steps in zip(tests, noise, steps):
+        for test, level, m_steps, rest in zip(tests, noise, steps, self.rest_forces):
             m = test.measurement
             driven = prepare_input(m.time_s, m.displacement_mm, m.measured_velocity_mm_s, decimate_holds=True,
-                                   steps=m_steps)
+                                   steps=m_steps, rest_force_N=rest)
             sigma = max(level.sigma_N, MIN_NOISE_FRACTION * level.rms_force_N)
             self.tests.append(PreparedTest(test.name, driven, m.force_N[driven.sample_index], sigma))
         self.rig_tests = list(tests)     # what it was made of: with_steps, prefix, with_fit_loop derive from them
@@ -220,7 +224,12 @@ class Objective:
             # a prefix of a step may end inside its ramp: as a plain time series, whose kind checks nothing
             cut.append(RigTest(replace(m, time_s=m.time_s[:k], displacement_mm=m.displacement_mm[:k],
                                        force_N=m.force_N[:k], velocity_mm_s=m.velocity_mm_s[:k])))
-        return Objective(cut, self.noise, self.steps_per_sample, self.bushing)
+        prefix = Objective(cut, self.noise, self.steps_per_sample, self.bushing)
+        # the whole tests' forces at rest (a prefix's own range would judge its rest on less)
+        prefix.rest_forces = list(self.rest_forces)
+        prefix.tests = [replace(t, driven=replace(t.driven, rest_force_N=rest))
+                        for t, rest in zip(prefix.tests, self.rest_forces)]
+        return prefix
 
     def with_fit_loop(self) -> "Objective":
         """The same objective with the table's fit loop instead of its search loop (itself if it

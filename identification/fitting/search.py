@@ -31,6 +31,7 @@ from identification.measured.measurements import Measurement
 from identification.measured.multiaxis import vector_nrmse
 from identification.fitting.multistart import (AnchoredStarts, PrefixScreening, Problem, StartRecord, failed_starts,
                                                first_records, jacobian, run_stages, screen, simulations_per_jacobian)
+from identification.measured.offsets import held_force
 from identification.measured.repeatability import estimate_repeatability
 from identification.measured.noise import NoiseEstimate
 from identification.fitting.objectives import MultiAxisTests, Objective, nrmse
@@ -311,6 +312,7 @@ class Search:
                 self.notes.append(note)
         objective = Objective(request.tests, request.noise, model=self.space.bushing, table=request.table,
                               search=request.table is not None, multiaxis=multi)
+        self.notes += resting_notes(request.tests, objective.rest_forces, self.space.bushing)
         self.n, self.d = objective.size, len(self.space.names)     # residuals, coordinates
         return Problem(objective, self.space, self.jacobian_kind)
 
@@ -497,6 +499,18 @@ def _check_steps(problem: Problem, records, n: int, d: int):
                         misfit_threshold(best.misfit, n, d) * n)
 
 
+def resting_notes(tests, rest_forces, bushing: BushingModel) -> list[str]:
+    """The fit's notes on the tests that start at rest holding a force (``offsets.held_force``): the
+    model starts them there (its ``resting_state``), or cannot hold one and starts them relaxed."""
+    notes = []
+    for test, rest in zip(tests, rest_forces):
+        if math.isfinite(rest):
+            notes.append(f"note: {test.name} holds {rest:+.4g} N at rest before it moves: the {bushing.name} model "
+                         + ("starts it there, its elements stuck holding that force" if bushing.resting_state
+                            is not None else "holds no force at rest and starts it relaxed"))
+    return notes
+
+
 def test_fits(tests, noise, parameters: ParameterSet, steps=None) -> list[RigTestFit]:
     """Each test's noise, repeatability (a sine's) and NRMSE at ``parameters``, simulated with
     ``steps`` per sample (per test; default: chosen from the signal)."""
@@ -504,7 +518,7 @@ def test_fits(tests, noise, parameters: ParameterSet, steps=None) -> list[RigTes
     for test, level, m_steps in zip(tests, noise, steps or [None] * len(tests)):
         m = test.measurement
         predicted = simulate(parameters, m.time_s, m.displacement_mm, m.measured_velocity_mm_s,
-                             steps_per_sample=m_steps)
+                             steps_per_sample=m_steps, rest_force_N=held_force(m))
         repeats = estimate_repeatability(m.time_s, m.displacement_mm, m.force_N) if test.kind == "sine" else None
         fits.append(RigTestFit(test.name, test.kind, level, nrmse(predicted, m.force_N), repeats, predicted))
     return fits

@@ -66,7 +66,8 @@ class DrivenInput:
     interpolant's displacement there and the secant velocity of each step (last entry 0);
     ``output_index``: the communication points that are samples whose force is computed,
     ``sample_index``: which samples of the test they are, ``output_velocity_mm_s``: the
-    interpolant's velocity there; ``steps_per_sample``: m.
+    interpolant's velocity there; ``steps_per_sample``: m; ``rest_force_N``: the force the test
+    holds at rest before it moves (``offsets.held_force``), NaN: none.
     """
     time_s: np.ndarray
     displacement_mm: np.ndarray
@@ -75,6 +76,8 @@ class DrivenInput:
     sample_index: np.ndarray
     output_velocity_mm_s: np.ndarray
     steps_per_sample: int
+    rest_force_N: float = math.nan
+    """The force [N] the run starts holding at rest (a model with a resting state); NaN: relaxed."""
 
 
 def steps_per_sample(time_s: np.ndarray, displacement_mm: np.ndarray, velocity_mm_s: np.ndarray,
@@ -126,10 +129,11 @@ def turning_rate(displacement_mm: np.ndarray, h: float, rms_velocity: float) -> 
 
 
 def prepare_input(time_s, displacement_mm, velocity_mm_s=None, decimate_holds: bool = False,
-                  steps: int | None = None) -> DrivenInput:
+                  steps: int | None = None, rest_force_N: float = math.nan) -> DrivenInput:
     """The driven input of a sampled test (see the module docstring). ``velocity_mm_s``: the
     test's velocity at the samples if known (then the Hermite interpolant is used);
-    ``steps``: force m instead of choosing it."""
+    ``steps``: force m instead of choosing it; ``rest_force_N``: the force [N] the run starts
+    holding at rest (NaN: relaxed)."""
     t = np.asarray(time_s, dtype=float)
     x = np.asarray(displacement_mm, dtype=float)
     if not (t.ndim == 1 and t.shape == x.shape and t.size >= 2):
@@ -166,7 +170,8 @@ def prepare_input(time_s, displacement_mm, velocity_mm_s=None, decimate_holds: b
     grid_x = np.concatenate(pieces_x)
     grid_v = np.append(np.diff(grid_x) / np.diff(grid_t), 0.0)
     output_index = np.searchsorted(grid_t, t[sample_index])
-    return DrivenInput(grid_t, grid_x, grid_v, output_index, sample_index, sample_velocity[sample_index], m)
+    return DrivenInput(grid_t, grid_x, grid_v, output_index, sample_index, sample_velocity[sample_index], m,
+                       float(rest_force_N))
 
 
 def _held_samples_to_skip(x: np.ndarray) -> np.ndarray:

@@ -5,7 +5,7 @@ derivatives of the search space's map theta -> p, ``SearchSpace.to_parameters_an
 simulation gives the forces F_k at the output samples and their derivatives dF_k/dtheta_j for all
 K directions: forward-mode sensitivities propagated through the model's own kernels,
 
-    m = prepare(p), state = initial_state(m, x_0), ms = prepare_step(m, h),
+    m = prepare(p), state = start_state(m, x_0, F_rest), ms = prepare_step(m, h),
     state = step_prepared(m, ms, state, state_x, x_k, v_k, h, max_substeps)   (jump + integrate),
     F_k = force(m, state, x_k, v_out_k),
 
@@ -31,6 +31,7 @@ from __future__ import annotations
 import ast
 import builtins
 import inspect
+import math
 import sys
 import threading
 import types
@@ -44,7 +45,7 @@ from fmu_src.model.registry import BushingModel, DEFAULT_MODEL, resolve_model
 from fmu_src.kernels.jit import numba
 from fmu_src.syntax_trees import parse
 from identification.forward.population import (CommunicationPoints, _input_arrays, _population_loop, _step_sizes,
-                                               output_points, parameter_matrix)
+                                               output_points, parameter_matrix, rest_force)
 
 _MAX_SUBSTEPS = integration.DEFAULT_MAX_SUBSTEPS
 
@@ -55,7 +56,7 @@ def _tangent_names(model: BushingModel, generator: tangents.Generator) -> dict[s
     namespace = model.step.__globals__     # the step protocol bound to the model's kernels
     return {
         "_PREPARE": generator.emit(model.prepare, (True,)),
-        "_INITIAL": generator.emit(model.initial_state, (True, False)),
+        "_INITIAL": generator.emit(model.start_state, (True, False, False)),
         "_PREPARE_STEP": generator.emit(namespace["prepare_step"], (True, False)),
         "_STEP": generator.emit(namespace["step_prepared"], (True, True, True, False, False, False, False, False)),
         "_FORCE": generator.emit(model.force, (True, True, False, False)),
@@ -189,7 +190,7 @@ def sensitivity_module(model: str | BushingModel, lanes: int) -> types.ModuleTyp
             two = np.array([0.0, 1e-3])
             with _kernels.compile_lock(module.__name__):      # and a second process too
                 module._simulate_sensitivities(values, np.zeros(values.shape + (lanes,)), two, two, two,
-                                               np.arange(2, dtype=np.int64), two, 10, *_step_sizes(two))
+                                               np.arange(2, dtype=np.int64), two, 10, *_step_sizes(two), math.nan)
             _compiled[key] = module
     return _compiled[key]
 
@@ -239,13 +240,13 @@ def population_sensitivities(parameter_sets, seeds, points: CommunicationPoints,
     module = sensitivity_module(bushing, size)
     if size == lanes:
         return module._simulate_sensitivities(matrix, seeds, t, x, v, out_index, out_velocity, max_substeps,
-                                              *_step_sizes(t))
+                                              *_step_sizes(t), rest_force(points))
     forces, parts = None, []
     for first in range(0, lanes, size):
         chunk = np.zeros(seeds.shape[:2] + (size,))
         chunk[:, :, :min(size, lanes - first)] = seeds[:, :, first:first + size]
         values, derivatives = module._simulate_sensitivities(matrix, chunk, t, x, v, out_index, out_velocity,
-                                                             max_substeps, *_step_sizes(t))
+                                                             max_substeps, *_step_sizes(t), rest_force(points))
         forces = values if forces is None else forces      # the same bits from every chunk
         parts.append(derivatives)
     return forces, np.concatenate(parts, axis=2)[:, :, :lanes]

@@ -16,6 +16,7 @@ resolved and passes on) or a model's name.
 from __future__ import annotations
 
 import inspect
+import math
 import types
 from dataclasses import dataclass
 from typing import Mapping
@@ -31,7 +32,8 @@ from identification.forward import steady_state
 _MAX_SUBSTEPS = integration.DEFAULT_MAX_SUBSTEPS
 
 
-def _population_loop(matrix, seeds, t, x, v, out_index, out_velocity, max_substeps, step_sizes, step_size_index):
+def _population_loop(matrix, seeds, t, x, v, out_index, out_velocity, max_substeps, step_sizes, step_size_index,
+                     rest_force):
     """Forces (P, outputs) of every parameter set (rows of ``matrix``) at the communication points
     ``t[out_index]``, and what the loop carries beside them: their derivatives (P, outputs, K) in
     the K directions ``seeds`` (P, m, K: dp/dtheta of each row) for the fit's Jacobian
@@ -40,11 +42,13 @@ def _population_loop(matrix, seeds, t, x, v, out_index, out_velocity, max_subste
     with the velocity ``out_velocity`` (the FMU's direct feedthrough of the velocity set at that
     instant). ``step_sizes``: the distinct t_k+1 - t_k, and ``step_size_index[k]`` which one step
     k has: the step's constants (``prepare_step``) are made once per candidate and step size
-    (empty: at every step). A candidate that fails gets NaN from there on.
+    (empty: at every step). Each candidate starts at rest holding ``rest_force`` [N] where that is a
+    number (the model's ``resting_state``, for a model that has one), else relaxed (NaN). A
+    candidate that fails gets NaN from there on.
 
     Written here, never called here: its source is compiled in a generated module for each
     model, where its slots are bound to what it carries. Each slot returns a value and its derivative:
-    ``_PREPARE(values, d_values)``, ``_INITIAL(m, x0, d_m)``, ``_PREPARE_STEP(m, h, d_m)``,
+    ``_PREPARE(values, d_values)``, ``_INITIAL(m, x0, rest_force, d_m)`` (``integration.start_state``), ``_PREPARE_STEP(m, h, d_m)``,
     ``_STEP(m, ms, state, state_x, x, v, h, max_substeps, d_m, d_ms, d_state)`` (the step
     protocol, ``integration.step_prepared``), ``_FORCE(m, state, x, v, d_m, d_state)``;
     ``_VALUES(row)`` is the row as ``prepare``'s tuple, ``_SEEDS(seeds, i)`` row i's derivatives in
@@ -60,7 +64,7 @@ def _population_loop(matrix, seeds, t, x, v, out_index, out_velocity, max_subste
         prepared = [_PREPARE_STEP(m, step_sizes[u] if cached else t[1] - t[0], d_m)
                     for u in range(max(step_sizes.size, 1))]
         state_x = x[0]
-        state, d_state = _INITIAL(m, state_x, d_m)
+        state, d_state = _INITIAL(m, state_x, rest_force, d_m)
         j = 0
         if out_index[0] == 0:
             f, d_f = _FORCE(m, state, state_x, out_velocity[0], d_m, d_state)
@@ -94,8 +98,8 @@ def _PREPARE(values, d_values):
     return prepare(values), ()  # noqa: F821 (the model's, where bound)
 
 
-def _INITIAL(m, x0, d_m):
-    return initial_state(m, x0), ()  # noqa: F821
+def _INITIAL(m, x0, rest_force, d_m):
+    return start_state(m, x0, rest_force), ()  # noqa: F821
 
 
 def _PREPARE_STEP(m, h, d_m):
@@ -159,7 +163,7 @@ def _coupled_population_forces(matrix, t, x, v, out_index, out_velocity, max_sub
     return forces
 
 
-KERNELS = ("prepare", "initial_state", "prepare_step", "step_prepared", "force", "_VALUES")
+KERNELS = ("prepare", "initial_state", "start_state", "prepare_step", "step_prepared", "force", "_VALUES")
 """What the population loops take from a model's compiled module (``numba_binding.kernel_module``;
 ``_VALUES(row)``: the row's values as the tuple ``prepare`` takes)."""
 COUPLED_KERNELS = ("initial_state_coupled", "step_coupled", "force_coupled")
@@ -209,7 +213,7 @@ def compiled_model(model: str | BushingModel = DEFAULT_MODEL) -> types.ModuleTyp
 
 def simulate_population_held(parameter_sets, time_s, displacement_mm, velocity_mm_s,
                              max_substeps: int = _MAX_SUBSTEPS,
-                             model: str | BushingModel = DEFAULT_MODEL) -> np.ndarray:
+                             model: str | BushingModel = DEFAULT_MODEL, rest_force_N: float = math.nan) -> np.ndarray:
     """Forces [N], shape (P, samples), of P parameter sets of ``model`` under the FMU's input
     convention.
 
@@ -220,13 +224,14 @@ def simulate_population_held(parameter_sets, time_s, displacement_mm, velocity_m
     (``identification.forward.input_path``) drives the same kernel with a finer, consistent input.
     ``parameter_sets``: see :func:`parameter_matrix`; the sets must be valid. A candidate whose
     step fails (overflow, non-finite state, too many substeps) gets NaN from that sample on.
-    Runs on all cores.
+    ``rest_force_N``: the force [N] the run starts holding at rest (a model with a resting state;
+    NaN: relaxed). Runs on all cores.
     """
     t, x, v = _input_arrays(time_s, displacement_mm, velocity_mm_s)
     out_velocity = np.concatenate([v[:1], v[:-1]])
     model = resolve_model(model)
     return _forces(compiled_model(model), parameter_matrix(parameter_sets, model), t, x, v, np.arange(t.size),
-                   out_velocity, max_substeps, *_step_sizes(t))
+                   out_velocity, max_substeps, *_step_sizes(t), rest_force_N)
 
 
 @dataclass(frozen=True)
@@ -242,18 +247,26 @@ class CommunicationPoints:
     velocity_mm_s: np.ndarray
     output_index: np.ndarray
     output_velocity_mm_s: np.ndarray
+    rest_force_N: float = math.nan
+    """The force [N] the run starts holding at rest (NaN: relaxed), for a model with a resting state."""
+
+
+def rest_force(points) -> float:
+    """The force [N] a run on ``points`` starts holding at rest: its ``rest_force_N``, NaN (relaxed)
+    where it has none."""
+    return float(getattr(points, "rest_force_N", math.nan))
 
 
 def simulate_population_at(parameter_sets, points: CommunicationPoints, max_substeps: int = _MAX_SUBSTEPS,
                            model: str | BushingModel = DEFAULT_MODEL) -> np.ndarray:
     """Forces [N], shape (P, outputs), at the output points of ``points``
     (``CommunicationPoints``); the input between communication points as in
-    :func:`simulate_population_held`."""
+    :func:`simulate_population_held`, the start at rest holding ``points.rest_force_N`` where given."""
     t, x, v = _input_arrays(points.time_s, points.displacement_mm, points.velocity_mm_s)
     out_index, out_velocity = output_points(t, points.output_index, points.output_velocity_mm_s)
     model = resolve_model(model)
     return _forces(compiled_model(model), parameter_matrix(parameter_sets, model), t, x, v, out_index, out_velocity,
-                   max_substeps, *_step_sizes(t))
+                   max_substeps, *_step_sizes(t), rest_force(points))
 
 
 def simulate_coupled_held(parameter_sets, time_s, displacement_mm, velocity_mm_s,

@@ -11,9 +11,12 @@ slave, sees its inputs held over each communication step instead
 (:func:`simulate_multiaxis`), coupled or one model per axis.
 
 Units: time in s, displacement in mm, velocity in mm/s, force in N, parameters in the
-paper's N-mm-s units. The bushing starts in relaxed equilibrium at the first displacement.
+paper's N-mm-s units. The bushing starts in relaxed equilibrium at the first displacement, or at
+rest holding a given force (``rest_force_N``, for a model that can hold one).
 """
 from __future__ import annotations
+
+import math
 
 import numpy as np
 
@@ -25,7 +28,7 @@ from identification.measured.multiaxis import coupled_axes
 
 
 def simulate(parameters, time_s, displacement_mm, velocity_mm_s=None, model: str | BushingModel | None = None,
-             steps_per_sample: int | None = None) -> np.ndarray:
+             steps_per_sample: int | None = None, rest_force_N: float = math.nan) -> np.ndarray:
     """Simulate a model on a sampled displacement: the force at every sample.
 
     Parameters
@@ -45,6 +48,10 @@ def simulate(parameters, time_s, displacement_mm, velocity_mm_s=None, model: str
     steps_per_sample : int, optional
         Communication steps per sample interval (default: chosen from the signal); more give a
         finer reference solution.
+    rest_force_N : float, optional
+        The force [N] the test holds at rest before it moves (``measured.offsets.held_force``): a
+        model that can hold a force at rest (``BushingModel.resting_state``) starts holding it, its
+        mounting's preload aside; NaN (default): relaxed.
 
     Returns
     -------
@@ -63,7 +70,7 @@ def simulate(parameters, time_s, displacement_mm, velocity_mm_s=None, model: str
     values, bushing = _parameters_and_model(parameters, model)
     offset, preload = bushing.mounting(values)      # F = model(x - offset) + preload; 0 and 0: as it is
     driven = prepare_input(time_s, np.asarray(displacement_mm, dtype=float) - offset, velocity_mm_s,
-                           steps=steps_per_sample)
+                           steps=steps_per_sample, rest_force_N=rest_force_N - preload)
     return simulate_driven(parameter_matrix([values], bushing), driven, model=bushing)[0] + preload
 
 

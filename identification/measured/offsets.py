@@ -18,7 +18,10 @@ damper pushed from 0 to 25 mm, a mount tested about its preload) is common. What
   last upward crossing of the stroke's centre (``repeatability.cycle_starts``), so that a ramp-in
   and a part cycle do not weigh;
 - **quasi-static**: a periodic test of at most ``QUASI_STATIC_HZ`` (a slow triangle or sine that
-  loads and unloads the device: its backbone can be read off it, ``static_curve``).
+  loads and unloads the device: its backbone can be read off it, ``static_curve``);
+- the **held force** [N]: the force at rest where it counts (beyond ``OFFSET_FORCE`` of the force's
+  half range and ``NOISE_LEVELS`` of its noise level), which a model that can hold a force at rest
+  starts a run holding (``held_force``).
 
 Units: mm, N, s, Hz.
 """
@@ -30,6 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from identification.measured.measurements import Measurement
+from identification.measured.noise import estimate_noise
 from identification.measured.repeatability import cycle_starts
 
 REST_MOTION = 0.002
@@ -37,6 +41,10 @@ REST_MOTION = 0.002
 MIN_REST_SAMPLES = 20
 MIN_REST_S = 0.05
 """A rest shorter than these (samples and seconds) is not read: its force is the start of the motion."""
+OFFSET_FORCE = 0.02
+"""A force at rest, or a cycles' mean force, beyond this fraction of the record's force half range..."""
+NOISE_LEVELS = 5.0
+"""...and beyond this many of its noise levels is an offset no model of zero mean says."""
 QUASI_STATIC_HZ = 0.1
 """A periodic test at most this slow is quasi-static (the rate-dependent part of a filled rubber is
 a few per cent of its force there; a rig's slow triangle for a static curve runs at 0.01-0.1 Hz)."""
@@ -113,3 +121,25 @@ def rig_zeros(offsets, steps=()) -> tuple[float, float]:
     if resting:
         return float(np.median([r.start_mm for r in resting])), float(np.median([r.rest_force_N for r in resting]))
     return 0.0, 0.0
+
+
+def offset_floor(measurement: Measurement, offsets: RecordOffsets | None = None) -> float:
+    """The force [N] an offset of this record must exceed to count: OFFSET_FORCE of its force half
+    range and NOISE_LEVELS of its noise level, whichever is more."""
+    offsets = offsets or record_offsets(measurement)
+    try:
+        noise = estimate_noise(measurement.force_N).sigma_N
+    except ValueError:
+        noise = 0.0
+    return max(OFFSET_FORCE * offsets.force_half_range_N, NOISE_LEVELS * noise)
+
+
+def held_force(measurement: Measurement) -> float:
+    """The force [N] a record holds at rest before it moves (:func:`rest_at_start`) where it counts
+    (:func:`offset_floor`): what a model that can hold a force at rest starts holding
+    (``BushingModel.resting_state``); NaN where the record does not start at rest or holds no
+    more than that (a run then starts relaxed, as it always did)."""
+    force, _ = rest_at_start(measurement)
+    if math.isfinite(force) and abs(force) > offset_floor(measurement):
+        return force
+    return math.nan
