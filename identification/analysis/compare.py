@@ -47,7 +47,8 @@ import numpy as np
 from fmu_src.model.registry import BushingModel, resolve_model
 from identification.fitting.engine import make_engine
 from identification.errors import FitNotConvergedWarning
-from identification.fitting.result import FLOOR_FACTOR, FitResult, TableFit, information_criterion
+from identification.fitting.result import (FLOOR_FACTOR, FitResult, TableFit, information_criterion,
+                                           sines_repeatability)
 from identification.fitting.fit import training_request
 from identification.fitting.presets import FitOptions
 from identification.analysis.race import Stopped, race_models
@@ -284,6 +285,9 @@ def compare_models(models: Sequence[str | BushingModel], tests: Sequence[RigTest
     print(format_assessments(assessments, recommendation, stopped))
     if validation:
         print(format_comparison(errors, models, [Path(m.source).name for m in validation], training_names))
+        repeats = sines_repeatability(results[models[0]].tests) if models else None
+        for line in general_excitation_lines(validation, errors, models, repeats):
+            print(line)
     if table is not None:
         print(format_table_errors(table, assessments))
     if coupling is not None:
@@ -445,6 +449,27 @@ def format_comparison(errors: dict, models: Sequence[str], files: Sequence[str],
         lines.append(f"{name + (' (training)' if name in training else ''):{width}s}{cells}")
     lines.append("NRMSE = rms(F_pre - F_exp)/rms(F_exp); (eq. 10) = (rms F_exp - rms F_pre)/rms F_exp")
     return "\n".join(lines)
+
+
+def general_excitation_lines(validation, errors: dict, models: Sequence[str], repeats: float | None) -> list[str]:
+    """For each validation file without steady cycles (``repeatability.estimate_repeatability``
+    finds none: an earthquake, a random road), that its floor is its noise, and each model's
+    NRMSE on it against what the device repeats on the training sines (``repeats``, a fraction;
+    None: no training sine says)."""
+    from identification.measured.repeatability import estimate_repeatability
+    lines = []
+    for m in validation:
+        if estimate_repeatability(m.time_s, m.displacement_mm, m.force_N).known:
+            continue
+        name = Path(m.source).name
+        if repeats is None:
+            lines.append(f"{name} has no steady cycles: its floor is its noise, and no training sine says what the "
+                         "device repeats")
+            continue
+        cells = ", ".join(f"{model} {errors[name, model][0] / repeats:.3g}x" for model in models)
+        lines.append(f"{name} has no steady cycles (its floor is its noise); against what the device repeats on "
+                     f"the training sines ({repeats:.2%}): {cells}")
+    return lines
 
 
 def format_table_errors(table: KdynTable, assessments: Sequence[Assessment]) -> str:

@@ -117,6 +117,28 @@ class RigTestFit:
         return out
 
 
+def sines_repeatability(tests: Sequence[RigTestFit]) -> float | None:
+    """The mean of what the device repeats on the sines of ``tests`` whose repeatability is known
+    (a fraction of each one's rms force), or None without any."""
+    known = [t.repeat_fraction for t in tests if t.repeat_fraction is not None]
+    return float(np.mean(known)) if known else None
+
+
+def general_excitation_notes(tests: Sequence[RigTestFit]) -> list[str]:
+    """For each test without steady cycles (a random input, an earthquake), that its floor is its
+    noise alone, and its NRMSE against what the device repeats on the sines among ``tests``: the
+    floor a model driven by the displacement can reach on the device."""
+    repeats = sines_repeatability(tests)
+    notes = []
+    for t in tests:
+        if t.kind == "random" and t.repeat_fraction is None:
+            beside = (f"; {t.nrmse / repeats:.3g}x what the device repeats on its sines ({repeats:.2%})"
+                      if repeats is not None else "")
+            notes.append(f"note: {t.name} has no steady cycles to repeat: its floor is its noise ({t.noise_fraction:.2%})"
+                         + beside)
+    return notes
+
+
 @dataclass
 class TableFit:
     """A dynamic-stiffness table at the fitted parameters: the converged characterisation
@@ -349,6 +371,7 @@ class FitResult(FittedParameters):
         unknown = [t for t in self.tests if t.kind == "sine" and t.repeat_fraction is None and t.repeatability]
         for t in unknown:
             lines.append(f"note: {t.name}: {t.repeatability.describe()}; its floor is the noise level alone")
+        lines += general_excitation_notes(self.tests)
         if self.table is not None:
             lines.append(self.table.format())
             if self.table.cycles_error > 0.1 * KDYN_UNCERTAINTY:
