@@ -4,7 +4,8 @@ resampled to 100 Hz, as a device tested on a 100 Hz rig gives them, timed warm.
     python benchmarks/bench_low_rate_fit.py [--models LIST] [--file NAME ...] [--workers N]
 
 The shipped 0.5 Hz and 0.25 Hz, 1 in sines of ``data/brfd/`` (14 s and 28 s at 1024 Hz) are
-interpolated linearly onto a 100 Hz grid (1400 and 2800 samples, 200 and 400 samples a cycle) and written to a temporary folder. Each model is fitted twice in this process with the default preset and
+interpolated linearly onto a 100 Hz grid (1400 and 2800 samples, 200 and 400 samples a cycle) and
+written to a temporary folder. Each model is fitted twice in this process with the default preset and
 no ensemble (``fit(..., ensemble=False)``): the first run compiles or loads its modules, the second
 is the warm figure (the issue's target: <= 20 s each). Prints the model, the samples, both wall
 times and the training NRMSE.

@@ -18,7 +18,12 @@ point errors are reported by ``identification.analysis.paper_verification``.
 
 The model is simulated with the forward model (``identification.forward.input_path``) on each
 test as sampled, with held stretches of a step decimated: the residuals are those of the
-samples that remain (about 14 % of a 10 s step). A candidate whose simulation fails
+samples that remain (about 14 % of a 10 s step). A sine sampled more finely than
+``FIT_SAMPLES_PER_CYCLE`` a cycle (a rig's slow sine at 1024 Hz) counts every ``stride``-th
+sample's force only, each weighing ``stride`` samples (its noise level divided by
+sqrt(stride), n counting the samples it stands for): chi^2/n keeps its scale, where the misfit is
+a model's (smooth over a stride) and where it is white noise, and the cost falls with the
+samples asked for. A candidate whose simulation fails
 (overflow, more than FIT_MAX_SUBSTEPS substeps in a communication step) gets residuals of
 FAILED_RESIDUAL noise levels from there on: worse than any candidate that runs.
 """
@@ -48,6 +53,10 @@ MIN_NOISE_FRACTION = 1e-3
 """Noise levels below 0.1 % of a test's rms force are taken as 0.1 %: the forward model's own
 accuracy at 1 kHz is about 0.04 % (tests/identification/forward/test_forward_model.py), so a fit cannot resolve less."""
 MIN_PREFIX_SAMPLES = 50
+FIT_SAMPLES_PER_CYCLE = 256
+"""A sine's forces counted per cycle, at least: a finer one counts every stride-th sample (stride
+the samples a cycle over this, rounded down). A loop of the paper's tests has 100 (10 Hz at
+1 kHz); the real friction damper's 0.25 Hz sines at 1024 Hz have 4096."""
 """The shortest prefix of a test a candidate is first screened on (``Objective.prefix``)."""
 
 
@@ -182,16 +191,11 @@ class Objective:
         if len(steps) != len(tests):
             raise ValueError(f"{len(steps)} step counts for {len(tests)} tests")
         self.rest_forces = [held_force(t.measurement) for t in tests]
+        self.strides = [fit_stride(t) for t in tests]
         self.noise = noise
         self.bushing = resolve_model(model)
         self.model = model if isinstance(model, str) else self.bushing.name
-        self.tests: list[PreparedTest] = []
-        for test, level, m_steps, rest in zip(tests, noise, steps, self.rest_forces):
-            m = test.measurement
-            driven = prepare_input(m.time_s, m.displacement_mm, m.measured_velocity_mm_s, decimate_holds=True,
-                                   steps=m_steps, rest_force_N=rest)
-            sigma = max(level.sigma_N, MIN_NOISE_FRACTION * level.rms_force_N)
-            self.tests.append(PreparedTest(test.name, driven, m.force_N[driven.sample_index], sigma))
+        self.tests = _prepared_tests(tests, noise, steps, self.rest_forces, self.strides)
         self.rig_tests = list(tests)     # what it was made of: with_steps, prefix, with_fit_loop derive from them
         self._source_table = table
         self.search = search and table is not None
@@ -202,7 +206,7 @@ class Objective:
         self.coupling = multiaxis.coupling
         self.multiaxis = [PreparedMultiAxis.of(m, levels, multiaxis.coupling)
                           for m, levels in zip(multiaxis.measurements, noise)]
-        self.size = (sum(t.measured_N.size for t in self.tests) + sum(m.size for m in self.multiaxis)
+        self.size = (sum(t.measured_N.size * t.driven.stride for t in self.tests) + sum(m.size for m in self.multiaxis)
                      + (self.table.size if self.table else 0))
 
     def with_steps(self, steps: Sequence[int]) -> "Objective":
@@ -225,10 +229,10 @@ class Objective:
             cut.append(RigTest(replace(m, time_s=m.time_s[:k], displacement_mm=m.displacement_mm[:k],
                                        force_N=m.force_N[:k], velocity_mm_s=m.velocity_mm_s[:k])))
         prefix = Objective(cut, self.noise, self.steps_per_sample, self.bushing)
-        # the whole tests' forces at rest (a prefix's own range would judge its rest on less)
-        prefix.rest_forces = list(self.rest_forces)
-        prefix.tests = [replace(t, driven=replace(t.driven, rest_force_N=rest))
-                        for t, rest in zip(prefix.tests, self.rest_forces)]
+        # the whole tests' forces at rest and strides (a prefix's own would judge them on less)
+        prefix.rest_forces, prefix.strides = list(self.rest_forces), list(self.strides)
+        prefix.tests = _prepared_tests(cut, self.noise, self.steps_per_sample, prefix.rest_forces, prefix.strides)
+        prefix.size = sum(t.measured_N.size * t.driven.stride for t in prefix.tests)
         return prefix
 
     def with_fit_loop(self) -> "Objective":
@@ -325,7 +329,38 @@ class Objective:
         residual = self.residual_matrix(np.atleast_2d(matrix)) * math.sqrt(self.size)
         bounds = np.cumsum([0] + [t.measured_N.size for t in self.tests] + [m.size for m in self.multiaxis]
                            + ([self.table.size] if self.table else []))
-        return np.column_stack([np.mean(residual[:, a:b] ** 2, axis=1) for a, b in zip(bounds[:-1], bounds[1:])])
+        weights = [t.driven.stride for t in self.tests] + [1] * (len(bounds) - 1 - len(self.tests))
+        return np.column_stack([np.mean(residual[:, a:b] ** 2, axis=1) / w
+                                for a, b, w in zip(bounds[:-1], bounds[1:], weights)])
+
+
+def fit_stride(test: RigTest) -> int:
+    """Every how many samples a test's force counts in the fit: a sine's samples a cycle over
+    FIT_SAMPLES_PER_CYCLE, rounded down (1 at or below it, and for every other kind of test)."""
+    if test.kind != "sine":
+        return 1
+    from identification.measured.offsets import record_offsets
+    m = test.measurement
+    frequency = record_offsets(m).frequency_hz
+    if not math.isfinite(frequency) or frequency <= 0.0:
+        return 1
+    per_cycle = 1.0 / (frequency * float(np.median(np.diff(m.time_s))))
+    return max(1, int(per_cycle // FIT_SAMPLES_PER_CYCLE))
+
+
+def _prepared_tests(tests, noise, steps, rests, strides) -> list[PreparedTest]:
+    """Each test as the objective keeps it: its driven input (its steps per sample, the force it
+    holds at rest, its stride) and the measured forces it is compared at, with the noise level
+    they count with (divided by sqrt(stride): each stands for stride samples)."""
+    prepared = []
+    for test, level, m_steps, rest, stride in zip(tests, noise, steps, rests, strides):
+        m = test.measurement
+        driven = prepare_input(m.time_s, m.displacement_mm, m.measured_velocity_mm_s, decimate_holds=True,
+                               steps=m_steps, rest_force_N=rest, stride=stride)
+        sigma = max(level.sigma_N, MIN_NOISE_FRACTION * level.rms_force_N)
+        prepared.append(PreparedTest(test.name, driven, m.force_N[driven.sample_index],
+                                     sigma / math.sqrt(stride) if stride > 1 else sigma))
+    return prepared
 
 
 def nrmse(predicted: np.ndarray, measured: np.ndarray) -> float:

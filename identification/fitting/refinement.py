@@ -75,7 +75,8 @@ def refine_steps(objective: Objective, row: np.ndarray, delta_chi2: float) -> Re
         while 2 * m <= MAX_REFINED_STEPS:
             measurement = test.measurement
             finer = prepare_input(measurement.time_s, measurement.displacement_mm, measurement.measured_velocity_mm_s,
-                                  decimate_holds=True, steps=2 * m, rest_force_N=prepared.driven.rest_force_N)
+                                  decimate_holds=True, steps=2 * m, rest_force_N=prepared.driven.rest_force_N,
+                                  stride=prepared.driven.stride)
             fine = simulate_driven(candidate, finer, FIT_MAX_SUBSTEPS, objective.bushing)[0]
             work += 2 * m
             runs, ran = bool(np.all(np.isfinite(fine))), bool(np.all(np.isfinite(coarse)))

@@ -436,7 +436,9 @@ class Search:
         ensemble = [dict(zip(space.bushing.parameter_names, map(float, row))) for row in rows]
         parameters = ParameterSet(space.bushing, ensemble[0])
         steps = problem.objective.steps_per_sample
-        fits = test_fits(request.tests, request.noise, parameters, steps) + request.multi.fits(parameters)
+        # a strided test's steps are per stride: its figures on every sample take the signal's own
+        every = [m if t.driven.stride == 1 else None for m, t in zip(steps, problem.objective.tests)]
+        fits = test_fits(request.tests, request.noise, parameters, every) + request.multi.fits(parameters)
         steps = steps + [m.driven.steps_per_sample for m in problem.objective.multiaxis]
         result = FitResult(parameters, float(best.misfit), fits, records, threshold,
                            ensemble, ident, request.preset, request.seed, self.evaluations,

@@ -33,6 +33,12 @@ of only every ``HOLD_DECIMATION``-th sample can be asked for (``decimate_holds``
 is constant there, so one long communication step is as exact as ten short ones, and the
 step test costs a fifth.
 
+Where a periodic test samples each cycle far more finely than a fit needs (a rig's slow sine at
+1024 Hz: 4096 samples a cycle at 0.25 Hz), the forces of only every ``stride``-th sample can be
+asked for: the path still follows the interpolant through every sample, in steps chosen by the
+same turning rule over the stride's interval, so the cost falls with the samples asked for
+(``identification.fitting.objectives``: ``FIT_SAMPLES_PER_CYCLE``).
+
 Units: time in s, displacement in mm, velocity in mm/s, force in N.
 """
 from __future__ import annotations
@@ -78,14 +84,18 @@ class DrivenInput:
     steps_per_sample: int
     rest_force_N: float = math.nan
     """The force [N] the run starts holding at rest (a model with a resting state); NaN: relaxed."""
+    stride: int = 1
+    """The forces of every ``stride``-th sample are asked for (1: every sample's, holds aside);
+    ``steps_per_sample`` is then per stride's interval."""
 
 
 def steps_per_sample(time_s: np.ndarray, displacement_mm: np.ndarray, velocity_mm_s: np.ndarray,
-                     interpolant) -> int:
-    """m: communication steps per sample interval so that the input turns by at most
-    MAX_PHASE_PER_STEP_RAD per step at its rms frequency rms(x'')/rms(x') (capped at
-    MAX_STEPS_PER_SAMPLE); x'' the interpolant's at the samples, or, where the displacement is
-    measured with noise, its second differences over several samples (:func:`turning_rate`)."""
+                     interpolant, stride: int = 1) -> int:
+    """m: communication steps per sample interval (per ``stride`` sample intervals) so that the
+    input turns by at most MAX_PHASE_PER_STEP_RAD per step at its rms frequency rms(x'')/rms(x')
+    (capped at MAX_STEPS_PER_SAMPLE); x'' the interpolant's at the samples, or, where the
+    displacement is measured with noise, its second differences over several samples
+    (:func:`turning_rate`)."""
     rms_velocity = math.sqrt(float(np.mean(velocity_mm_s ** 2)))
     if rms_velocity == 0.0:
         return 1
@@ -93,7 +103,7 @@ def steps_per_sample(time_s: np.ndarray, displacement_mm: np.ndarray, velocity_m
     rms_acceleration = turning_rate(displacement_mm, h, rms_velocity)
     if rms_acceleration is None:
         rms_acceleration = math.sqrt(float(np.mean(interpolant(time_s, 2) ** 2)))
-    phase = rms_acceleration / rms_velocity * h
+    phase = rms_acceleration / rms_velocity * h * stride
     return int(min(MAX_STEPS_PER_SAMPLE, max(1, math.ceil(phase / MAX_PHASE_PER_STEP_RAD))))
 
 
@@ -129,11 +139,12 @@ def turning_rate(displacement_mm: np.ndarray, h: float, rms_velocity: float) -> 
 
 
 def prepare_input(time_s, displacement_mm, velocity_mm_s=None, decimate_holds: bool = False,
-                  steps: int | None = None, rest_force_N: float = math.nan) -> DrivenInput:
+                  steps: int | None = None, rest_force_N: float = math.nan, stride: int = 1) -> DrivenInput:
     """The driven input of a sampled test (see the module docstring). ``velocity_mm_s``: the
     test's velocity at the samples if known (then the Hermite interpolant is used);
     ``steps``: force m instead of choosing it; ``rest_force_N``: the force [N] the run starts
-    holding at rest (NaN: relaxed)."""
+    holding at rest (NaN: relaxed); ``stride``: the forces of every stride-th sample only (the
+    first, and the holds' as ``decimate_holds`` says)."""
     t = np.asarray(time_s, dtype=float)
     x = np.asarray(displacement_mm, dtype=float)
     if not (t.ndim == 1 and t.shape == x.shape and t.size >= 2):
@@ -149,15 +160,26 @@ def prepare_input(time_s, displacement_mm, velocity_mm_s=None, decimate_holds: b
             raise ValueError(f"velocity has shape {v.shape}, time {t.shape}")
         interpolant = CubicHermiteSpline(t, x, v)
     sample_velocity = interpolant(t, 1)
-    m = steps or steps_per_sample(t, x, sample_velocity, interpolant)
+    stride = int(stride)
+    if stride < 1:
+        raise ValueError(f"stride = {stride}: give 1 (every sample's force) or more")
+    m = steps or steps_per_sample(t, x, sample_velocity, interpolant, stride)
 
     keep = _held_samples_to_skip(x) if decimate_holds else np.zeros(t.size, dtype=bool)
+    if stride > 1:
+        keep |= np.arange(t.size) % stride != 0
     sample_index = np.flatnonzero(~keep)
     # Communication points: m per kept interval between consecutive kept samples that are
-    # neighbours; one across a decimated hold (there the displacement is constant).
+    # neighbours or a stride apart along a moving input; one across a decimated hold (there the
+    # displacement is constant).
     pieces_t, pieces_x = [t[:1]], [x[:1]]
     for start, end in zip(sample_index[:-1], sample_index[1:]):
-        if end == start + 1 and m > 1:
+        if end > start + 1 and np.any(x[start:end + 1] != x[start]):     # a stride's interval, moving
+            fine = t[start] + (t[end] - t[start]) * np.arange(1, m + 1) / m
+            fine[-1] = t[end]
+            values = interpolant(fine)
+            values[-1] = x[end]
+        elif end == start + 1 and m > 1:
             fine = t[start] + (t[end] - t[start]) * np.arange(1, m + 1) / m
             fine[-1] = t[end]
             values = interpolant(fine)
@@ -171,7 +193,7 @@ def prepare_input(time_s, displacement_mm, velocity_mm_s=None, decimate_holds: b
     grid_v = np.append(np.diff(grid_x) / np.diff(grid_t), 0.0)
     output_index = np.searchsorted(grid_t, t[sample_index])
     return DrivenInput(grid_t, grid_x, grid_v, output_index, sample_index, sample_velocity[sample_index], m,
-                       float(rest_force_N))
+                       float(rest_force_N), stride)
 
 
 def _held_samples_to_skip(x: np.ndarray) -> np.ndarray:
