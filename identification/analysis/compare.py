@@ -196,6 +196,9 @@ class CompareOptions:
     after the race and join it; the recommendation is made again over all."""
     first_contact: Any = None
     """What was assumed before the fits (``first_contact.FirstContact``): said in the summary."""
+    leave_one_out: bool = False
+    """Fit the recommended model again to the training tests but one, for each test, and predict
+    that one (:class:`LeaveOneOut`): the matrix's leave-one-out score beside its training figures."""
 
     def training(self) -> FitOptions:
         """Each model's fit (its ensemble, if any, sampled later for the recommended one)."""
@@ -223,88 +226,190 @@ def compare_models(models: Sequence[str | BushingModel], tests: Sequence[RigTest
     assessment, only its row in ``stopped``)."""
     from threadpoolctl import threadpool_limits
     options = CompareOptions(**keywords)
-    bushings = [resolve_model(model) for model in models]
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    validation = [load_measurement(path) for path in validation_files]
-    training_names = {Path(t.measurement.source).name for t in tests}
-    training = options.training()
-    by_model = options.fixed_by_model or {}
-
-    def request(bushing, fixed=None):
-        held = fixed if fixed is not None else by_model.get(bushing.name, options.fixed)
-        return training_request(tests, bushing, replace(training, fixed=held))
-    requests = [request(bushing) for bushing in bushings]
-    table, training_table = options.table, options.training_table
-    data = [t.measurement.source for t in tests] + ([training_table.source] if training_table is not None else [])
+    run = _Comparison([resolve_model(model) for model in models], list(tests),
+                      [load_measurement(path) for path in validation_files], out_dir, options)
     # one BLAS thread, as fit() runs its searches
     with make_engine(options.workers, options.scheduler) as engine, warnings.catch_warnings(), \
             threadpool_limits(limits=1):
         warnings.simplefilter("ignore", FitNotConvergedWarning)   # reported below, per model
-        settled = _SettledWriter(out_dir, table, data)
-        results, stopped, searches = race_models(requests, engine, options.race, options.progress, settled)
-        recommendation = None
-        pending = (options.alternatives or {})
+        run.fit(engine)
+        if options.ensemble:
+            run.sample_ensembles()
+        left_out = None
+        if options.leave_one_out and len(tests) >= 2:
+            chosen = next(b for b in run.bushings if b.name == run.recommendation.model)
+            left_out = leave_one_out(tests, run.results[chosen.name], lambda rest: run.request(chosen, tests=rest),
+                                     engine, options.progress)
+    return run.report(left_out)
+
+
+class _Comparison:
+    """One ``compare_models`` run: its models, tests and options, the fits as they are settled
+    (written as they finish, :class:`_SettledWriter`), their assessments and the recommendation."""
+
+    def __init__(self, bushings, tests, validation, out_dir: Path, options: CompareOptions):
+        self.bushings, self.tests, self.validation, self.out_dir, self.options = bushings, tests, validation, out_dir, options
+        self.training_names = {Path(t.measurement.source).name for t in tests}
+        self.training = options.training()
+        table = options.training_table
+        self.data = [t.measurement.source for t in tests] + ([table.source] if table is not None else [])
+        self.settled = _SettledWriter(out_dir, options.table, self.data)
+
+    def request(self, bushing, fixed=None, tests=None):
+        """The search request of ``bushing`` (its held parameters ``fixed``, else the options'), on
+        ``tests`` (default: every training test)."""
+        by_model = self.options.fixed_by_model or {}
+        held = fixed if fixed is not None else by_model.get(bushing.name, self.options.fixed)
+        return training_request(self.tests if tests is None else tests, bushing, replace(self.training, fixed=held))
+
+    def fit(self, engine) -> None:
+        """Race the models, assess them and recommend one; then race the recommended model's
+        variants (``CompareOptions.alternatives``) and recommend again over all."""
+        options, settled = self.options, self.settled
+        self.engine = engine
+        self.results, self.stopped, self.searches = race_models([self.request(b) for b in self.bushings], engine,
+                                                                options.race, options.progress, settled)
+        pending = options.alternatives or {}
         while True:
-            bushings = [b for b in bushings if b.name in results]
-            models = [b.name for b in bushings]
-            parameters = {model: results[model].parameters.parameters for model in models}
-            assessments = [settled.assessment(results[model]) for model in models]
-            errors, predictions = _validation_errors(validation, bushings, parameters, assessments, training_names)
-            recommendation = recommend(assessments)
-            variants = [(b, f) for b, f in pending.get(recommendation.model, ()) if b.name not in results
-                        and b.name not in {s.model for s in stopped}]
+            self._assess()
+            variants = [(b, f) for b, f in pending.get(self.recommendation.model, ()) if b.name not in self.results
+                        and b.name not in {s.model for s in self.stopped}]
             pending = {}
             if not variants:
-                break
-            print(f"weighing {recommendation.model} without each option assumed: "
+                return
+            print(f"weighing {self.recommendation.model} without each option assumed: "
                   f"{', '.join(b.name for b, _ in variants)} ...", file=sys.stderr)
-            more, more_stopped, more_searches = race_models([request(b, dict(f)) for b, f in variants], engine, False,
-                                                            options.progress,
+            results, stopped = self.results, self.stopped
+            more, more_stopped, more_searches = race_models([self.request(b, dict(f)) for b, f in variants], engine,
+                                                            False, options.progress,
                                                             lambda r, s: settled({**results, **r}, stopped + s))
-            results.update(more)
-            searches.update(more_searches)
-            stopped = stopped + more_stopped
-            bushings = bushings + [b for b, _ in variants]
-        if options.ensemble:
-            # the ensemble keeps the best fit: the assessments and the recommendation stand
-            for model in [m for m in models if m in searches and (options.every_ensemble
-                                                                  or m == recommendation.model)]:
-                print(f"sampling the ensemble of {model} (profiles, posterior) ...", file=sys.stderr)
-                results[model] = searches[model].with_ensemble()
-                results[model].save(out_dir / f"params_{model}.json", data=data)
-    for m in validation:
-        plot_comparison(m, predictions[Path(m.source).name], out_dir / f"compare_{measurement_name(m.source)}.png")
-    if table is not None:
-        plot_table_comparison(table, {a.model: a.table for a in assessments}, out_dir / f"compare_{table.name}.png")
-    coupling = (weigh_couplings(parameters, bushings, options.multiaxis, options.couplings, recommendation.model)
-                if options.couplings else None)
+            self.results.update(more)
+            self.searches.update(more_searches)
+            self.stopped = self.stopped + more_stopped
+            self.bushings = self.bushings + [b for b, _ in variants]
 
-    if options.first_contact is not None:
-        print(options.first_contact.format())
-    print(format_assessments(assessments, recommendation, stopped))
-    if validation:
-        print(format_comparison(errors, models, [Path(m.source).name for m in validation], training_names))
-        repeats = sines_repeatability(results[models[0]].tests) if models else None
-        for line in general_excitation_lines(validation, errors, models, repeats):
-            print(line)
-    if table is not None:
-        print(format_table_errors(table, assessments))
-    if coupling is not None:
-        print(coupling.format())
-    _write_csvs(out_dir, assessments, recommendation, errors, table, stopped)
-    if coupling is not None:
-        coupling.write(out_dir / "coupling.csv")
-    print(f"wrote {out_dir}/comparison.csv, validation.csv{', kdyn_errors.csv' if table is not None else ''}"
-          f"{', coupling.csv' if coupling is not None else ''}, params_<model>.json and compare_*.png", file=sys.stderr)
-    if recommendation.caveat:
-        print(f"note: {recommendation.caveat}")
-    if coupling is not None:
-        print(f"recommended coupling: {coupling.chosen} ({coupling.reason})")
-    print(f"why: {recommendation.reason}")
-    print(f"recommended: {recommendation.model}")
-    return {"parameters": parameters, "errors": errors, "assessments": assessments, "recommendation": recommendation,
-            "coupling": coupling, "stopped": stopped}
+    def _assess(self) -> None:
+        self.bushings = [b for b in self.bushings if b.name in self.results]
+        self.models = [b.name for b in self.bushings]
+        self.parameters = {model: self.results[model].parameters.parameters for model in self.models}
+        self.assessments = [self.settled.assessment(self.results[model]) for model in self.models]
+        self.errors, self.predictions = _validation_errors(self.validation, self.bushings, self.parameters,
+                                                           self.assessments, self.training_names)
+        self.recommendation = recommend(self.assessments)
+
+    def sample_ensembles(self) -> None:
+        """The recommended model's ensemble (every finished model's with ``every_ensemble``): the
+        best fit, the assessments and the recommendation stand."""
+        for model in [m for m in self.models if m in self.searches and (self.options.every_ensemble
+                                                                         or m == self.recommendation.model)]:
+            print(f"sampling the ensemble of {model} (profiles, posterior) ...", file=sys.stderr)
+            self.results[model] = self.searches[model].with_ensemble()
+            self.results[model].save(self.out_dir / f"params_{model}.json", data=self.data)
+
+    def report(self, left_out: "LeaveOneOut | None") -> dict:
+        """The figures, the tables and the files (``compare_models``' module docstring); returns
+        what ``compare_models`` does."""
+        options, out_dir, recommendation = self.options, self.out_dir, self.recommendation
+        table, validation, models, errors = options.table, self.validation, self.models, self.errors
+        for m in validation:
+            plot_comparison(m, self.predictions[Path(m.source).name],
+                            out_dir / f"compare_{measurement_name(m.source)}.png")
+        if table is not None:
+            plot_table_comparison(table, {a.model: a.table for a in self.assessments}, out_dir / f"compare_{table.name}.png")
+        coupling = (weigh_couplings(self.parameters, self.bushings, options.multiaxis, options.couplings,
+                                    recommendation.model) if options.couplings else None)
+        if options.first_contact is not None:
+            print(options.first_contact.format())
+        print(format_assessments(self.assessments, recommendation, self.stopped))
+        if validation:
+            print(format_comparison(errors, models, [Path(m.source).name for m in validation], self.training_names))
+            repeats = sines_repeatability(self.results[models[0]].tests) if models else None
+            for line in general_excitation_lines(validation, errors, models, repeats):
+                print(line)
+        if table is not None:
+            print(format_table_errors(table, self.assessments))
+        if coupling is not None:
+            print(coupling.format())
+        _write_csvs(out_dir, self.assessments, recommendation, errors, table, self.stopped)
+        if coupling is not None:
+            coupling.write(out_dir / "coupling.csv")
+        if left_out is not None:
+            print(left_out.format())
+            left_out.write(out_dir / "leave_one_out.csv")
+        print(f"wrote {out_dir}/comparison.csv, validation.csv{', kdyn_errors.csv' if table is not None else ''}"
+              f"{', coupling.csv' if coupling is not None else ''}{', leave_one_out.csv' if left_out else ''}, "
+              "params_<model>.json and compare_*.png", file=sys.stderr)
+        if recommendation.caveat:
+            print(f"note: {recommendation.caveat}")
+        if coupling is not None:
+            print(f"recommended coupling: {coupling.chosen} ({coupling.reason})")
+        print(f"why: {recommendation.reason}")
+        print(f"recommended: {recommendation.model}")
+        return {"parameters": self.parameters, "errors": errors, "assessments": self.assessments,
+                "recommendation": recommendation, "coupling": coupling, "stopped": self.stopped,
+                "leave_one_out": left_out}
+
+
+@dataclass
+class LeaveOneOut:
+    """The recommended model on each training test: fitted to all (``training``), and fitted to
+    the others and predicting it (``left_out``), NRMSE both, beside what the test repeats
+    (``repeats``, a fraction of its rms force; None for a test without steady cycles, whose floor
+    is its noise, ``noise``)."""
+    model: str
+    tests: list[str]
+    training: list[float]
+    left_out: list[float]
+    repeats: list[float | None]
+    noise: list[float]
+
+    def floors(self) -> list[float]:
+        return [r if r is not None and r > n else n for r, n in zip(self.repeats, self.noise)]
+
+    def format(self) -> str:
+        width = max([30] + [len(name) for name in self.tests])
+        lines = [f"leave-one-out: {self.model} fitted to the training tests but one, predicting that one",
+                 f"{'test':{width}s} {'training':>9s} {'left out':>9s} {'floor':>7s} {'training/floor':>15s} "
+                 f"{'left out/floor':>15s}"]
+        for name, trained, out, floor in zip(self.tests, self.training, self.left_out, self.floors()):
+            lines.append(f"{name:{width}s} {trained:9.2%} {out:9.2%} {floor:7.2%} {trained / floor:15.2f} "
+                         f"{out / floor:15.2f}")
+        ratios = [out / floor for out, floor in zip(self.left_out, self.floors())]
+        trained = [t / floor for t, floor in zip(self.training, self.floors())]
+        lines.append(f"mean over the floor: training {np.mean(trained):.2f}x, left out {np.mean(ratios):.2f}x; "
+                     f"worst: training {np.max(trained):.2f}x, left out {np.max(ratios):.2f}x (floor: what the test "
+                     "repeats from cycle to cycle, or its noise where that is larger)")
+        return "\n".join(lines)
+
+    def write(self, path: Path) -> None:
+        with writing(path) as temporary, open(temporary, "w", newline="") as handle:
+            writer = csv.writer(handle)
+            writer.writerow(["model", "test", "training_nrmse", "left_out_nrmse", "repeatability_fraction",
+                             "noise_fraction", "floor_fraction"])
+            for row in zip(self.tests, self.training, self.left_out, self.repeats, self.noise, self.floors()):
+                name, trained, out, repeats, noise, floor = row
+                writer.writerow([self.model, name, _cell(trained), _cell(out), _cell(repeats), _cell(noise),
+                                 _cell(floor)])
+
+
+def leave_one_out(tests: Sequence[RigTest], fitted: FitResult, request_of, engine, progress: bool) -> LeaveOneOut:
+    """For each training test, the model of ``fitted`` fitted to the others (``request_of(tests)``,
+    as the comparison fits, no ensemble) and simulated on it (from rest where it holds a force):
+    :class:`LeaveOneOut`."""
+    out = []
+    for i, test in enumerate(tests):
+        print(f"leave-one-out {i + 1}/{len(tests)}: {fitted.model} fitted without {test.name} ...", file=sys.stderr)
+        rest = [t for j, t in enumerate(tests) if j != i]
+        result = race_models([request_of(rest)], engine, False, progress)[0][fitted.model]
+        m = test.measurement
+        predicted = simulate(result.parameters, m.time_s, m.displacement_mm, m.measured_velocity_mm_s,
+                             rest_force_N=held_force(m))
+        out.append(nrmse(predicted, m.force_N))
+    by_name = {t.name: t for t in fitted.tests}
+    return LeaveOneOut(fitted.model, [t.name for t in tests], [by_name[t.name].nrmse for t in tests], out,
+                       [by_name[t.name].repeat_fraction for t in tests], [by_name[t.name].noise_fraction for t in tests])
 
 
 def _assessed(result: FitResult, table: KdynTable | None) -> Assessment:

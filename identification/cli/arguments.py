@@ -175,6 +175,10 @@ def _add_compare(subcommands) -> None:
     compare_parser.add_argument("--every-ensemble", action="store_true",
                                 help="sample the ensemble (profiles, posterior) of every fitted model, not only of "
                                      "the recommended one")
+    compare_parser.add_argument("--leave-one-out", action="store_true",
+                                help="fit the recommended model again to the training tests but one, for each test, "
+                                     "and predict that one: a test matrix's leave-one-out score beside its training "
+                                     "figures (leave_one_out.csv)")
 
 
 def _add_predict(subcommands) -> None:

@@ -448,7 +448,8 @@ def compare_command(args) -> int:
     validation = args.validate or [Path(t.measurement.source) for t in tests]
     compare_models(models, tests, validation, args.out, table=table, multiaxis=multiaxis, couplings=couplings,
                    training_table=training_table, race=not args.no_race, every_ensemble=args.every_ensemble,
-                   fixed_by_model=fixed, alternatives=alternatives, first_contact=contact, **search_settings(args))
+                   fixed_by_model=fixed, alternatives=alternatives, first_contact=contact,
+                   leave_one_out=args.leave_one_out, **search_settings(args))
     return 0
 
 

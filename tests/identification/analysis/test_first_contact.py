@@ -140,3 +140,19 @@ def test_the_rig_zeros_are_searched_about_the_records_centre_on_the_centred_scal
     assert parameters["rig_displacement_zero"] == pytest.approx(rig.x_zero)
     assert parameters["rig_force_zero"] == pytest.approx(rig.F_zero)
     assert SearchSpace.from_measurements(original, "proposed", steps=[False, True]).x_zero == 0.0
+
+
+def test_compare_scores_the_recommended_model_leaving_each_test_out(tmp_path, capsys):
+    # two sines of the filled rubber: each predicted by the model fitted to the other
+    filled = DATA / "synthetic_filled_rubber"
+    out = tmp_path / "compare"
+    assert main(["compare", "--sine", f"{filled}_sine_2mm_10Hz.csv", "--sine", f"{filled}_sine_0.5mm_3Hz.csv",
+                 "--models", "kelvin_voigt", "--leave-one-out", "--no-ensemble", "--quiet", "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "leave-one-out: kelvin_voigt fitted to the training tests but one" in printed
+    with open(out / "leave_one_out.csv") as handle:
+        rows = list(csv.DictReader(handle))
+    assert [row["test"] for row in rows] == ["synthetic_filled_rubber_sine_2mm_10Hz.csv",
+                                             "synthetic_filled_rubber_sine_0.5mm_3Hz.csv"]
+    # a linear fit to one amplitude misses the other more than the fit to both does
+    assert all(float(row["left_out_nrmse"]) > float(row["training_nrmse"]) for row in rows)
