@@ -8,7 +8,9 @@ k-th sample: a rate-independent model's force depends on the path, which 256 Hz 
 finely at these 1-5 Hz motions). Each model is fitted with the default preset to
 ``earthquake_KocaeliDBE`` and ``earthquake_ImperialValleyDBE`` as random-input tests, without an
 ensemble; then simulated on every record at 1024 Hz with ``rest_force_N`` the record's held force
-(``offsets.held_force``) and with none (virgin), and the NRMSE printed, the training records marked.
+(``offsets.held_force``) and with none (virgin), and the NRMSE printed, the training records marked;
+with ``--ensemble`` the fit samples its ensemble, and the share of each record's samples inside its
+band (``predict``'s envelope widened by the record's noise level) is printed.
 """
 from __future__ import annotations
 
@@ -37,6 +39,9 @@ def main() -> None:
     parser.add_argument("--rate", type=float, default=1024.0)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--ensemble", action="store_true",
+                        help="sample each fit's ensemble and print the share of each record's samples its band "
+                             "(widened by the record's noise level) covers")
     args = parser.parse_args()
     warnings.simplefilter("ignore")
     records = {name: load_measurement(REPO / "data" / "brfd" / f"earthquake_{name}.csv.gz") for name in RECORDS}
@@ -51,7 +56,8 @@ def main() -> None:
         print(f"{name}: held force at rest {held_force(m):+.1f} N", flush=True)
     for model in args.models.split(","):
         began = time.perf_counter()
-        result = fit(training, model=model, ensemble=False, progress=False, workers=args.workers, seed=args.seed)
+        result = fit(training, model=model, ensemble=args.ensemble, progress=False, workers=args.workers,
+                     seed=args.seed)
         seconds = time.perf_counter() - began
         cells = []
         for name, m in records.items():
@@ -60,6 +66,18 @@ def main() -> None:
             cells.append(f"{name}{' (training)' if name in TRAINING else ''} {scores[0]:.1%} (virgin {scores[1]:.1%})")
         print(f"{model} fitted on the DBE pair at {1024.0 / step:g} Hz in {seconds:.0f} s: " + "; ".join(cells),
               flush=True)
+        if args.ensemble:
+            from identification import predict
+            from identification.measured.noise import estimate_noise
+            shares = []
+            for name, m in records.items():
+                band = predict(result, m.time_s, m.displacement_mm, m.measured_velocity_mm_s,
+                               rest_force_N=held_force(m))
+                noise = estimate_noise(m.force_N).sigma_N
+                inside = (m.force_N >= band.lower_N - noise) & (m.force_N <= band.upper_N + noise)
+                shares.append(f"{name} {np.mean(inside):.1%}")
+            print(f"  its ensemble of {len(result.ensemble)} sets covers the measured force (the band widened by "
+                  f"the noise level) at: " + "; ".join(shares), flush=True)
 
 
 if __name__ == "__main__":

@@ -78,20 +78,46 @@ class FirstContact:
         return "\n".join(lines)
 
 
-def _offset_reasons(offsets: RecordOffsets, test: RigTest) -> list[str]:
-    """Why one record needs the rig's offsets (empty: it does not)."""
-    reasons = []
-    name = test.name
+def _offsets_shown(offsets: RecordOffsets, test: RigTest) -> dict[str, tuple[float, float, str]]:
+    """What one record shows that needs the rig's offsets, by kind ("stroke", "rest", "mean"):
+    (the value, its fraction of the record's range, the sentence for this record alone)."""
+    shown, name = {}, test.name
     if test.kind == "sine" and offsets.one_sided > ONE_SIDED:
-        reasons.append(f"the stroke of {name} is one-sided (centred at {offsets.centre_mm:+.3g} mm, "
-                       f"{offsets.half_range_mm:.3g} mm each way about it)")
+        shown["stroke"] = (offsets.centre_mm, offsets.one_sided,
+                           f"the stroke of {name} is one-sided (centred at {offsets.centre_mm:+.3g} mm, "
+                           f"{offsets.half_range_mm:.3g} mm each way about it)")
     floor = offset_floor(test.measurement, offsets)
     if math.isfinite(offsets.rest_force_N) and abs(offsets.rest_force_N) > floor:
-        reasons.append(f"{name} holds {offsets.rest_force_N:+.4g} N at rest before it moves "
-                       f"({offsets.rest_s:.3g} s at {offsets.start_mm:+.3g} mm)")
+        shown["rest"] = (offsets.rest_force_N, abs(offsets.rest_force_N) / offsets.force_half_range_N,
+                         f"{name} holds {offsets.rest_force_N:+.4g} N at rest before it moves "
+                         f"({offsets.rest_s:.3g} s at {offsets.start_mm:+.3g} mm)")
     if test.kind == "sine" and math.isfinite(offsets.cycle_mean_force_N) and abs(offsets.cycle_mean_force_N) > floor:
-        reasons.append(f"the whole cycles of {name} average {offsets.cycle_mean_force_N:+.4g} N "
-                       f"({abs(offsets.cycle_mean_force_N) / offsets.force_half_range_N:.1%} of its force half range)")
+        fraction = abs(offsets.cycle_mean_force_N) / offsets.force_half_range_N
+        shown["mean"] = (offsets.cycle_mean_force_N, fraction,
+                         f"the whole cycles of {name} average {offsets.cycle_mean_force_N:+.4g} N ({fraction:.1%} "
+                         "of its force half range)")
+    return shown
+
+
+def _offset_reasons(tests: Sequence[RigTest], offsets: Sequence[RecordOffsets]) -> list[str]:
+    """Why the records need the rig's offsets, a clause per kind of offset (empty: they do not):
+    one record's own sentence, or the count and range of several."""
+    by_kind: dict[str, list] = {}
+    for test, record in zip(tests, offsets):
+        for kind, entry in _offsets_shown(record, test).items():
+            by_kind.setdefault(kind, []).append(entry)
+    reasons = []
+    for kind, entries in by_kind.items():
+        if len(entries) == 1:
+            reasons.append(entries[0][2])
+            continue
+        low, high = min(e[0] for e in entries), max(e[0] for e in entries)
+        least, most = min(e[1] for e in entries), max(e[1] for e in entries)
+        reasons.append({
+            "stroke": f"the strokes of {len(entries)} sines are one-sided (centred at {low:+.3g} to {high:+.3g} mm)",
+            "rest": f"{len(entries)} records hold {low:+.4g} to {high:+.4g} N at rest before they move",
+            "mean": f"the whole cycles of {len(entries)} sines average {low:+.4g} to {high:+.4g} N ({least:.1%} to "
+                    f"{most:.1%} of their force half range)"}[kind])
     return reasons
 
 
@@ -164,7 +190,7 @@ def first_contact(tests: Sequence[RigTest], static_test: RigTest | None = None) 
         slow = [t for t, o in zip(tests, offsets) if t.kind != "step" and o.quasi_static]
         static_test = slow[0] if slow else None
     assumptions = []
-    reasons = [reason for t, o in zip(tests, offsets) for reason in _offset_reasons(o, t)]
+    reasons = _offset_reasons(tests, offsets)
     if reasons:
         assumptions.append(Assumption("rig", "; ".join(reasons) + ": no model of zero mean says that, the rig's "
                                              "zeros fitted beside it do"))

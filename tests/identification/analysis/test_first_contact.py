@@ -156,3 +156,10 @@ def test_compare_scores_the_recommended_model_leaving_each_test_out(tmp_path, ca
                                              "synthetic_filled_rubber_sine_0.5mm_3Hz.csv"]
     # a linear fit to one amplitude misses the other more than the fit to both does
     assert all(float(row["left_out_nrmse"]) > float(row["training_nrmse"]) for row in rows)
+
+
+def test_several_records_offsets_are_said_once_with_their_range(tmp_path):
+    sine = load_measurement(shifted(TABLE5_SINE, tmp_path))
+    other = Measurement(sine.time_s, sine.displacement_mm + 1.0, sine.force_N, sine.velocity_mm_s, source="b.csv")
+    (rig,) = first_contact([RigTest(sine, "sine"), RigTest(other, "sine")]).assumptions
+    assert rig.reason.startswith("the strokes of 2 sines are one-sided (centred at +2 to +3 mm)")
