@@ -33,9 +33,12 @@ from dataclasses import dataclass
 from typing import Sequence
 
 import numpy as np
+from scipy.interpolate import PchipInterpolator
 
+from identification.errors import MeasurementError
 from identification.measured.offsets import RecordOffsets, offset_floor, record_offsets
 from identification.measured.rig_tests import RigTest
+from identification.measured.static_curve import read_static_curve
 
 ONE_SIDED = 0.2
 """A sine whose stroke is centred beyond this fraction of its half range is one-sided."""
@@ -123,9 +126,6 @@ def _offset_reasons(tests: Sequence[RigTest], offsets: Sequence[RecordOffsets]) 
 
 def _knot_count(measurement) -> tuple[int, str]:
     """The backbone's knots for a quasi-static test and why (module docstring)."""
-    from scipy.interpolate import PchipInterpolator
-
-    from identification.measured.static_curve import read_static_curve
     coarse, fine = (read_static_curve(measurement, count=count) for count in KNOT_COUNTS)
     between = PchipInterpolator(coarse.knots_mm, coarse.forces_N)(fine.knots_mm)
     miss = float(np.max(np.abs(between - fine.forces_N)))
@@ -141,9 +141,6 @@ def _rate_stiffening(static_test: RigTest, dynamic: Sequence[RigTest]) -> str:
     """Why a rate-dependent element is tried beside the static curve ("": it is not): the dynamic
     test whose force is stiffest against the static curve's on the same samples (least-squares
     slopes on the displacement, the velocity and a constant)."""
-    from scipy.interpolate import PchipInterpolator
-
-    from identification.measured.static_curve import read_static_curve
     curve = read_static_curve(static_test.measurement, count=KNOT_COUNTS[1])
     backbone = PchipInterpolator(curve.knots_mm, curve.forces_N)
     worst, words = 0.0, ""
@@ -165,8 +162,6 @@ def _rate_stiffening(static_test: RigTest, dynamic: Sequence[RigTest]) -> str:
 
 def _stops(test: RigTest) -> str:
     """Why travel limits are tried for the largest sine ("": they are not)."""
-    from identification.errors import MeasurementError
-    from identification.measured.static_curve import read_static_curve
     try:
         curve = read_static_curve(test.measurement, count=KNOT_COUNTS[0])
     except MeasurementError:

@@ -41,7 +41,7 @@ from identification.measured.kdyn_table import (FIT_CYCLES, FIT_STEPS_PER_CYCLE,
                                                 SEARCH_CYCLES, SEARCH_STEPS_PER_CYCLE, KdynTable)
 from identification.measured.multiaxis import MultiAxisMeasurement, coupled_axes
 from identification.measured.noise import NoiseEstimate, estimate_noise
-from identification.measured.offsets import held_force
+from identification.measured.offsets import held_force, record_offsets
 from identification.measured.rig_tests import RigTest
 from identification.forward.simulate import simulate_driven, simulate_driven_vector
 
@@ -53,11 +53,11 @@ MIN_NOISE_FRACTION = 1e-3
 """Noise levels below 0.1 % of a test's rms force are taken as 0.1 %: the forward model's own
 accuracy at 1 kHz is about 0.04 % (tests/identification/forward/test_forward_model.py), so a fit cannot resolve less."""
 MIN_PREFIX_SAMPLES = 50
+"""The shortest prefix of a test a candidate is first screened on (``Objective.prefix``)."""
 FIT_SAMPLES_PER_CYCLE = 256
 """A sine's forces counted per cycle, at least: a finer one counts every stride-th sample (stride
 the samples a cycle over this, rounded down). A loop of the paper's tests has 100 (10 Hz at
 1 kHz); the real friction damper's 0.25 Hz sines at 1024 Hz have 4096."""
-"""The shortest prefix of a test a candidate is first screened on (``Objective.prefix``)."""
 
 
 @dataclass(frozen=True)
@@ -229,7 +229,8 @@ class Objective:
             cut.append(RigTest(replace(m, time_s=m.time_s[:k], displacement_mm=m.displacement_mm[:k],
                                        force_N=m.force_N[:k], velocity_mm_s=m.velocity_mm_s[:k])))
         prefix = Objective(cut, self.noise, self.steps_per_sample, self.bushing)
-        # the whole tests' forces at rest and strides (a prefix's own would judge them on less)
+        # the whole tests' forces at rest and strides (a prefix's own would judge them on less:
+        # a cycle of a slow sine is longer than its prefix), its tests prepared again with them
         prefix.rest_forces, prefix.strides = list(self.rest_forces), list(self.strides)
         prefix.tests = _prepared_tests(cut, self.noise, self.steps_per_sample, prefix.rest_forces, prefix.strides)
         prefix.size = sum(t.measured_N.size * t.driven.stride for t in prefix.tests)
@@ -339,7 +340,6 @@ def fit_stride(test: RigTest) -> int:
     FIT_SAMPLES_PER_CYCLE, rounded down (1 at or below it, and for every other kind of test)."""
     if test.kind != "sine":
         return 1
-    from identification.measured.offsets import record_offsets
     m = test.measurement
     frequency = record_offsets(m).frequency_hz
     if not math.isfinite(frequency) or frequency <= 0.0:
