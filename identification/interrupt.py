@@ -98,7 +98,8 @@ def record_written(*paths) -> None:
     """Note files a command has written, for the line printed if it is interrupted later (only
     while a command runs under :func:`signals_raise`: a library user's process keeps no list)."""
     if _command_running[0]:
-        _written.extend(Path(path) for path in paths if path is not None)
+        # a file written again (compare's table as each model is settled) is named once
+        _written.extend(path for path in dict.fromkeys(Path(p) for p in paths if p is not None) if path not in _written)
 
 
 def interrupted_message() -> str:

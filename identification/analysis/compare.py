@@ -125,7 +125,11 @@ def recommend(assessments: Sequence[Assessment], tolerance: float = PREDICTION_T
     free parameters, then the lowest BIC. Where none does, parsimony says nothing (every model misses
     the data): the ones that predict within ``tolerance`` of the best, where held-out data are given,
     and of those (of all, without) the lowest BIC, which weighs the fit itself against its
-    parameters."""
+    parameters. A model whose fitted set fails on a whole training record (an infinite training
+    ratio: the fit ran a stride or a prefix of it) is left out while another is not."""
+    failed = [a for a in assessments if not math.isfinite(a.training_ratio)]
+    if failed and len(failed) < len(assessments):    # a fitted set that fails on a whole training record
+        assessments = [a for a in assessments if a not in failed]
     pool = [a for a in assessments if a.at_floor]
     why = [f"{len(pool)} of {len(assessments)} at the floor"]
     if not pool:

@@ -364,7 +364,10 @@ def _prepared_tests(tests, noise, steps, rests, strides) -> list[PreparedTest]:
 
 
 def nrmse(predicted: np.ndarray, measured: np.ndarray) -> float:
-    """RMS of the difference over the RMS of the measurement (the stricter error)."""
+    """RMS of the difference over the RMS of the measurement (the stricter error); infinite where
+    the prediction is not finite somewhere (a simulation that failed from there on)."""
+    if not np.all(np.isfinite(predicted)):
+        return math.inf
     return float(np.sqrt(np.mean((predicted - measured) ** 2)) / np.sqrt(np.mean(measured ** 2)))
 
 

@@ -278,7 +278,11 @@ class FitResult(FittedParameters):
             return None
         reasons = []
         worst = max(self.tests, key=lambda t: t.ratio) if self.tests else None
-        if worst is not None and not worst.at_floor:
+        failed = [t.name for t in self.tests if not math.isfinite(t.nrmse)]
+        if failed:
+            reasons.append(f"the fitted set's simulation fails on {', '.join(failed)} (too many substeps or an "
+                           "overflow on its whole record, where the fit ran every stride-th sample or a prefix)")
+        elif worst is not None and not worst.at_floor:
             reasons.append(f"training NRMSE {worst.nrmse:.2%} on {worst.name} is {worst.ratio:.2f}x "
                            f"{worst.floor_words} ({worst.floor_fraction:.2%}; the floor is {FLOOR_FACTOR}x)")
         if self.table is not None and not self.table.at_floor:

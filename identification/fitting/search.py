@@ -436,8 +436,8 @@ class Search:
         ensemble = [dict(zip(space.bushing.parameter_names, map(float, row))) for row in rows]
         parameters = ParameterSet(space.bushing, ensemble[0])
         steps = problem.objective.steps_per_sample
-        # a strided test's steps are per stride: its figures on every sample take the signal's own
-        every = [m if t.driven.stride == 1 else None for m, t in zip(steps, problem.objective.tests)]
+        # a strided test's steps are per stride: on every sample, as many as make steps no longer
+        every = [-(-m // t.driven.stride) for m, t in zip(steps, problem.objective.tests)]
         fits = test_fits(request.tests, request.noise, parameters, every) + request.multi.fits(parameters)
         steps = steps + [m.driven.steps_per_sample for m in problem.objective.multiaxis]
         result = FitResult(parameters, float(best.misfit), fits, records, threshold,

@@ -163,3 +163,10 @@ def test_compare_on_filled_rubber_does_not_recommend_the_hydraulic_model(tmp_pat
                  "--screening", "256", "--starts", "8", "--no-ensemble", "--quiet", "--out", str(out)])
     assert code == 0
     assert capsys.readouterr().out.strip().splitlines()[-1] == "recommended: berg"
+
+
+def test_a_model_whose_fitted_set_fails_on_a_whole_record_is_not_recommended():
+    # its misfit on the fit's strided samples was the lowest; on every sample its simulation fails
+    failed = assessment("stiff", 4, math.inf, misfit=1.0)
+    choice = recommend([failed, assessment("other", 8, 3.0, misfit=9.0)])
+    assert choice.model == "other"

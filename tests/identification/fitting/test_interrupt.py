@@ -326,5 +326,6 @@ def test_compare_stopped_after_its_third_fit_leaves_those_three_models_files(mon
     with open(out / "comparison.csv") as handle:
         rows = list(csv.DictReader(handle))
     assert [row["model"] for row in rows] == settled and all(row["recommended"] == "" for row in rows)
-    last = capsys.readouterr().err.splitlines()[-1]
-    assert last.startswith("interrupted: wrote") and all(f"params_{model}.json" in last for model in settled)
+    (line,) = [line for line in capsys.readouterr().err.splitlines() if line.startswith("interrupted")]
+    assert line.startswith("interrupted: wrote") and all(f"params_{model}.json" in line for model in settled)
+    assert line.count("comparison.csv") == 1        # written again as each model settled, named once
