@@ -46,7 +46,12 @@ class CoordinateKind:
 
 
 def _log_ratio(value: float, scale: float) -> float:
-    return math.log10(value / scale) if value > 0 else -math.inf
+    if not value > 0:
+        return -math.inf
+    ratio = value / scale
+    # a subnormal value (a slow loop's start of 5e-324) over a scale of 100 underflows to 0, which
+    # log10 refuses: the difference of the logs then, the log of the ratio (as ever) otherwise
+    return math.log10(ratio) if ratio > 0 else math.log10(value) - math.log10(scale)
 
 
 class LogScaled(CoordinateKind):
@@ -221,7 +226,7 @@ class PowerLaw(CoordinateKind):
         return scales.k_ref * scales.tau_ref ** values[c.exponent] * 10.0 ** u
 
     def to_coordinate(self, c, value, params, scales):
-        return math.log10(value / (scales.k_ref * scales.tau_ref ** params[c.exponent])) if value > 0 else -math.inf
+        return _log_ratio(value, scales.k_ref * scales.tau_ref ** params[c.exponent])
 
 
 class Resonance(CoordinateKind):
@@ -252,7 +257,7 @@ class DampingRatio(CoordinateKind):
 
     def to_coordinate(self, c, value, params, scales):
         critical = 2.0 * math.sqrt(sum(params[name] for name in c.over) * params[c.partner])
-        return math.log10(value / critical) if value > 0 else -math.inf
+        return _log_ratio(value, critical)
 
 
 class QuadraticDamping(CoordinateKind):

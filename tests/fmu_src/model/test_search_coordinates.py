@@ -142,3 +142,12 @@ def test_no_generic_module_names_a_model():
     found = [f"{path.relative_to(ROOT)}:{line} {value!r}" for path in GENERIC for line, value in _code_strings(path)
              if value in names]
     assert not found, found
+
+
+@pytest.mark.parametrize("name", ["stiffness", "damping", "force", "travel", "power_law"])
+def test_a_subnormal_value_maps_to_a_finite_coordinate(name):
+    # a slow loop's least-squares start gave Berg's friction 5e-324 N, whose ratio to a scale of
+    # 150 underflows to 0: the coordinate is log10(5e-324) - log10(scale), about -325.5, not an error
+    c = COORDINATES[name]
+    u = c.kind.to_coordinate(c, 5e-324, dict(OTHERS, p=5e-324), Scales)
+    assert math.isfinite(u) and u < -300.0
