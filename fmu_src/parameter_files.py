@@ -385,8 +385,8 @@ def read_six_axis(path: str | Path) -> SixAxisSet:
 def check_groups(coupling: Coupling, axes: Mapping[str, ParameterSet], where: str = "") -> None:
     """Refuse a coupled group whose axes carry different models or parameters (their mounting may
     differ: an offset and a preload per axis), or a parameter that a coupled model requires to be 0
-    (``CoupledKernels.zero_parameters``); ParameterError names the group, the axes, the values and
-    what is allowed."""
+    (``CoupledKernels.zero_parameters``), or a held force at rest (a group starts relaxed);
+    ParameterError names the group, the axes, the values and what is allowed."""
     for kind, group in coupling.named_groups:
         sets = {name: axes[name] for name in group}
         label = f"{where}the {kind} group ({', '.join(group)})"
@@ -408,6 +408,11 @@ def check_groups(coupling: Coupling, axes: Mapping[str, ParameterSet], where: st
             if value != 0.0:
                 raise ParameterError(MESSAGES["GROUP_PARAMETER_NOT_ZERO"].text(
                     label=f"{label}: ", name=name, value=repr(value), unit=model.units[name]))
+        for axis in group:
+            held = model.held_force(sets[axis].parameters)
+            if held != 0.0:
+                raise ParameterError(MESSAGES["GROUP_HELD_FORCE_NOT_ZERO"].text(
+                    label=f"{label}: ", axis=axis, value=repr(held), unit=model.fmu_units["held_force"]))
 
 
 def _check_axis_names(path: Path, names: set[str]) -> None:

@@ -15,15 +15,19 @@ from fmpy.fmi2 import (FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFr
                        fmi2CallbackFunctions, fmi2CallbackLoggerTYPE)
 from fmpy.fmi2 import calloc, free
 
+from fmu_src.model.integration import DEFAULT_MAX_SUBSTEPS, OK
+
 STATUS_NAMES = ["ok", "warning", "discard", "error", "fatal", "pending"]
 
 
 def logging_callbacks(log) -> fmi2CallbackFunctions:
     """FMI 2 callbacks that pass each message to ``log(status name, category, message)`` (keep the
-    returned object alive while the instance lives)."""
+    returned object alive while the instance lives). pythonfmu logs the exception that fails a
+    call with no category (NULL): ""."""
     callbacks = fmi2CallbackFunctions()
     callbacks.logger = fmi2CallbackLoggerTYPE(lambda component, instance_name, status, category, message:
-                                              log(STATUS_NAMES[status], category.decode(), message.decode()))
+                                              log(STATUS_NAMES[status], (category or b"").decode(),
+                                                  (message or b"").decode()))
     callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
     callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
     return callbacks
@@ -101,3 +105,20 @@ def simulate_with_fmpy(fmu_path, time_s, x_mm, v_mm_s, start_values=None):
                           start_values=start_values or {})
     assert np.allclose(result["time"], time_s, rtol=0, atol=1e-9)
     return result["F"]
+
+
+def kernel_forces(model, params, x_mm, step_s, state=None):
+    """A one-axis model's force [N] after every step of ``step_s`` [s] along ``x_mm`` [mm], its
+    kernels in plain Python from ``state`` at x_mm[0] (default: relaxed there), fed as an FMU is
+    fed by a master that sets x and the secant velocity: the ports in metres, times 1000."""
+    m = model.constants(params)
+    x = [value * 1e-3 * 1000.0 for value in x_mm]
+    velocity = [(x_mm[k + 1] - x_mm[k]) / step_s * 1e-3 * 1000.0 for k in range(len(x_mm) - 1)]
+    state = model.initial_state(m, x[0]) if state is None else state
+    state_x, out = x[0], []
+    for k, v in enumerate(velocity):
+        state, _, status = model.step(m, state, state_x, x[k], v, step_s, DEFAULT_MAX_SUBSTEPS)
+        assert status == OK
+        state_x = x[k] + v * step_s
+        out.append(model.force(m, state, state_x, v))
+    return np.array(out)

@@ -51,6 +51,12 @@ MOUNTING_UNITS = {"offset": "mm", "preload": "N"}
 preload is its own parameter, the same force)."""
 
 
+HOLDING_MODELS = ("asymmetric_bouc_wen", "single_bouc_wen")
+"""The models whose friction element can hold a force at rest: their FMUs' axes take a held force
+at the start, a force [N]."""
+
+
 def fmu_parameter_units(model: str) -> dict[str, str]:
-    """The parameters an FMU of ``model`` declares: the model's, then its mounting's."""
-    return {**PARAMETER_UNITS[model], **MOUNTING_UNITS}
+    """The parameters an FMU of ``model`` declares: the model's, then its mounting's (and the held
+    force at rest of a model that can hold one)."""
+    return {**PARAMETER_UNITS[model], **MOUNTING_UNITS, **({"held_force": "N"} if model in HOLDING_MODELS else {})}

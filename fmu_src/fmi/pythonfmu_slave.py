@@ -440,7 +440,14 @@ class BushingSlave(Fmi2Slave):
                                    + f" [{first.units[name]}]" for name in differing)
                 unit.errors = [MESSAGES["GROUP_PARAMETERS_DIFFER"].text(label=unit.label, values=values)]
                 self._error(unit.errors[0])
-            unit.usable = usable and not differing
+            if len(unit.members) > 1:      # a coupled group starts relaxed: it holds no force at rest
+                for a in unit.members:
+                    if a.model.held_force(a.values) != 0.0:
+                        unit.errors.append(MESSAGES["GROUP_HELD_FORCE_NOT_ZERO"].text(
+                            label=unit.label, axis=a.axis.name, value=repr(a.values["held_force"]),
+                            unit=a.units["held_force"]))
+                        self._error(unit.errors[-1])
+            unit.usable = usable and not unit.errors
             unit.constants = first.constants if unit.usable else None
         return unit.usable
 
@@ -477,10 +484,16 @@ class BushingSlave(Fmi2Slave):
 
     def _set_initial_state(self):
         """Each unit at relaxed equilibrium at its current displacement (its model's initial_state;
-        a coupled group's at its members' displacement vector)."""
+        a coupled group's at its members' displacement vector), an axis alone holding its
+        ``held_force`` beyond that where it is not 0 (``BushingModel.holding_state``)."""
         for unit in self._units:
             x, _ = unit.inputs()
-            unit.state, unit.state_x = unit.kernels.initial_state(unit.constants, x), x
+            if isinstance(unit, _AxisUnit):
+                a = unit.axis_state
+                unit.state = unit.model.holding_state(unit.constants, x[0], a.model.held_force(a.values))
+            else:
+                unit.state = unit.kernels.initial_state(unit.constants, x)
+            unit.state_x = x
             for a in unit.members:
                 a.state_x = a.x_now
                 a.output_is_current = False

@@ -89,6 +89,9 @@ MESSAGES = {
     "GROUP_PARAMETER_NOT_ZERO": Message("error", "{label}{name} = {value} [{unit}] must be 0 in a coupled group (it "
                                                  "has no direction in the plane); give the axes an offset and a "
                                                  "preload instead"),
+    "GROUP_HELD_FORCE_NOT_ZERO": Message("error", "{label}{axis}.held_force = {value} [{unit}] must be 0 in a "
+                                                  "coupled group: the group starts relaxed (an axis alone starts "
+                                                  "holding it)"),
     # inputs as set
     "INPUT_SET_NOT_FINITE": Message("error", "input {port} = {value} {unit} is not a finite number; the next doStep "
                                              "will be refused"),

@@ -64,6 +64,14 @@ MOUNTING_SPECS = (
 is, bit for bit). A model with a parameter of the same name (Kelvin-Voigt's preload, the same
 constant force) keeps its own; on a rotational axis they are in rad and N.mm."""
 
+HELD_FORCE_SPEC = ParameterSpec(
+    "held_force", "N", "force the axis holds at rest when the run starts, beyond its relaxed force at the "
+    "start displacement: its friction element stuck, the slider deflected (what the test before left in the "
+    "device); 0: relaxed", bound_powers=(0, 0))
+"""The start a model that can hold a force at rest (``BushingModel.resting_state``) takes on an
+FMU's axis, after the mounting: the FMU starts that axis in ``BushingModel.holding_state``; 0 is
+the relaxed start, bit for bit. An axis of a coupled group starts relaxed and takes 0 only."""
+
 
 class ModelContractError(ValueError):
     """A model module outside the contract of the compiled path (the message names the module,
@@ -342,9 +350,11 @@ class BushingModel:
     @property
     def mounting_specs(self) -> tuple[ParameterSpec, ...]:
         """The mounting's parameters this model takes besides its own (``MOUNTING_SPECS`` but a name
-        the model has itself), in the units of its axis."""
+        the model has itself; ``HELD_FORCE_SPEC`` after them for a model with a ``resting_state``),
+        in the units of its axis."""
         units = {"mm": "rad", "N": "N.mm"} if self.rotational else {}
-        return tuple(replace(spec, unit=units.get(spec.unit, spec.unit)) for spec in MOUNTING_SPECS
+        held = (HELD_FORCE_SPEC,) if self.resting_state is not None else ()
+        return tuple(replace(spec, unit=units.get(spec.unit, spec.unit)) for spec in MOUNTING_SPECS + held
                      if spec.name not in self.parameter_names)
 
     @property
@@ -363,6 +373,21 @@ class BushingModel:
         names = {spec.name for spec in self.mounting_specs}
         return (float(params.get("offset", 0.0)) if "offset" in names else 0.0,
                 float(params.get("preload", 0.0)) if "preload" in names else 0.0)
+
+    def held_force(self, params: Mapping[str, float]) -> float:
+        """The force [N or N.mm] a parameter set's axis holds at rest at its start beyond its
+        relaxed force (``HELD_FORCE_SPEC``): 0 where not given or the model holds none."""
+        return float(params.get("held_force", 0.0)) if self.resting_state is not None else 0.0
+
+    def holding_state(self, constants, x0: float, held: float):
+        """The state a run starts from at rest at ``x0`` [mm or rad] holding ``held`` [N or N.mm]
+        beyond the relaxed force there (its force at rest, v = 0): relaxed (``initial_state``)
+        where ``held`` is 0, else the ``resting_state`` of that force. What both FMUs start an
+        axis in (the native C calls the same three kernels in this order)."""
+        relaxed = self.initial_state(constants, x0)
+        if held == 0.0:
+            return relaxed
+        return self.resting_state(constants, x0, self.force(constants, relaxed, x0, 0.0) + held)
 
     @property
     def units(self) -> dict[str, str]:

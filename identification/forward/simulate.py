@@ -51,7 +51,8 @@ def simulate(parameters, time_s, displacement_mm, velocity_mm_s=None, model: str
     rest_force_N : float, optional
         The force [N] the test holds at rest before it moves (``measured.offsets.held_force``): a
         model that can hold a force at rest (``BushingModel.resting_state``) starts holding it, its
-        mounting's preload aside; NaN (default): relaxed.
+        mounting's preload aside; NaN (default): relaxed, or holding the set's ``held_force`` [N]
+        beyond its relaxed force at the first displacement, as the FMU starts.
 
     Returns
     -------
@@ -69,6 +70,10 @@ def simulate(parameters, time_s, displacement_mm, velocity_mm_s=None, model: str
     """
     values, bushing = _parameters_and_model(parameters, model)
     offset, preload = bushing.mounting(values)      # F = model(x - offset) + preload; 0 and 0: as it is
+    held = bushing.held_force(values)
+    if held != 0.0 and not rest_force_N == rest_force_N:   # the FMU's start: its relaxed force at rest + held
+        m, x0 = bushing.constants(values), float(np.asarray(displacement_mm, dtype=float).flat[0]) - offset
+        rest_force_N = bushing.force(m, bushing.initial_state(m, x0), x0, 0.0) + held + preload
     driven = prepare_input(time_s, np.asarray(displacement_mm, dtype=float) - offset, velocity_mm_s,
                            steps=steps_per_sample, rest_force_N=rest_force_N - preload)
     return simulate_driven(parameter_matrix([values], bushing), driven, model=bushing)[0] + preload

@@ -74,6 +74,8 @@ class ModelCode:
                                                             (m, s, DOUBLE, DOUBLE))
         if model.update is not None:
             self.kernels["update"] = translation.function(model.update, (m, s, DOUBLE, DOUBLE))
+        if model.resting_state is not None:
+            self.kernels["resting_state"] = translation.function(model.resting_state, (m, DOUBLE, DOUBLE))
         self.coupled = CoupledCode(translation, model, self.constants_type) if coupled else None
         self.switches = len(self.kernels["switches"].return_type)
         if [s.index for s in model.switch_specs] != list(range(self.switches)):
@@ -122,6 +124,11 @@ class ModelCode:
         else:
             lines.append(f"static int bw_{name}_update(const void *c, double *s, double x, double v) {{\n"
                          "    (void)c;\n    (void)s;\n    (void)x;\n    (void)v;\n    return 0;\n}\n")
+        if "resting_state" in k:
+            lines.append(
+                f"static void bw_{name}_resting_state(const void *c, double x0, double force, double *s) {{\n"
+                f"    {self.translation.c_type(self.state_type)} r = {k['resting_state'].name}({constants}, x0, "
+                f"force);\n" + copy_state("r", "s") + "}\n")
         for kernel, out in (("derivatives", "rates"), ("switches", "values")):
             count = len(k[kernel].return_type)
             lines.append(
@@ -202,10 +209,12 @@ class ModelCode:
         kernels = ", ".join(f"bw_{self.name}_{kernel}" for kernel in
                             ("prepare", "initial_state", "step", "jump", "force", "derivatives", "switches",
                              "update", "force_tangent", "derivatives_tangent", "jump_tangent"))
+        kernels += f", {'bw_' + self.name + '_resting_state' if 'resting_state' in self.kernels else 'NULL'}"
         mounting = {spec.name: index[spec.name] for spec in model.mounting_specs}
         coupled = f"&bw_coupled_{self.name}" if self.coupled is not None else "NULL"
         out += (f"static const bw_model bw_model_{name} = {{{c_string(self.name)}, {len(model.specs)}, "
                 f"{len(model.fmu_specs)}, {mounting.get('offset', -1)}, {mounting.get('preload', -1)}, "
+                f"{mounting.get('held_force', -1)}, "
                 f"{len(self.state_type)}, {self.switches}, bw_specs_{name}, {len(constraints)}, "
                 f"{'bw_constraints_' + name if constraints else 'NULL'}, {kernels}, {coupled}}};\n")
         return out

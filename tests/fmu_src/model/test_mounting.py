@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 
 from conftest import DATA
-from fmu_harness import BushingFmu
+from fmu_harness import BushingFmu, kernel_forces
 from fmu_src.fmi.axes import SIX_AXES
 from fmu_src.model.registry import MODELS, get_model
-from fmu_src.model.integration import DEFAULT_MAX_SUBSTEPS, OK
+from fmu_src.model.integration import DEFAULT_MAX_SUBSTEPS
 from fmu_src.parameter_files import read_parameter_set, read_six_axis
 from identification.forward.simulate import simulate
 
@@ -44,17 +44,8 @@ def run_fmu(fmu_path, x_mm, start_values=None, prefix="", unit=1e-3):
 
 def run_kernels(model, params, x_mm):
     """The model's force after every step, its kernels in plain Python (relaxed at x_mm[0]), fed
-    as the FMU feeds them: the ports in metres, times 1000."""
-    m = model.constants(params)
-    x = [value * 1e-3 * 1000.0 for value in x_mm]
-    velocity = [(x_mm[k + 1] - x_mm[k]) / STEP_S * 1e-3 * 1000.0 for k in range(len(x_mm) - 1)]
-    state, state_x, out = model.initial_state(m, x[0]), x[0], []
-    for k, v in enumerate(velocity):
-        state, _, status = model.step(m, state, state_x, x[k], v, STEP_S, DEFAULT_MAX_SUBSTEPS)
-        assert status == OK
-        state_x = x[k] + v * STEP_S
-        out.append(model.force(m, state, state_x, v))
-    return np.array(out)
+    as the FMU feeds them."""
+    return kernel_forces(model, params, x_mm, STEP_S)
 
 
 def mounting_of(model, offset, preload):

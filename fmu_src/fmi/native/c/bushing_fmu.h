@@ -105,6 +105,7 @@ typedef struct {
     int fmu_parameters; /* and its mounting's after them (definition.MOUNTING_SPECS): specs has this many */
     int offset;         /* the mounting's offset and preload among them, or -1 (a model with its own preload) */
     int preload;
+    int held;           /* the held force at rest among them (definition.HELD_FORCE_SPEC), or -1 (none) */
     int states;
     int switches;
     const bw_parameter_spec *specs;
@@ -126,6 +127,8 @@ typedef struct {
     void (*derivatives_tangent)(const void *constants, const double *state, double x, double v, const double *d_state,
                                 double dx, double dv, double *d_rates);
     int (*jump_tangent)(const void *constants, double *state, double jump, double *d_state);
+    /* At rest at x0 holding force (kernel units): BushingModel.resting_state; NULL for a model that holds none. */
+    void (*resting_state)(const void *constants, double x0, double force, double *state);
     const bw_coupled_model *coupled;   /* its coupled form, where a coupled group of this FMU runs it; else NULL */
 } bw_model;
 

@@ -1,6 +1,6 @@
 /* Part of the native FMU's instance (bushing_instance.h).
    Life cycle: a new instance, reset, the exit of initialization mode (start values that cannot run
-   are an error, each named) and the relaxed initial state. */
+   are an error, each named) and the initial state: relaxed, or holding a force at rest. */
 static void bw_reset(bw_instance *inst);
 
 /* A new instance's settings (the FMI layer allocated it, zeroed), then its start values. */
@@ -32,11 +32,22 @@ static void bw_reset(bw_instance *inst) {
     inst->jump_warned = 0;
 }
 
+/* Each axis alone relaxed at its displacement, holding its held force beyond that where it is not
+   0 (BushingModel.holding_state: the relaxed state, its force at rest, the resting state of that
+   plus the held force); each coupled group relaxed at its members' displacement vector. */
 static void bw_set_initial_state(bw_instance *inst) {
     int a, g;
     for (a = 0; a < BW_AXES; a++) {
         bw_axis *axis = &inst->data.axes[a];
-        if (bw_axis_group[a] < 0) bw_axis_specs[a].model->initial_state(&axis->constants, axis->x_now, axis->state);
+        const bw_model *model = bw_axis_specs[a].model;
+        if (bw_axis_group[a] < 0) {
+            model->initial_state(&axis->constants, axis->x_now, axis->state);
+            if (model->held >= 0 && axis->parameters[model->held] != 0.0) {
+                double relaxed = model->force(&axis->constants, axis->state, axis->x_now, 0.0);
+                model->resting_state(&axis->constants, axis->x_now, relaxed + axis->parameters[model->held],
+                                     axis->state);
+            }
+        }
         axis->state_x = axis->x_now;
         axis->output_is_current = 0;
     }

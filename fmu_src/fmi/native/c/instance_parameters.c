@@ -33,7 +33,7 @@ static void bw_group_inputs(const bw_instance *inst, int g, double *x, double *v
 }
 
 /* Whether the members' own parameters are one set (their mounting may differ), and the coupled
-   model's zero parameters 0 (Spencer's x0); logs every difference, naming the group, the axes and
+   model's zero parameters 0 (Spencer's x0) and their held forces at rest 0; logs every difference, naming the group, the axes and
    the values (as parameter_files.check_groups). */
 static int bw_check_group(bw_instance *inst, int g) {
     const bw_group_spec *spec = &bw_group_specs[g];
@@ -59,6 +59,14 @@ static int bw_check_group(bw_instance *inst, int g) {
         if (first->parameters[k] == 0.0) continue;
         bw_format_double(a, sizeof a, first->parameters[k]);
         BW_MESSAGE_GROUP_PARAMETER_NOT_ZERO(inst, spec->label, model->specs[k].name, a, model->specs[k].unit);
+        equal = 0;
+    }
+    for (c = 0; model->held >= 0 && c < spec->members; c++) {     /* a group starts relaxed */
+        double held = inst->data.axes[spec->axis[c]].parameters[model->held];
+        if (held == 0.0) continue;
+        bw_format_double(a, sizeof a, held);
+        BW_MESSAGE_GROUP_HELD_FORCE_NOT_ZERO(inst, spec->label, bw_axis_specs[spec->axis[c]].name, a,
+                                             model->specs[model->held].unit);
         equal = 0;
     }
     return equal;
