@@ -140,3 +140,20 @@ def test_a_coupled_groups_fmu_refuses_a_held_force_set_at_its_start(tmp_path):
             assert any("y.held_force = 90.0 [N] must be 0 in a coupled group" in m for m in fmu.messages_with("error"))
         finally:
             fmu.free()
+
+
+def test_a_model_with_options_starts_holding_its_force_in_both_fmus(tmp_path):
+    # the derived model's resting_state (the options' forces at rest taken off what the base holds)
+    # translated to C as the base's is: the axis gives its relaxed force at 0 plus the held force
+    import build_fmu
+    from example_parameter_files import derived_parameter_file
+    path, name = derived_parameter_file(tmp_path), "single_bouc_wen+backbone4+limits+maxwell"
+    outputs = []
+    for fmu_path in (build_fmu.build_native_fmu(path, tmp_path / "native", model=name).path,
+                     build_fmu.build_fmu(path, tmp_path / "pythonfmu", model=name)):
+        relaxed, errors = run_fmu(fmu_path, {})
+        held, more = run_fmu(fmu_path, {"held_force": 150.0})
+        assert not errors and not more and relaxed[0] != 0.0
+        assert held[0] == pytest.approx(relaxed[0] + 150.0, rel=1e-12)
+        outputs.append(held)
+    assert np.max(np.abs(outputs[0] - outputs[1])) <= 1e-12 * np.max(np.abs(outputs[1]))
