@@ -408,8 +408,8 @@ def check_groups(coupling: Coupling, axes: Mapping[str, ParameterSet], where: st
             if value != 0.0:
                 raise ParameterError(MESSAGES["GROUP_PARAMETER_NOT_ZERO"].text(
                     label=f"{label}: ", name=name, value=repr(value), unit=model.units[name]))
-        for axis in group:
-            held = model.held_force(sets[axis].parameters)
+        for axis in (group if model.coupled is not None else ()):   # a group of a model without a
+            held = model.held_force(sets[axis].parameters)              # coupled form runs its axes alone
             if held != 0.0:
                 raise ParameterError(MESSAGES["GROUP_HELD_FORCE_NOT_ZERO"].text(
                     label=f"{label}: ", axis=axis, value=repr(held), unit=model.fmu_units["held_force"]))

@@ -440,7 +440,7 @@ class BushingSlave(Fmi2Slave):
                                    + f" [{first.units[name]}]" for name in differing)
                 unit.errors = [MESSAGES["GROUP_PARAMETERS_DIFFER"].text(label=unit.label, values=values)]
                 self._error(unit.errors[0])
-            if len(unit.members) > 1:      # a coupled group starts relaxed: it holds no force at rest
+            if usable and len(unit.members) > 1:   # a coupled group starts relaxed: it holds no force at rest
                 for a in unit.members:
                     if a.model.held_force(a.values) != 0.0:
                         unit.errors.append(MESSAGES["GROUP_HELD_FORCE_NOT_ZERO"].text(

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ..model.definition import HELD_FORCE_SPEC
 from ..model.registry import DEFAULT_MODEL, get_model
 
 
@@ -30,7 +31,7 @@ class FmuVariable:
     name: str
     value_reference: int
     causality: str          # parameter, input, output, local
-    variability: str        # tunable, continuous
+    variability: str        # tunable, fixed (read at the start only), continuous
     unit: str
     description: str
     axis: int               # position of the axis in the FMU's axes
@@ -56,7 +57,9 @@ def fmu_variables(axis_models, groups=()) -> list[FmuVariable]:
 
     for position, (axis, model, parameters) in enumerate(axis_models):
         for index, spec in enumerate(model.fmu_specs):    # the model's, then its mounting's (default 0)
-            add(name=axis.prefix + spec.name, causality="parameter", variability="tunable", unit=spec.unit,
+            # the held force is read once, at the start: fixed (set before initialization ends)
+            variability = "fixed" if spec.name == HELD_FORCE_SPEC.name else "tunable"
+            add(name=axis.prefix + spec.name, causality="parameter", variability=variability, unit=spec.unit,
                 description=f"{axis.label}{spec.description} [{spec.unit}]", axis=position, kind="parameter",
                 index=index, start=float(parameters.get(spec.name, 0.0)))
         what = "rotation" if axis.rotational else "displacement"

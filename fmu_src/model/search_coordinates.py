@@ -176,7 +176,7 @@ class Slower(CoordinateKind):
 
     def to_coordinate(self, c, value, params, scales):
         tau = value / sum(params[name] for name in c.over)
-        return math.log10(tau / scales.time_constant(params, c.partner))
+        return _log_ratio(tau, scales.time_constant(params, c.partner))
 
 
 def shape_scale(scales, n):

@@ -25,7 +25,7 @@ from identification.forward.population import parameter_matrix
 from identification.errors import IdentificationError
 from identification.forward.input_path import prepare_input
 from identification.forward.parameter_sets import parameter_sets
-from identification.forward.simulate import simulate_driven
+from identification.forward.simulate import model_rest_force, simulate_driven
 
 
 @dataclass
@@ -104,8 +104,10 @@ def predict(parameters, time_s, displacement_mm, velocity_mm_s=None,
     """
     bushing, sets = parameter_sets(parameters, model)
     x = np.asarray(displacement_mm, dtype=float)
-    forces = _mounted_population(bushing, sets, lambda matrix, offset, preload: simulate_driven(
-        matrix, prepare_input(time_s, x - offset, velocity_mm_s, rest_force_N=rest_force_N - preload), model=bushing))
+    forces = _mounted_population(bushing, sets, lambda matrix, values, offset: simulate_driven(
+        matrix, prepare_input(time_s, x - offset, velocity_mm_s,
+                              rest_force_N=model_rest_force(bushing, values, float(x.flat[0]) - offset, rest_force_N)),
+        model=bushing), by_start=True)
     _refuse_failed(forces[0], time_s)
     return Prediction(np.asarray(time_s, dtype=float), x, forces[0], np.nanmin(forces, axis=0),
                       np.nanmax(forces, axis=0), len(sets))
@@ -164,22 +166,27 @@ def predict_multiaxis(parameters, time_s, displacement_mm, coupling: str, veloci
         raise IdentificationError(f"a multi-axis path has 2 or 3 displacement columns, one row per time: got "
                                   f"{x.shape} for {t.size} times")
     coupled = coupled_axes(coupling, x.shape[1])
-    forces = _mounted_population(bushing, sets, lambda matrix, offset, preload: simulate_driven_vector(
+    forces = _mounted_population(bushing, sets, lambda matrix, values, offset: simulate_driven_vector(
         matrix, prepare_vector_input(t, x - offset, velocity_mm_s), model=bushing, coupled_axes=coupled))
     _refuse_failed(forces[0], t)
     return MultiAxisPrediction(t, x, forces[0], np.nanmin(forces, axis=0), np.nanmax(forces, axis=0), len(sets),
                                coupling)
 
 
-def _mounted_population(bushing: BushingModel, sets, simulate_at) -> np.ndarray:
+def _mounted_population(bushing: BushingModel, sets, simulate_at, by_start: bool = False) -> np.ndarray:
     """Forces (P, ...) of the parameter sets, each with its mounting (F = model(x - offset) +
-    preload, ``BushingModel.mounting``): ``simulate_at(matrix, offset, preload)`` once for each mounting
-    the sets carry (a fit's members share one)."""
-    mountings = [bushing.mounting(values) for values in sets]
+    preload, ``BushingModel.mounting``): ``simulate_at(matrix, a member's values, offset)`` once for
+    each mounting the sets carry (a fit's members share one); with ``by_start``, once for each
+    member of a set that holds a ``held_force`` at its start (its relaxed force, and so the force
+    it starts holding, is its own)."""
+    def key(i, values):
+        start = i if by_start and bushing.held_force(values) != 0.0 else None
+        return (*bushing.mounting(values), start)
+    keys = [key(i, values) for i, values in enumerate(sets)]
     forces = [None] * len(sets)
-    for offset, preload in dict.fromkeys(mountings):
-        members = [i for i, mounting in enumerate(mountings) if mounting == (offset, preload)]
-        result = simulate_at(parameter_matrix([sets[i] for i in members], bushing), offset, preload) + preload
+    for offset, preload, start in dict.fromkeys(keys):
+        members = [i for i, k in enumerate(keys) if k == (offset, preload, start)]
+        result = simulate_at(parameter_matrix([sets[i] for i in members], bushing), sets[members[0]], offset) + preload
         for row, i in zip(result, members):
             forces[i] = row
     return np.array(forces)

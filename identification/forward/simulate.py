@@ -70,13 +70,24 @@ def simulate(parameters, time_s, displacement_mm, velocity_mm_s=None, model: str
     """
     values, bushing = _parameters_and_model(parameters, model)
     offset, preload = bushing.mounting(values)      # F = model(x - offset) + preload; 0 and 0: as it is
-    held = bushing.held_force(values)
-    if held != 0.0 and not rest_force_N == rest_force_N:   # the FMU's start: its relaxed force at rest + held
-        m, x0 = bushing.constants(values), float(np.asarray(displacement_mm, dtype=float).flat[0]) - offset
-        rest_force_N = bushing.force(m, bushing.initial_state(m, x0), x0, 0.0) + held + preload
-    driven = prepare_input(time_s, np.asarray(displacement_mm, dtype=float) - offset, velocity_mm_s,
-                           steps=steps_per_sample, rest_force_N=rest_force_N - preload)
+    x = np.asarray(displacement_mm, dtype=float) - offset
+    driven = prepare_input(time_s, x, velocity_mm_s, steps=steps_per_sample,
+                           rest_force_N=model_rest_force(bushing, values, float(x.flat[0]), rest_force_N))
     return simulate_driven(parameter_matrix([values], bushing), driven, model=bushing)[0] + preload
+
+
+def model_rest_force(bushing: BushingModel, values, x0_mm: float, rest_force_N: float = math.nan) -> float:
+    """The force [N] the model (its mounting aside) starts holding at rest at its displacement
+    ``x0_mm`` [mm] (the offset taken off): a record's ``rest_force_N`` less the set's preload where
+    that is a number, else the set's ``held_force`` beyond its relaxed force there (the FMU's start,
+    ``BushingModel.holding_state``), else NaN: relaxed."""
+    if rest_force_N == rest_force_N:
+        return rest_force_N - bushing.mounting(values)[1]
+    held = bushing.held_force(values)
+    if held == 0.0:
+        return math.nan
+    m = bushing.constants(values)
+    return bushing.force(m, bushing.initial_state(m, x0_mm), x0_mm, 0.0) + held
 
 
 def simulate_driven(matrix: np.ndarray, driven: DrivenInput, max_substeps: int | None = None,

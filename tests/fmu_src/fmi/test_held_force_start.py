@@ -103,10 +103,43 @@ def test_both_fmus_and_simulate_start_alike(name, pythonfmu_model_fmus, native_m
 
 
 def test_zero_is_the_relaxed_start_bit_for_bit(native_model_fmus, pythonfmu_model_fmus):
+    # held_force = 0 runs the kernels from initial_state (the relaxed start as it ever was): the
+    # pythonfmu FMU runs them, the C is translated from them and compiled without contraction
+    model, params = get_model("asymmetric_bouc_wen"), defaults("asymmetric_bouc_wen")
+    relaxed = run_kernels(model, params, model.initial_state(model.constants(params), 0.0))
     for fmus in (pythonfmu_model_fmus, native_model_fmus):
-        plain, _ = run_fmu(fmus["asymmetric_bouc_wen"], {})
         zero, _ = run_fmu(fmus["asymmetric_bouc_wen"], {"held_force": 0.0})
-        assert np.array_equal(plain, zero)
+        assert np.array_equal(zero, relaxed)
+
+
+@pytest.mark.parametrize("kind", ["pythonfmu", "native"])
+def test_away_from_zero_the_held_force_adds_to_the_relaxed_force_and_the_preload(kind, pythonfmu_model_fmus,
+                                                                                 native_model_fmus):
+    # the asymmetric element relaxed at x0 gives k0*x0 (its slider centred, D(0) = 0); the FMU
+    # starts at k0*x0 + held + preload, and so do simulate and predict of the same set
+    from identification import predict
+    fmu = (pythonfmu_model_fmus if kind == "pythonfmu" else native_model_fmus)["asymmetric_bouc_wen"]
+    params, x0_mm, held = defaults("asymmetric_bouc_wen"), 0.4, -600.0
+    start = BushingFmu(fmu, start_values={"held_force": held, "preload": PRELOAD_N},
+                       initial_inputs={"x": x0_mm * 1e-3, "v": 0.0})
+    try:
+        expected = params["k0"] * x0_mm + held + PRELOAD_N
+        assert start.get("F") == pytest.approx(expected, rel=1e-12)
+    finally:
+        start.free()
+    path = x0_mm + PATH_MM
+    values = dict(params, held_force=held, preload=PRELOAD_N)
+    forces = simulate(values, t, path, model="asymmetric_bouc_wen")
+    assert forces[0] == pytest.approx(expected, rel=1e-5)     # the dashpot's c0*v aside
+    assert np.array_equal(predict(values, t, path, model="asymmetric_bouc_wen").force_N, forces)
+
+
+def test_the_variable_is_fixed_read_at_the_start(pythonfmu_model_fmus, native_model_fmus):
+    from fmpy import read_model_description
+    for fmus in (pythonfmu_model_fmus, native_model_fmus):
+        variables = {v.name: v for v in read_model_description(str(fmus["single_bouc_wen"])).modelVariables}
+        assert variables["held_force"].variability == "fixed" and variables["held_force"].unit == "N"
+        assert variables["preload"].variability == "tunable"
 
 
 def test_a_coupled_group_refuses_a_held_force():
@@ -116,6 +149,10 @@ def test_a_coupled_group_refuses_a_held_force():
     axes.update({axis: ("single_bouc_wen", single) for axis in ("x", "y")})
     with pytest.raises(ParameterError, match=r"x.held_force = 120.0 \[N\] must be 0 in a coupled group"):
         six_axis_document(axes, coupling="radial")
+    # a group of a model without a coupled form (the asymmetric element) runs its axes alone: accepted
+    asymmetric = dict(defaults("asymmetric_bouc_wen"), held_force=120.0)
+    axes.update({axis: ("asymmetric_bouc_wen", asymmetric) for axis in ("x", "y")})
+    assert six_axis_document(axes, coupling="radial")
 
 
 def test_a_coupled_groups_fmu_refuses_a_held_force_set_at_its_start(tmp_path):

@@ -144,10 +144,13 @@ def test_no_generic_module_names_a_model():
     assert not found, found
 
 
-@pytest.mark.parametrize("name", ["stiffness", "damping", "force", "travel", "power_law"])
-def test_a_subnormal_value_maps_to_a_finite_coordinate(name):
+@pytest.mark.parametrize("name", ["stiffness", "damping", "force", "travel", "power_law", "slower"])
+def test_a_subnormal_value_maps_far_below_the_box_not_to_an_error(name):
     # a slow loop's least-squares start gave Berg's friction 5e-324 N, whose ratio to a scale of
-    # 150 underflows to 0: the coordinate is log10(5e-324) - log10(scale), about -325.5, not an error
+    # 150 underflows to 0: the coordinate is log10(5e-324) - log10(scale), about -325.5 (a time
+    # constant over a stiffness underflows before: -inf), which the box's clip takes to its bound
     c = COORDINATES[name]
     u = c.kind.to_coordinate(c, 5e-324, dict(OTHERS, p=5e-324), Scales)
-    assert math.isfinite(u) and u < -300.0
+    assert u < -300.0
+    if name != "slower":
+        assert math.isfinite(u)
