@@ -194,3 +194,28 @@ def test_a_model_with_options_starts_holding_its_force_in_both_fmus(tmp_path):
         assert held[0] == pytest.approx(relaxed[0] + 150.0, rel=1e-12)
         outputs.append(held)
     assert np.max(np.abs(outputs[0] - outputs[1])) <= 1e-12 * np.max(np.abs(outputs[1]))
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_model_exchange_starts_holding_its_force_in_fmi_2_and_3(version, native_model_fmus, native_model_fmi3_fmus):
+    # the host integrates the states itself: the FMU's start (its states at the exit of
+    # initialization) holds the force; at rest at 0 the output stays at it, stuck
+    from model_exchange import simulate_model_exchange
+    fmu = (native_model_fmus if version == 2 else native_model_fmi3_fmus)["asymmetric_bouc_wen"]
+    run = simulate_model_exchange(fmu, np.linspace(0.0, 0.05, 6), lambda s: 0.0, lambda s: 0.0,
+                                  start_values={"held_force": 700.0})
+    assert np.allclose(run.force_N, 700.0, rtol=1e-12, atol=0.0)
+    # a push from there: the host's CVode on the FMU's derivatives against the co-simulation
+    # FMU's own walk from the same start (two integrations of one model)
+    push = simulate_model_exchange(fmu, np.array([0.0, 0.05]), lambda s: 0.02 * s, lambda s: 0.02,
+                                   start_values={"held_force": 700.0})
+    cosimulation = BushingFmu(native_model_fmus["asymmetric_bouc_wen"], start_values={"held_force": 700.0},
+                              initial_inputs={"x": 0.0, "v": 0.02})
+    try:
+        for k in range(50):
+            assert cosimulation.step(0.02 * k * 1e-3, 0.02, 1e-3) == "ok"
+        walked = cosimulation.get("F")
+    finally:
+        cosimulation.free()
+    assert abs(walked - 700.0) > 100.0       # 1 mm: the element takes up load beyond its start
+    assert push.force_N[-1] == pytest.approx(walked, rel=1e-5)
