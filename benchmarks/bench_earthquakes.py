@@ -10,8 +10,8 @@ finely at these 1-5 Hz motions). Each model is fitted with the default preset to
 ensemble; then simulated on every record at 1024 Hz with ``rest_force_N`` the record's held force
 (``offsets.held_force``) and with none (virgin), and the NRMSE printed, the training records marked;
 with ``--ensemble`` the fit samples its ensemble, and the share of each record's samples inside its
-band (``predict``'s envelope widened by the record's noise level, and by 1.96 times the rms of the best
-set's residual over the training records: what the model demonstrably misses) is printed.
+band (``predict``'s envelope widened by the record's noise level, and ``predict``'s likely band: the
+envelope widened by 1.96 times the fit's rms misfit on its training records) is printed.
 """
 from __future__ import annotations
 
@@ -69,20 +69,22 @@ def main() -> None:
               flush=True)
         if args.ensemble:
             from identification import predict
+            from identification.analysis.predict import MISFIT_WIDENING
             from identification.measured.noise import estimate_noise
             bands = {name: predict(result, m.time_s, m.displacement_mm, m.measured_velocity_mm_s,
                                    rest_force_N=held_force(m)) for name, m in records.items()}
-            # what the model demonstrably misses: the rms of the best set's residual over the training records
-            misfit = float(np.sqrt(np.mean(np.concatenate([(bands[name].force_N - records[name].force_N) ** 2
-                                                           for name in TRAINING]))))
-            for label, widen in (("the noise level", None), (f"1.96 x the training misfit, {misfit:.0f} N rms", misfit)):
-                shares = []
-                for name, m in records.items():
-                    margin = 1.96 * widen if widen is not None else estimate_noise(m.force_N).sigma_N
-                    inside = (m.force_N >= bands[name].lower_N - margin) & (m.force_N <= bands[name].upper_N + margin)
-                    shares.append(f"{name} {np.mean(inside):.1%}")
-                print(f"  its ensemble of {len(result.ensemble)} sets covers the measured force (the band widened by "
-                      f"{label}) at: " + "; ".join(shares), flush=True)
+            envelope, likely = [], []
+            for name, m in records.items():
+                noise = estimate_noise(m.force_N).sigma_N
+                band, force = bands[name], m.force_N
+                inside = (force >= band.lower_N - noise) & (force <= band.upper_N + noise)
+                envelope.append(f"{name} {np.mean(inside):.1%}")
+                inside = (force >= band.likely_lower_N) & (force <= band.likely_upper_N)
+                likely.append(f"{name} {np.mean(inside):.1%}")
+            print(f"  its ensemble of {len(result.ensemble)} sets covers the measured force (the band widened by "
+                  f"the noise level) at: " + "; ".join(envelope), flush=True)
+            print(f"  predict's likely band (the envelope widened by {MISFIT_WIDENING} x the fit's training misfit, "
+                  f"{bands[TRAINING[0]].misfit_N:.0f} N rms) covers it at: " + "; ".join(likely), flush=True)
 
 
 if __name__ == "__main__":

@@ -51,19 +51,37 @@ class Prediction:
     lower_N: np.ndarray              # the envelope of every member (equal to force_N for one set)
     upper_N: np.ndarray
     members: int
+    misfit_N: float = math.nan       # the fit's rms residual over its training tests (NaN: not known)
 
     @property
     def band_width_N(self) -> np.ndarray:
         return self.upper_N - self.lower_N
 
+    @property
+    def likely_lower_N(self) -> np.ndarray:
+        """Where a measurement likely falls, as far as the fit's own records say: the members'
+        envelope widened by ``MISFIT_WIDENING`` times the fit's training misfit (the envelope where
+        that is not known). The envelope alone is the parameters' uncertainty; the misfit is what
+        the model misses even at its best, which on a device it does not describe dominates."""
+        return self.lower_N - (MISFIT_WIDENING * self.misfit_N if self.misfit_N == self.misfit_N else 0.0)
+
+    @property
+    def likely_upper_N(self) -> np.ndarray:
+        """The upper side of :attr:`likely_lower_N`'s band."""
+        return self.upper_N + (MISFIT_WIDENING * self.misfit_N if self.misfit_N == self.misfit_N else 0.0)
+
     def write_csv(self, path: str | Path) -> Path:
-        """``time_s,displacement_mm,force_N`` and, for an ensemble, ``force_min_N,force_max_N``."""
+        """``time_s,displacement_mm,force_N`` and, for an ensemble, ``force_min_N,force_max_N``;
+        where the fit's training misfit is known, ``likely_min_N,likely_max_N``."""
         path = Path(path)
         columns = [self.time_s, self.displacement_mm, self.force_N]
         header = ["time_s", "displacement_mm", "force_N"]
         if self.members > 1:
             columns += [self.lower_N, self.upper_N]
             header += ["force_min_N", "force_max_N"]
+        if self.misfit_N == self.misfit_N:
+            columns += [self.likely_lower_N, self.likely_upper_N]
+            header += ["likely_min_N", "likely_max_N"]
         with open(path, "w", newline="", encoding="utf-8") as stream:
             stream.write(f"# predicted by identification.predict from {self.members} parameter set(s)\n")
             writer = csv.writer(stream)
@@ -110,7 +128,7 @@ def predict(parameters, time_s, displacement_mm, velocity_mm_s=None,
         model=bushing), by_start=True)
     _refuse_failed(forces[0], time_s)
     return Prediction(np.asarray(time_s, dtype=float), x, forces[0], np.nanmin(forces, axis=0),
-                      np.nanmax(forces, axis=0), len(sets))
+                      np.nanmax(forces, axis=0), len(sets), training_misfit_N(parameters))
 
 
 @dataclass
@@ -171,6 +189,32 @@ def predict_multiaxis(parameters, time_s, displacement_mm, coupling: str, veloci
     _refuse_failed(forces[0], t)
     return MultiAxisPrediction(t, x, forces[0], np.nanmin(forces, axis=0), np.nanmax(forces, axis=0), len(sets),
                                coupling)
+
+
+MISFIT_WIDENING = 1.96
+"""Times the fit's rms training misfit a measurement likely falls beyond the members' envelope
+(``Prediction.likely_lower_N``): the 95 % point of a normal residual."""
+
+
+def training_misfit_N(parameters) -> float:
+    """The rms [N] of the fit's residual over every sample of its training time series (each
+    test's ``misfit_N`` weighted by its samples), from a FitResult or a parameter file's record
+    of its fit; NaN where neither says (a set typed by hand, a fit to a data sheet alone)."""
+    from fmu_src.parameter_files import ParameterEnsemble, ParameterSet, read_ensemble
+    from identification.fitting.result import FitResult
+    if isinstance(parameters, FitResult):
+        record = parameters.provenance()
+    elif isinstance(parameters, (ParameterEnsemble, ParameterSet)):
+        record = parameters.provenance
+    elif isinstance(parameters, (str, Path)):
+        record = read_ensemble(parameters).provenance
+    else:
+        return math.nan
+    tests = [t for t in (record or {}).get("tests", []) if "misfit_N" in t and t.get("samples")]
+    if not tests:
+        return math.nan
+    samples = sum(t["samples"] for t in tests)
+    return math.sqrt(sum(t["samples"] * t["misfit_N"] ** 2 for t in tests) / samples)
 
 
 def _mounted_population(bushing: BushingModel, sets, simulate_at, by_start: bool = False) -> np.ndarray:

@@ -295,6 +295,11 @@ def _print_prediction(prediction, written) -> None:
     print(f"{prediction.members} parameter set(s); rms force {np.sqrt(np.mean(np.sum(force ** 2, axis=1))):.1f} N"
           + (f"; band width: mean {np.mean(width):.1f} N, largest {np.max(width):.1f} N" if prediction.members > 1
              else ""))
+    misfit = getattr(prediction, "misfit_N", math.nan)     # a multi-axis prediction has none
+    if misfit == misfit:
+        from identification.analysis.predict import MISFIT_WIDENING
+        print(f"the fit misses its own training tests by {misfit:.1f} N rms: a measurement likely falls within the "
+              f"band widened by {MISFIT_WIDENING * misfit:.1f} N (likely_min_N, likely_max_N)")
     print("wrote " + ", ".join(map(str, written)))
 
 

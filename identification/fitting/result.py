@@ -68,6 +68,12 @@ class RigTestFit:
         return max(self.noise.relative, MIN_NOISE_FRACTION)
 
     @property
+    def misfit_N(self) -> float:
+        """The rms [N] of the fitted set's residual on the test (its NRMSE times its rms force):
+        what the model demonstrably misses on its own training data."""
+        return self.nrmse * self.noise.rms_force_N
+
+    @property
     def repeat_fraction(self) -> float | None:
         """What the device does not repeat, as a fraction of the rms force (None: not a sine, or
         too few steady cycles)."""
@@ -110,7 +116,9 @@ class RigTestFit:
     def as_dict(self) -> dict:
         out = {"file": self.name, "kind": self.kind, "noise_N": round_for_file(self.noise_fraction * self.noise.rms_force_N),
                "noise_fraction": round_for_file(self.noise_fraction), "nrmse": round_for_file(self.nrmse),
-               "nrmse_over_noise": round_for_file(self.noise_ratio)}
+               "nrmse_over_noise": round_for_file(self.noise_ratio), "misfit_N": round_for_file(self.misfit_N)}
+        if self.predicted_N is not None:
+            out["samples"] = int(np.shape(self.predicted_N)[0])
         if self.repeat_fraction is not None:
             out["repeatability_fraction"] = round_for_file(self.repeat_fraction)
         out.update({"floor": self.floor_source, "nrmse_over_floor": round_for_file(self.ratio), "at_floor": self.at_floor})
