@@ -384,10 +384,14 @@ class BushingModel:
         beyond the relaxed force there (its force at rest, v = 0): relaxed (``initial_state``)
         where ``held`` is 0, else the ``resting_state`` of that force. What both FMUs start an
         axis in (the native C calls the same three kernels in this order)."""
-        relaxed = self.initial_state(constants, x0)
         if held == 0.0:
-            return relaxed
-        return self.resting_state(constants, x0, self.force(constants, relaxed, x0, 0.0) + held)
+            return self.initial_state(constants, x0)
+        return self.resting_state(constants, x0, self.relaxed_force(constants, x0) + held)
+
+    def relaxed_force(self, constants, x0: float) -> float:
+        """The force [N or N.mm] at rest (v = 0) at ``x0`` [mm or rad] from the relaxed state there
+        (``initial_state``)."""
+        return self.force(constants, self.initial_state(constants, x0), x0, 0.0)
 
     @property
     def units(self) -> dict[str, str]:
@@ -434,8 +438,7 @@ class BushingModel:
     def force_offset(self, params: Mapping[str, float]) -> float:
         """The constant part of the force [N] (a preload, Spencer's spring offset): the force at
         rest at x = 0 from the relaxed initial state there."""
-        constants = self.constants(params)
-        return self.force(constants, self.initial_state(constants, 0.0), 0.0, 0.0)
+        return self.relaxed_force(self.constants(params), 0.0)
 
     def plausible_force_bound(self, params: Mapping[str, float], travel: float = PLAUSIBLE_TRAVEL_MM,
                               velocity: float = PLAUSIBLE_VELOCITY_MM_S) -> float:

@@ -63,12 +63,16 @@ class Prediction:
         envelope widened by ``MISFIT_WIDENING`` times the fit's training misfit (the envelope where
         that is not known). The envelope alone is the parameters' uncertainty; the misfit is what
         the model misses even at its best, which on a device it does not describe dominates."""
-        return self.lower_N - (MISFIT_WIDENING * self.misfit_N if self.misfit_N == self.misfit_N else 0.0)
+        return self.lower_N - self._likely_margin_N
 
     @property
     def likely_upper_N(self) -> np.ndarray:
         """The upper side of :attr:`likely_lower_N`'s band."""
-        return self.upper_N + (MISFIT_WIDENING * self.misfit_N if self.misfit_N == self.misfit_N else 0.0)
+        return self.upper_N + self._likely_margin_N
+
+    @property
+    def _likely_margin_N(self) -> float:
+        return MISFIT_WIDENING * self.misfit_N if self.misfit_N == self.misfit_N else 0.0
 
     def write_csv(self, path: str | Path) -> Path:
         """``time_s,displacement_mm,force_N`` and, for an ensemble, ``force_min_N,force_max_N``;
@@ -120,6 +124,9 @@ def predict(parameters, time_s, displacement_mm, velocity_mm_s=None,
     IdentificationError
         The best set's simulation fails (overflow), with the time it fails from.
     """
+    if isinstance(parameters, (str, Path)):      # read once: its sets and its fit's record
+        from fmu_src.parameter_files import read_ensemble
+        parameters = read_ensemble(parameters)
     bushing, sets = parameter_sets(parameters, model)
     x = np.asarray(displacement_mm, dtype=float)
     forces = _mounted_population(bushing, sets, lambda matrix, values, offset: simulate_driven(
@@ -202,12 +209,12 @@ def training_misfit_N(parameters) -> float:
     of its fit; NaN where neither says (a set typed by hand, a fit to a data sheet alone)."""
     from fmu_src.parameter_files import ParameterEnsemble, ParameterSet, read_ensemble
     from identification.fitting.result import FitResult
+    if isinstance(parameters, (str, Path)):
+        parameters = read_ensemble(parameters)
     if isinstance(parameters, FitResult):
         record = parameters.provenance()
     elif isinstance(parameters, (ParameterEnsemble, ParameterSet)):
         record = parameters.provenance
-    elif isinstance(parameters, (str, Path)):
-        record = read_ensemble(parameters).provenance
     else:
         return math.nan
     tests = [t for t in (record or {}).get("tests", []) if "misfit_N" in t and t.get("samples")]

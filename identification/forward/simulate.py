@@ -86,8 +86,7 @@ def model_rest_force(bushing: BushingModel, values, x0_mm: float, rest_force_N: 
     held = bushing.held_force(values)
     if held == 0.0:
         return math.nan
-    m = bushing.constants(values)
-    return bushing.force(m, bushing.initial_state(m, x0_mm), x0_mm, 0.0) + held
+    return bushing.relaxed_force(bushing.constants(values), x0_mm) + held
 
 
 def simulate_driven(matrix: np.ndarray, driven: DrivenInput, max_substeps: int | None = None,
