@@ -113,13 +113,13 @@ def friction_damper(out: Path, models, ensemble: bool, held_out: bool = True) ->
 
 
 def voided(out: Path, models, ensemble: bool) -> None:
-    from fmu_src.model.derived import Options
+    from fmu_src.model.options import Options
     from identification.cli.model_options import ModelOptions
     from identification.measured.static_curve import read_static_curve
     prefix = DATA / "synthetic_voided"
     static = load_measurement(f"{prefix}_triangle_4.2mm_0.05Hz.csv")
     curve = read_static_curve(static, count=17)
-    options = ModelOptions(Options(knots=17, maxwell=True, rig=True),
+    options = ModelOptions(Options.parse(["backbone17", "maxwell", "rig"]),
                            {**{k: v for k, v in curve.parameters(pinned_at_zero=True).items()},
                             "rig_displacement_zero": 0.0}, curve)
     tests = training_tests(sine=[f"{prefix}_sine_2mm_5Hz.csv", f"{prefix}_sine_3.5mm_1Hz.csv"],

@@ -11,10 +11,13 @@
 - ``elements``: the elements the models share (free play, the softplus corner, travel limits, the
   monotone cubic, the fluid column's substeps, Berg's friction, the Maxwell element), in the
   kernel language, compiled and translated as ``integration`` is;
-- ``derived``: a model with options any model takes (a measured backbone, travel limits, a
-  Maxwell element, the rig's offsets): their parameters, names, search box, the model;
+- ``options``: the options any model takes, one element per module (a measured backbone, travel
+  limits, a Maxwell element, the rig's offsets; the contract ``options.element``), and the set
+  of them a model has (``Options``);
+- ``derived``: a model composed with options: its parameters, name, states, switches, search
+  box, the model;
 - ``derived_source``: that model's kernel module, written as source (the base's kernels renamed,
-  the options' wrappers);
+  the options' parts put into the wrappers);
 - ``registry``: every model of ``fmu_src.models``, by name and identifier.
 
 May import: nothing of fmu_src but itself (``registry`` finds ``models`` by name, at import).

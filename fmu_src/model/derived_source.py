@@ -18,6 +18,7 @@ import types
 from . import elements, integration
 from .definition import BushingModel, ModelContractError
 from ..syntax_trees import parse
+from .options.element import OptionElement, Slot, tuple_text
 
 KERNELS = ("prepare", "initial_state", "jump", "integrate", "force", "derivatives", "switches")
 """The base's kernels a derived model wraps (``update`` and ``prepare_step`` too, where it has them)."""
@@ -102,14 +103,10 @@ def base_source(base: BushingModel) -> tuple[str, set[str]]:
     return "\n\n\n".join(lines), shared
 
 
-def tuple_text(names) -> str:
-    names = list(names)
-    return "(" + ", ".join(names) + ("," if len(names) == 1 else "") + ")"
-
-
-def _constants(base: BushingModel, options) -> tuple[list[str], dict[str, int]]:
-    """The derived ``prepare``'s parts (expressions of p) and which part each option's constants are."""
-    held = set(base.static_spring) if options.knots else set()
+def _layout(base: BushingModel, options) -> tuple[list[str], list[tuple[OptionElement, int, Slot]]]:
+    """The derived ``prepare``'s parts (expressions of p) and each option element with its count
+    and its slot (its part of the prepared constants, its states after the base's)."""
+    held = set(base.static_spring) if options.replaces_static_spring else set()
     base_values, index = [], 0
     for spec in base.specs:
         if spec.name in held:
@@ -117,127 +114,87 @@ def _constants(base: BushingModel, options) -> tuple[list[str], dict[str, int]]:
         else:
             base_values.append(f"p[{index}]")
             index += 1
-    parts, slot = [f"base_prepare({tuple_text(base_values)})"], {}
-
-    def take(name: str, count: int, wrap: str = "{}"):
-        nonlocal index
-        slot[name] = len(parts)
-        parts.append(wrap.format(tuple_text(f"p[{index + i}]" for i in range(count))))
-        index += count
-    if options.knots:
-        take("backbone", 2 * options.knots, "backbone_prepare({})")
-    if options.limits:
-        take("limits", 11)
-    if options.maxwell:   # (k, rate = k/c)
-        slot["maxwell"] = len(parts)
-        parts.append(f"(p[{index}], p[{index}] / p[{index + 1}])")
-        index += 2
-    if options.rig:
-        take("rig", 2)
-    return parts, slot
+    parts, placed, state_index = [f"base_prepare({tuple_text(base_values)})"], [], len(base.states)
+    for element, count in options.elements:
+        size = len(element.specs(count))
+        states = tuple(f"state[{state_index + i}]" for i in range(len(element.states)))
+        state_index += len(states)
+        placed.append((element, count, Slot(f"m[{len(parts)}]", states)))
+        parts.append(element.prepare(tuple(f"p[{index + i}]" for i in range(size))))
+        index += size
+    return parts, placed
 
 
 def wrapper_source(base: BushingModel, options) -> tuple[str, set[str]]:
     """The derived model's kernels, delegating to the renamed base's (module docstring); and the
-    shared names they import. A Maxwell element's force is the state's last entry."""
-    parts, slot = _constants(base, options)
-    zero = f" - m[{slot['rig']}][0]" if options.rig else ""
+    shared names they import. The option elements' states follow the base's."""
+    parts, placed = _layout(base, options)
+    zero = "".join(f" - {element.displacement_zero(slot)}" for element, _, slot in placed
+                   if element.displacement_zero is not None)
     u = "x" + zero
     n = len(base.states)
-    mx = slot.get("maxwell")
-    own = tuple_text(f"state[{i}]" for i in range(n)) if mx is not None else "state"    # the base's state
-    out = (lambda name: tuple_text([f"{name}[{i}]" for i in range(n)] + ["{}"])) if mx is not None else None
+    stateful = [(element, slot) for element, _, slot in placed if slot.states]
+    own = tuple_text(f"state[{i}]" for i in range(n)) if stateful else "state"    # the base's state
+
+    def out(name: str, extra) -> str:
+        return tuple_text([f"{name}[{i}]" for i in range(n)] + list(extra))
+
+    def each(hook) -> list[str]:
+        return [text for element, slot in stateful for text in hook(element)(slot)]
     source = [f"def prepare(p):\n    return {tuple_text(parts)}\n"]
     if "prepare_step" in vars(sys.modules[base.kernel_module]):
         source.append(f"def prepare_step(m, h):\n    return {tuple_text(['base_prepare_step(m[0], h)'] + [f'm[{i}]' for i in range(1, len(parts))])}\n")
-    if mx is None:
+    if not stateful:
         source += [f"def initial_state(m, x0):\n    return base_initial_state(m[0], x0{zero})\n",
                    "def jump(m, state, jump_mm):\n    return base_jump(m[0], state, jump_mm)\n",
                    f"def integrate(m, state, x, v, h, max_substeps):\n"
                    f"    return base_integrate(m[0], state, {u}, v, h, max_substeps)\n",
                    f"def derivatives(m, state, x, v):\n    return base_derivatives(m[0], state, {u}, v)\n"]
     else:
-        f = f"state[{n}]"
+        steps = [element.step(slot) for element, slot in stateful]
+        lines = "".join(f"    {line}\n" for step in steps for line in step.lines)
+        values = [value for step in steps for value in step.values]
+        finite = " or ".join(f"not math.isfinite({value})" for value in values)
+        finite = f"({finite})" if len(values) > 1 else finite
         source += [
-            f"def initial_state(m, x0):\n    s = base_initial_state(m[0], x0{zero})\n    return {out('s').format('0.0')}\n",
+            f"def initial_state(m, x0):\n    s = base_initial_state(m[0], x0{zero})\n"
+            f"    return {out('s', each(lambda e: e.initial))}\n",
             f"def jump(m, state, jump_mm):\n    s, status = base_jump(m[0], {own}, jump_mm)\n"
-            f"    return {out('s').format(f'{f} + m[{mx}][0] * jump_mm')}, status\n",
+            f"    return {out('s', each(lambda e: e.jump))}, status\n",
             f"def integrate(m, state, x, v, h, max_substeps):\n"
-            f"    s, used, status = base_integrate(m[0], {own}, {u}, v, h, max_substeps)\n"
-            f"    f = maxwell_step({f}, m[{mx}][0], maxwell_decay(m[{mx}][1], h), v, h)\n"
-            f"    if status == OK and not math.isfinite(f):\n        status = NOT_FINITE\n"
-            f"    return {out('s').format('f')}, used, status\n",
+            f"    s, used, status = base_integrate(m[0], {own}, {u}, v, h, max_substeps)\n{lines}"
+            f"    if status == OK and {finite}:\n        status = NOT_FINITE\n"
+            f"    return {out('s', values)}, used, status\n",
             f"def derivatives(m, state, x, v):\n    d = base_derivatives(m[0], {own}, {u}, v)\n"
-            f"    return {out('d').format(f'm[{mx}][0] * v - m[{mx}][1] * {f}')}\n"]
+            f"    return {out('d', each(lambda e: e.derivatives))}\n"]
     force = [f"    u = {u}", f"    f = base_force(m[0], {own}, u, v)"]
-    force += [f"    f = f + backbone_force(m[{slot['backbone']}], u)"] if options.knots else []
-    force += [f"    f = f + limits_force(m[{slot['limits']}], u, v)"] if options.limits else []
-    force += [f"    f = f + state[{n}]"] if mx is not None else []
-    force += [f"    f = f + m[{slot['rig']}][1]"] if options.rig else []
+    force += [f"    f = f + {element.force(slot)}" for element, _, slot in placed if element.force is not None]
     source.append("def force(m, state, x, v):\n" + "\n".join(force) + "\n    return f\n")
     if base.resting_state is not None:
-        # the options' forces at rest (a Maxwell element holds none) taken off what the base holds
+        # the options' forces at rest taken off what the base holds; their states start as they start
         rest = [f"    u = x0{zero}", "    f = force"]
-        rest += [f"    f = f - backbone_force(m[{slot['backbone']}], u)"] if options.knots else []
-        rest += [f"    f = f - limits_force(m[{slot['limits']}], u, 0.0)"] if options.limits else []
-        rest += [f"    f = f - m[{slot['rig']}][1]"] if options.rig else []
+        rest += [f"    f = f - {element.rest_force(slot)}" for element, _, slot in placed
+                 if element.rest_force is not None]
         held = "base_resting_state(m[0], u, f)"
-        rest += [f"    return {held}"] if mx is None else [f"    s = {held}", f"    return {out('s').format('0.0')}"]
+        rest += [f"    return {held}"] if not stateful else [f"    s = {held}",
+                                                              f"    return {out('s', each(lambda e: e.initial))}"]
         source.append("def resting_state(m, x0, force):\n" + "\n".join(rest) + "\n")
     switches = [f"s[{i}]" for i in range(len(base.switch_specs))]
-    if options.limits:
-        switches += [f"u - m[{slot['limits']}][0]", f"u + m[{slot['limits']}][5]"]
+    switches += [text for element, _, slot in placed for text in element.switch_values(slot)]
     body = f"    u = {u}\n" + (f"    s = base_switches(m[0], {own}, u, v)\n" if base.switch_specs else "")
     source.append("def switches(m, state, x, v):\n" + body + f"    return {tuple_text(switches) if switches else '()'}\n")
     if base.update is not None:
         update = f"base_update(m[0], {own}, {u}, v)"
-        source.append(f"def update(m, state, x, v):\n    return {update}\n" if mx is None else
-                      f"def update(m, state, x, v):\n    s = {update}\n    return {out('s').format(f'state[{n}]')}\n")
-    shared = {"OK", "NOT_FINITE", "maxwell_step", "maxwell_decay"} if mx is not None else set()
-    if options.knots:
-        source.append(backbone_source(options.knots))
-        shared |= {"pchip_slope", "pchip_end_slope", "hermite"}
-    if options.limits:
-        source.append(LIMITS_SOURCE)
-        shared.add("limit_force")
+        source.append(f"def update(m, state, x, v):\n    return {update}\n" if not stateful else
+                      f"def update(m, state, x, v):\n    s = {update}\n"
+                      f"    return {out('s', [state for _, slot in stateful for state in slot.states])}\n")
+    shared = {"OK", "NOT_FINITE"} if stateful else set()
+    for element, count, _ in placed:
+        shared |= element.shared
+        helpers = element.helpers(count)
+        if helpers:
+            source.append(helpers)
     return "\n\n".join(source), shared
-
-
-LIMITS_SOURCE = '''def limits_force(c, u, v):
-    """Both travel limits' force [N] at u [mm], v [mm/s]; c = (gap, k, exponent, damping, depth)
-    of the positive side, then of the negative, then the width."""
-    gp, kp, ep, cp, dp, gn, kn, en, cn, dn, width = c
-    return limit_force(u, v, gp, kp, ep, cp, dp, width) - limit_force(-u, -v, gn, kn, en, cn, dn, width)
-'''
-
-
-def backbone_source(knots: int) -> str:
-    """``backbone_prepare(q)`` (the knots and forces -> the knots, forces and the monotone cubic's
-    slopes) and ``backbone_force(b, u)`` for ``knots`` knots, written out."""
-    k = knots
-    xs = [f"x{i}" for i in range(k)]
-    fs = [f"f{i}" for i in range(k)]
-    ds = [f"d{i}" for i in range(k)]
-    lines = ["def backbone_prepare(q):", f"    {', '.join(xs + fs)} = q"]
-    for i in range(k - 1):
-        lines.append(f"    h{i} = x{i + 1} - x{i}")
-        lines.append(f"    s{i} = (f{i + 1} - f{i}) / h{i}")
-    if k == 2:
-        lines += ["    d0 = s0", "    d1 = s0"]
-    else:
-        lines.append("    d0 = pchip_end_slope(h0, h1, s0, s1)")
-        for i in range(1, k - 1):
-            lines.append(f"    d{i} = pchip_slope(h{i - 1}, h{i}, s{i - 1}, s{i})")
-        lines.append(f"    d{k - 1} = pchip_end_slope(h{k - 2}, h{k - 3}, s{k - 2}, s{k - 3})")
-    lines.append(f"    return {tuple_text(xs + fs + ds)}")
-    prepare = "\n".join(lines) + "\n"
-    lines = ["def backbone_force(b, u):", f"    {', '.join(xs + fs + ds)} = b",
-             "    if u <= x0:", "        return f0 + d0 * (u - x0)"]
-    for i in range(k - 1):
-        lines += [f"    if u <= x{i + 1}:",
-                  f"        return hermite(u, x{i}, x{i + 1}, f{i}, f{i + 1}, d{i}, d{i + 1})"]
-    lines.append(f"    return f{k - 1} + d{k - 1} * (u - x{k - 1})")
-    return prepare + "\n\n" + "\n".join(lines) + "\n"
 
 
 def derived_source(base: BushingModel, options) -> str:

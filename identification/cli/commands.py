@@ -397,7 +397,7 @@ def fit_many_command(args) -> int:
 
 
 def compare_command(args) -> int:
-    from fmu_src.model.derived import Options
+    from fmu_src.model.options import Options
     from identification.analysis.compare import compare_models
     from identification.analysis.first_contact import first_contact
     if args.multiaxis:

@@ -21,7 +21,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
-from fmu_src.model.derived import Options, derive
+from fmu_src.model.derived import derive
+from fmu_src.model.options import Options
+from fmu_src.model.options.backbone import BACKBONE
+from fmu_src.model.options.rig import RIG
 from fmu_src.model.parameter_specs import ParameterError
 from fmu_src.model.registry import get_model
 from identification.errors import UsageError
@@ -47,12 +50,10 @@ class ModelOptions:
         bushing = get_model(name)
         base = bushing.base if bushing.base is not None else bushing
         present = bushing.options or Options()
-        knots = self.options.knots or present.knots
-        if self.options.knots and present.knots and self.options.knots != present.knots:
-            raise UsageError(f"{bushing.name} has a backbone of {present.knots} knots, the options one of "
-                             f"{self.options.knots}: give one")
-        merged = Options(knots, present.limits or self.options.limits, present.rig or self.options.rig,
-                         present.maxwell or self.options.maxwell)
+        try:
+            merged = present.union(self.options)
+        except ParameterError as error:
+            raise UsageError(f"{bushing.name} and the options ({', '.join(self.options.tokens)}): {error}") from None
         return derive(base, merged)
 
     def fixed_for(self, bushing) -> dict[str, float]:
@@ -93,21 +94,21 @@ def build_model_options(options: Options, fixed: dict, static=None, knots=None) 
     fixed = dict(fixed)
     curve = static_test = None
     if static is not None:
-        curve = read_static_curve(static, knots, len(knots) if knots is not None else options.knots or DEFAULT_KNOTS)
+        curve = read_static_curve(static, knots, len(knots) if knots is not None else options.count(BACKBONE) or DEFAULT_KNOTS)
         knots = list(curve.knots_mm)
         static_test = RigTest(static)
     if knots is not None:
         if len(knots) < 2 or any(b <= a for a, b in zip(knots, knots[1:])):
             raise UsageError(f"--backbone-knots {','.join(f'{k:g}' for k in knots)}: give 2 or more knot positions "
                              "[mm], increasing")
-        if options.knots and options.knots != len(knots):
-            raise UsageError(f"--options backbone{options.knots} and {len(knots)} backbone knots: give one count")
+        if options.count(BACKBONE) and options.count(BACKBONE) != len(knots):
+            raise UsageError(f"--options backbone{options.count(BACKBONE)} and {len(knots)} backbone knots: give one count")
         options = replace(options, knots=len(knots))
         fixed.update({f"backbone_x{i + 1}": float(k) for i, k in enumerate(knots)})
     if curve is not None:
-        forces = curve.parameters(pinned_at_zero=options.rig)
+        forces = curve.parameters(pinned_at_zero=RIG in options)
         fixed.update({name: value for name, value in forces.items() if name.startswith("backbone_F")})
-        if options.rig:     # the static test's displacement is the backbone's: its zero is the model's
+        if RIG in options:     # the static test's displacement is the backbone's: its zero is the model's
             fixed.setdefault("rig_displacement_zero", 0.0)
     return ModelOptions(options, fixed, curve, static_test)
 

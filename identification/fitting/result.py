@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING, Sequence
 import numpy as np
 
 from fmu_src.model.derived import derive
+from fmu_src.model.options.rig import RIG
 from fmu_src.parameter_files import ParameterSet, save_ensemble, save_parameters
 from identification.errors import FitNotConvergedWarning, IdentificationError  # noqa: F401  (also imported from here)
 from identification.interrupt import deferred, writing
@@ -424,7 +425,7 @@ class FitResult(FittedParameters):
         region's half width, or nan where the ensemble was not sampled, unit)} of a model with the
         ``rig`` option, but those the fit held; empty otherwise."""
         options = self.parameters.model.options
-        if options is None or not options.rig:
+        if options is None or RIG not in options:
             return {}
         held = {name for name, _ in self.space.fixed} if self.space is not None else set()
         out = {}
@@ -442,9 +443,9 @@ class FitResult(FittedParameters):
         offsets without them (they are the test rig's, not the bushing's), or with them as its
         mounting's ``offset`` and ``preload`` where ``into_fmu``; any other model as it is."""
         model = self.parameters.model
-        if model.options is None or not model.options.rig:
+        if model.options is None or RIG not in model.options:
             return model, [dict(member) for member in members]
-        bushing = derive(model.base, model.options.without_rig())
+        bushing = derive(model.base, model.options.without(RIG))
         mounting = {spec.name for spec in bushing.mounting_specs}
         sets = []
         for member in members:
@@ -495,7 +496,7 @@ class FitResult(FittedParameters):
             raise IdentificationError(f"no ensemble to write to {ensemble}: this fit ran with ensemble=False "
                                       "(--no-ensemble); fit again without it for the ensemble")
         provenance = dict(self.provenance(), data=[str(d) for d in data])
-        if self.parameters.model.options is not None and self.parameters.model.options.rig:
+        if self.parameters.model.options is not None and RIG in self.parameters.model.options:
             provenance["rig_offsets_in_fmu"] = bool(rig_into_fmu)
         model, (best, *_) = self.for_fmu([self.parameters.parameters], rig_into_fmu)
         # each file whole or not at all, and a Ctrl-C or SIGTERM held until the set is written

@@ -36,6 +36,7 @@ from scipy.optimize import lsq_linear
 
 from fmu_src.model.registry import BushingModel, DEFAULT_MODEL, MODELS, resolve_model
 from fmu_src.model.definition import SearchCoordinate
+from fmu_src.model.options.rig import RIG
 from fmu_src.model.search_coordinates import evaluation_order
 from identification.errors import IdentificationError
 from identification.measured.measurements import Measurement
@@ -74,7 +75,7 @@ class KelvinVoigtFit:
 def _rig_zeros(measurements, steps, model: BushingModel, fixed: dict) -> tuple[float, float]:
     """(x_zero [mm], F_zero [N]): where the records are centred (``offsets.rig_zeros``), for a model
     with the rig's offsets (a held displacement zero is its own centre); (0, 0) for any other."""
-    if model.options is None or not model.options.rig:
+    if model.options is None or RIG not in model.options:
         return 0.0, 0.0
     from identification.measured.offsets import record_offsets, rig_zeros
     x_zero, F_zero = rig_zeros([record_offsets(m) for m in measurements], steps)

@@ -12,7 +12,8 @@ import pytest
 from scipy.interpolate import PchipInterpolator
 
 from conftest import DATA
-from fmu_src.model.derived import Options, split_name
+from fmu_src.model.derived import split_name
+from fmu_src.model.options import Options
 from fmu_src.model.parameter_specs import ParameterError
 from fmu_src.model.registry import MODELS, get_model
 from fmu_src.parameter_files import read_parameter_set, save_parameters
@@ -33,11 +34,11 @@ def test_a_derived_model_is_named_by_its_base_and_options_either_way():
     assert model.name == "proposed+limits+rig" and model.identifier == "BoucWenBushing_Limits_Rig"
     assert get_model("BoucWenBushing_Limits_Rig") is model
     assert get_model("hydraulic_free_decoupler+backbone7").identifier == "HydraulicFreeDecoupler_Backbone7"
-    assert split_name("HydraulicFreeDecoupler_Backbone7") == ("HydraulicFreeDecoupler", Options(knots=7))
-    assert model.base is MODELS["proposed"] and model.options == Options(limits=True, rig=True)
+    assert split_name("HydraulicFreeDecoupler_Backbone7") == ("HydraulicFreeDecoupler", Options.parse(["backbone7"]))
+    assert model.base is MODELS["proposed"] and model.options == Options.parse(["rig", "limits"])
     with pytest.raises(ParameterError, match="unknown model option 'stops'.*limits"):
         get_model("proposed+stops")
-    with pytest.raises(ParameterError, match="1 knots: give 2 to 32"):
+    with pytest.raises(ParameterError, match="backbone1: the count must be 2 to 32"):
         get_model("proposed+backbone1")
 
 

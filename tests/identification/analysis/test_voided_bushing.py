@@ -44,13 +44,13 @@ def test_the_static_curve_read_off_the_triangle_is_the_truths():
 @pytest.mark.slow
 @pytest.mark.optimizer
 def test_compare_recommends_a_model_that_predicts_the_held_out_tests_within_two_percent(tmp_path):
-    from fmu_src.model.derived import Options
+    from fmu_src.model.options import Options
     from identification.analysis.compare import compare_models
     from identification.cli.model_options import ModelOptions
     from identification.measured.rig_tests import training_tests
     from identification.measured.static_curve import read_static_curve
     curve = read_static_curve(load_measurement(f"{PREFIX}_triangle_4.2mm_0.05Hz.csv"), count=17)
-    options = ModelOptions(Options(knots=17, maxwell=True, rig=True),
+    options = ModelOptions(Options.parse(["backbone17", "maxwell", "rig"]),
                            {**curve.parameters(pinned_at_zero=True), "rig_displacement_zero": 0.0}, curve)
     tests = training_tests(sine=[f"{PREFIX}_sine_2mm_5Hz.csv", f"{PREFIX}_sine_3.5mm_1Hz.csv"],
                            random=[f"{PREFIX}_triangle_4.2mm_0.05Hz.csv"])
