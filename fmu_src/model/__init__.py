@@ -12,7 +12,7 @@
   monotone cubic, the fluid column's substeps, Berg's friction, the Maxwell element), in the
   kernel language, compiled and translated as ``integration`` is;
 - ``options``: the options any model takes, one element per module (a measured backbone, travel
-  limits, a Maxwell element, the rig's offsets; the contract ``options.element``), and the set
+  limits, a Maxwell element, an Iwan element, the rig's offsets; the contract ``options.element``), and the set
   of them a model has (``Options``);
 - ``derived``: a model composed with options: its parameters, name, states, switches, search
   box, the model;

@@ -131,7 +131,10 @@ def derive(base: BushingModel, options: Options) -> BushingModel:
         constraints += element.constraints(count)
         switch_specs += tuple(StateSpec(s.name, len(switch_specs) + i, s.unit, s.description)
                               for i, s in enumerate(element.switches))
-        states += tuple(StateSpec(s.name, len(states) + i, s.unit, s.description) for i, s in enumerate(element.states))
+        own = element.states(count)
+        if own and element.step is None:
+            raise ModelContractError(f"the {element.token} option has states but no step")
+        states += tuple(StateSpec(s.name, len(states) + i, s.unit, s.description) for i, s in enumerate(own))
     title = f"{base.title} with " + ", ".join(element.word for element, _ in options.elements)
     model = BushingModel(
         name, derived_identifier(base, options), title, specs, states, base.default_file,

@@ -117,7 +117,7 @@ def _layout(base: BushingModel, options) -> tuple[list[str], list[tuple[OptionEl
     parts, placed, state_index = [f"base_prepare({tuple_text(base_values)})"], [], len(base.states)
     for element, count in options.elements:
         size = len(element.specs(count))
-        states = tuple(f"state[{state_index + i}]" for i in range(len(element.states)))
+        states = tuple(f"state[{state_index + i}]" for i in range(len(element.states(count))))
         state_index += len(states)
         placed.append((element, count, Slot(f"m[{len(parts)}]", states)))
         parts.append(element.prepare(tuple(f"p[{index + i}]" for i in range(size))))

@@ -2,12 +2,13 @@
 
 Each module here defines one option element (``element.OptionElement``) as ``ELEMENT``:
 ``backbone`` (a measured static curve), ``limits`` (travel limits), ``maxwell`` (a parallel
-Maxwell element), ``rig`` (a measured test's displacement and load-cell zeros). The table
+Maxwell element), ``iwan`` (distributed slip: spring-sliders in parallel), ``rig`` (a measured
+test's displacement and load-cell zeros). The table
 (``ELEMENTS``) is discovered from the modules, in each element's ``order``: a new element is its
 module, its independent reference and its tests, and touches no other element's file.
 
 ``Options`` is which elements a derived model has (and the counts of those counted), named by
-their tokens in one order: ``backbone9``, ``limits``, ``maxwell``, ``rig``.
+their tokens in one order: ``backbone9``, ``limits``, ``maxwell``, ``iwan4``, ``rig``.
 """
 from __future__ import annotations
 
@@ -84,7 +85,7 @@ class Options:
 
     @property
     def tokens(self) -> tuple[str, ...]:
-        """The options' names in their one order (``backbone9``, ``limits``, ``maxwell``, ``rig``)."""
+        """The options' names in their one order (``backbone9``, ``limits``, ``maxwell``, ``iwan4``, ``rig``)."""
         return tuple(f"{token}{count}" if ELEMENTS[token].counted else token for token, count in self.chosen)
 
     def __bool__(self) -> bool:
@@ -110,7 +111,7 @@ class Options:
 
     @classmethod
     def parse(cls, tokens) -> "Options":
-        """From option names (``backbone5``, ``limits``, ``maxwell``, ``rig``; any order, any case)."""
+        """From option names (``backbone5``, ``limits``, ``iwan4``, ``rig`` ...; any order, any case)."""
         chosen = []
         for token in tokens:
             found = _token_of(token.strip().lower())

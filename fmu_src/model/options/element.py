@@ -89,7 +89,8 @@ class OptionElement:
     """Text of the force [N] it adds at (u, v, its states); None: none."""
     rest_force: Callable[[Slot], str] | None = None
     """Text of the force [N] it holds at rest at u (its states as they start); None: none."""
-    states: tuple[ElementState, ...] = ()
+    states: Callable[[int], tuple[ElementState, ...]] = lambda count: ()
+    """Its states for its count (after the base's and the earlier elements'); with any, ``step``."""
     initial: Callable[[Slot], tuple[str, ...]] = lambda slot: tuple("0.0" for _ in slot.states)
     jump: Callable[[Slot], tuple[str, ...]] = lambda slot: slot.states
     step: Callable[[Slot], Step] | None = None
@@ -100,7 +101,3 @@ class OptionElement:
     """What a fit holds of it unless told otherwise (``fit(fixed=...)``)."""
     neutral: tuple[tuple[str, float], ...] = ()
     """Its values that leave the base's force as it is (a slow loop's friction alone)."""
-
-    def __post_init__(self):
-        if self.states and self.step is None:
-            raise TypeError(f"the {self.token} element has states but no step")

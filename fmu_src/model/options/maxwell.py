@@ -32,7 +32,7 @@ ELEMENT = OptionElement(
     prepare=lambda p: f"({p[0]}, {p[0]} / {p[1]})",
     shared=frozenset({"maxwell_step", "maxwell_decay"}),
     force=lambda slot: slot.states[0],
-    states=(ElementState("maxwell_f", "N", "the parallel Maxwell element's force"),),
+    states=lambda count: (ElementState("maxwell_f", "N", "the parallel Maxwell element's force"),),
     jump=lambda slot: (f"{slot.states[0]} + {slot.m}[0] * jump_mm",),
     step=lambda slot: Step((f"f = maxwell_step({slot.states[0]}, {slot.m}[0], maxwell_decay({slot.m}[1], h), v, h)",),
                            ("f",)),

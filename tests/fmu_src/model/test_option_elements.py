@@ -21,13 +21,13 @@ from fmu_src.model.search_coordinates import KIND
 from python_core import simulate_python_core
 
 
-def test_the_table_holds_the_four_options_in_their_order():
-    assert list(option_table.ELEMENTS) == ["backbone", "limits", "maxwell", "rig"]
+def test_the_table_holds_the_options_in_their_order():
+    assert list(option_table.ELEMENTS) == ["backbone", "limits", "maxwell", "iwan", "rig"]
     assert Options.parse(["Rig", "maxwell", "backbone5", "LIMITS"]).tokens == ("backbone5", "limits", "maxwell", "rig")
 
 
 def test_every_option_round_trips_through_a_name_and_an_identifier():
-    for token in ("backbone3", "limits", "maxwell", "rig"):
+    for token in ("backbone3", "limits", "maxwell", "iwan2", "rig"):
         model = get_model(f"berg+{token}")
         assert get_model(model.identifier) is model
         assert split_name(model.identifier) == (get_model("berg").identifier, Options.parse([token]))
@@ -35,7 +35,7 @@ def test_every_option_round_trips_through_a_name_and_an_identifier():
 
 def test_bad_options_are_refused_with_what_is_allowed():
     with pytest.raises(ParameterError, match=r"unknown model option 'stops'; the options are backbone<K> .*, "
-                                             r"limits, maxwell and rig"):
+                                             r"limits, maxwell, iwan<N> .* and rig"):
         Options.parse(["stops"])
     with pytest.raises(ParameterError, match="backbone40: the count must be 2 to 32"):
         Options.parse(["backbone40"])
@@ -72,7 +72,7 @@ JENKINS = OptionElement(
     coordinates=lambda count: (SearchCoordinate("jenkins_k", KIND.stiffness, -4.0, 1.0),),
     helpers=lambda count: JENKINS_SOURCE,
     force=lambda slot: slot.states[0],
-    states=(ElementState("jenkins_f", "N", "the Jenkins element's force"),),
+    states=lambda count: (ElementState("jenkins_f", "N", "the Jenkins element's force"),),
     jump=lambda slot: (f"jenkins_step({slot.states[0]}, {slot.m}[0], {slot.m}[1], jump_mm)",),
     step=lambda slot: Step((f"g = jenkins_step({slot.states[0]}, {slot.m}[0], {slot.m}[1], v * h)",), ("g",)),
     derivatives=lambda slot: (f"jenkins_rate({slot.states[0]}, {slot.m}[0], {slot.m}[1], v)",),
