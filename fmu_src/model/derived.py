@@ -2,10 +2,10 @@
 
 A derived model is named ``<base>+<option>[+<option>...]``, its FMI identifier the base's with the
 options appended (``proposed+limits`` -> ``BoucWenBushing_Limits``). Each option is an element
-defined once in its module of ``fmu_src.model.options`` (the contract: ``options.element``):
-``backbone<K>`` (a measured static curve that replaces the base's static spring), ``limits``
-(travel limits), ``maxwell`` (a parallel Maxwell element with a state of its own), ``rig`` (a
-measured test's displacement and load-cell zeros, which a fit estimates and an FMU takes as its
+defined once in its module of ``fmu_src.model.options`` (the contract: ``options.element``; the
+table: ``options.ELEMENTS``), such as ``backbone<K>`` (a measured static curve that replaces the
+base's static spring), ``maxwell`` (a parallel Maxwell element with a state of its own) or ``rig``
+(a measured test's displacement and load-cell zeros, which a fit estimates and an FMU takes as its
 mounting's ``offset`` and ``preload``).
 
 Every option works on the base's displacement u = x - the displacement zero (x where no option

@@ -156,8 +156,12 @@ def wrapper_source(base: BushingModel, options) -> tuple[str, set[str]]:
         values = [value for step in steps for value in step.values]
         finite = " or ".join(f"not math.isfinite({value})" for value in values)
         finite = f"({finite})" if len(values) > 1 else finite
+        # a base without states gives nothing to start or to integrate: its calls would be dead
+        # code, and the C translation refuses an unused function
+        start = f"    s = base_initial_state(m[0], x0{zero})\n" if n else ""
+        rates = f"    d = base_derivatives(m[0], {own}, {u}, v)\n" if n else ""
         source += [
-            f"def initial_state(m, x0):\n    s = base_initial_state(m[0], x0{zero})\n"
+            f"def initial_state(m, x0):\n{start}"
             f"    return {out('s', each(lambda e: e.initial))}\n",
             f"def jump(m, state, jump_mm):\n    s, status = base_jump(m[0], {own}, jump_mm)\n"
             f"    return {out('s', each(lambda e: e.jump))}, status\n",
@@ -165,7 +169,7 @@ def wrapper_source(base: BushingModel, options) -> tuple[str, set[str]]:
             f"    s, used, status = base_integrate(m[0], {own}, {u}, v, h, max_substeps)\n{lines}"
             f"    if status == OK and {finite}:\n        status = NOT_FINITE\n"
             f"    return {out('s', values)}, used, status\n",
-            f"def derivatives(m, state, x, v):\n    d = base_derivatives(m[0], {own}, {u}, v)\n"
+            f"def derivatives(m, state, x, v):\n{rates}"
             f"    return {out('d', each(lambda e: e.derivatives))}\n"]
     force = [f"    u = {u}", f"    f = base_force(m[0], {own}, u, v)"]
     force += [f"    f = f + {element.force(slot)}" for element, _, slot in placed if element.force is not None]
@@ -183,11 +187,14 @@ def wrapper_source(base: BushingModel, options) -> tuple[str, set[str]]:
     switches += [text for element, _, slot in placed for text in element.switch_values(slot)]
     body = f"    u = {u}\n" + (f"    s = base_switches(m[0], {own}, u, v)\n" if base.switch_specs else "")
     source.append("def switches(m, state, x, v):\n" + body + f"    return {tuple_text(switches) if switches else '()'}\n")
-    if base.update is not None:
-        update = f"base_update(m[0], {own}, {u}, v)"
+    updating = any(element.update is not None for element, _ in stateful)
+    if base.update is not None or updating:
+        update = f"base_update(m[0], {own}, {u}, v)" if base.update is not None else own
+        updated = [text for element, slot in stateful
+                   for text in (element.update(slot) if element.update is not None else slot.states)]
         source.append(f"def update(m, state, x, v):\n    return {update}\n" if not stateful else
                       f"def update(m, state, x, v):\n    s = {update}\n"
-                      f"    return {out('s', [state for _, slot in stateful for state in slot.states])}\n")
+                      f"    return {out('s', updated)}\n")
     shared = {"OK", "NOT_FINITE"} if stateful else set()
     for element, count, _ in placed:
         shared |= element.shared

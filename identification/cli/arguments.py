@@ -350,7 +350,8 @@ def _add_model_option_arguments(parser) -> None:
     group.add_argument("--options", metavar="LIST",
                        help="options every model gets, comma-separated: backbone<K> (a static curve of K knots), "
                             "limits (a travel limit each side), maxwell (a Maxwell element in parallel), iwan<N> (N "
-                            "spring-sliders in parallel: distributed slip), rig (the "
+                            "spring-sliders in parallel: distributed slip), band (a band brake's self-energizing "
+                            "friction through a play with a progressive contact), rig (the "
                             "rig's displacement and load-cell zeros, fitted and kept out of the FMU); none: no "
                             "option (compare, given no --options, assumes the ones its training tests show and says "
                             "which and why; named options, or none, turn that off)")

@@ -2,13 +2,14 @@
 
 Each module here defines one option element (``element.OptionElement``) as ``ELEMENT``:
 ``backbone`` (a measured static curve), ``limits`` (travel limits), ``maxwell`` (a parallel
-Maxwell element), ``iwan`` (distributed slip: spring-sliders in parallel), ``rig`` (a measured
+Maxwell element), ``iwan`` (distributed slip: spring-sliders in parallel), ``band`` (a band brake's
+self-energizing friction through its play), ``rig`` (a measured
 test's displacement and load-cell zeros). The table
 (``ELEMENTS``) is discovered from the modules, in each element's ``order``: a new element is its
 module, its independent reference and its tests, and touches no other element's file.
 
 ``Options`` is which elements a derived model has (and the counts of those counted), named by
-their tokens in one order: ``backbone9``, ``limits``, ``maxwell``, ``iwan4``, ``rig``.
+their tokens in one order: ``backbone9``, ``limits``, ``maxwell``, ``iwan4``, ``band``, ``rig``.
 """
 from __future__ import annotations
 

@@ -95,6 +95,9 @@ class OptionElement:
     jump: Callable[[Slot], tuple[str, ...]] = lambda slot: slot.states
     step: Callable[[Slot], Step] | None = None
     derivatives: Callable[[Slot], tuple[str, ...]] = _no_text
+    update: Callable[[Slot], tuple[str, ...]] | None = None
+    """Its states after an event of model exchange (a switch crossed: ``v``, ``x`` at hand), one
+    text per state; None: they do not change there."""
     switches: tuple[ElementState, ...] = ()
     switch_values: Callable[[Slot], tuple[str, ...]] = _no_text
     held: tuple[tuple[str, float], ...] = ()
