@@ -130,7 +130,7 @@ def derive(base: BushingModel, options: Options) -> BushingModel:
     for element, count in options.elements:
         constraints += element.constraints(count)
         switch_specs += tuple(StateSpec(s.name, len(switch_specs) + i, s.unit, s.description)
-                              for i, s in enumerate(element.switches))
+                              for i, s in enumerate(element.switches(count)))
         own = element.states(count)
         if own and element.step is None:
             raise ModelContractError(f"the {element.token} option has states but no step")

@@ -260,9 +260,10 @@ ELEMENT = OptionElement(
     update=_update,
     derivatives=lambda slot: (f"band_rate({slot.m}, {', '.join(slot.states)}, v)",
                               f"band_travel_rate({slot.m}, {slot.states[0]}, v)", "0.0"),
-    switches=(ElementState("band_upper", "m", "band_engagement - band_gap: the positive side's edge"),
-              ElementState("band_lower", "m", "band_engagement + band_gap: the negative side's edge"),
-              ElementState("band_slip", "1", "sticking: the contact force less its level; sliding: e*v")),
+    switches=lambda count: (
+        ElementState("band_upper", "m", "band_engagement - band_gap: the positive side's edge"),
+        ElementState("band_lower", "m", "band_engagement + band_gap: the negative side's edge"),
+        ElementState("band_slip", "1", "sticking: the contact force less its level; sliding: e*v")),
     switch_values=lambda slot: (f"{slot.states[0]} - {slot.m}[0]", f"{slot.states[0]} + {slot.m}[0]",
                                 f"band_slip_switch({slot.m}, {', '.join(slot.states)}, v)"),
     neutral=(("band_gap", 0.0), ("band_k", 0.0), ("band_depth", 0.0), ("band_f", 0.0), ("band_ratio_pos", 1.0),

@@ -98,7 +98,8 @@ class OptionElement:
     update: Callable[[Slot], tuple[str, ...]] | None = None
     """Its states after an event of model exchange (a switch crossed: ``v``, ``x`` at hand), one
     text per state; None: they do not change there."""
-    switches: tuple[ElementState, ...] = ()
+    switches: Callable[[int], tuple[ElementState, ...]] = lambda count: ()
+    """Its switches (event indicators) for its count, as ``switch_values`` gives them."""
     switch_values: Callable[[Slot], tuple[str, ...]] = _no_text
     held: tuple[tuple[str, float], ...] = ()
     """What a fit holds of it unless told otherwise (``fit(fixed=...)``)."""
