@@ -199,3 +199,23 @@ def test_model_exchange_reverses_the_band_at_events_and_follows_a_fine_walk(vers
     assert run.events >= 6          # each side engaged, slid and released
     # measured 2026-12-02: 1.4e-5 of the peak, 19 events
     np.testing.assert_allclose(run.force_N, walk, rtol=0, atol=1e-4 * np.max(np.abs(walk)))
+
+
+def test_the_band_brake_truth_of_data_is_the_model_with_its_values():
+    # data/generate_band_brake.py's truth (tests/references/band_brake.py, typed from the laws with
+    # scipy's brentq) walked on the samples is kelvin_voigt+band+rig with the same values
+    import sys
+    from conftest import REPO
+    sys.path.insert(0, str(REPO / "tests" / "references"))
+    import band_brake
+    p = band_brake.PARAMETERS
+    t = np.arange(0.0, 3.0, 2e-3)
+    t, x, v = path(3.5 * np.sin(2 * np.pi * 1.0 * t) * np.minimum(t, 1.0), dt=2e-3)
+    arriving = np.concatenate([v[:1], v[:-1]])      # the walk reports each sample's force at the step's v
+    truth = band_brake.force(p, t, lambda s: (np.interp(s, t, x), np.interp(s, t, arriving)), substeps=1)
+    params = dict(k=p["k0"], c=p["c"], preload=0.0, band_gap=p["gap"], band_k=p["kc"], band_depth=p["d"],
+                  band_f=p["f"], band_ratio_pos=p["r_pos"], band_ratio_neg=p["r_neg"], band_travel=p["S"],
+                  rig_displacement_zero=0.0, rig_force_zero=p["b"])
+    model = simulate_python_core(params, t, x, v, model="kelvin_voigt+band+rig")
+    assert np.max(truth - p["b"]) > p["f"] * p["r_pos"] and np.min(truth - p["b"]) < -p["f"]   # slid both ways
+    np.testing.assert_allclose(model, truth, rtol=0, atol=1e-8 * np.max(np.abs(truth)))
