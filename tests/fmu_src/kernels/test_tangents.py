@@ -19,6 +19,15 @@ from fmu_src.kernels.tangents import SLOPE_CAP, TangentError, tangent, tangent_p
 
 KERNELS = ("force", "derivatives")
 POINTS = 200
+DERIVED = {
+    # models with the stateful option elements, their values beside the base's defaults
+    "single_bouc_wen+iwan3+band+rig": dict(iwan_k=600.0, iwan_f=900.0, band_gap=0.5, band_k=1000.0, band_depth=0.2,
+                                           band_f=100.0, band_ratio_pos=4.0, band_ratio_neg=2.0, band_travel=2.0,
+                                           rig_displacement_zero=0.1, rig_force_zero=20.0),
+    "kelvin_voigt+band": dict(band_gap=0.0, band_k=800.0, band_depth=0.0, band_f=300.0, band_ratio_pos=3.0,
+                              band_ratio_neg=1.0, band_travel=0.0),
+}
+NAMES = list(MODELS) + list(DERIVED)
 
 
 def complex_step(kernel, m, state, x, v, d_state, d_x, d_v):
@@ -41,7 +50,11 @@ def central_difference(kernel, m, state, x, v, d_state, d_x, d_v, h):
 # ---------------------------------------------------------------------------- points
 def default_constants(name):
     model = get_model(name)
-    parameters = load_parameters(default_parameter_file(name), name)
+    if name in DERIVED:
+        base = name.split("+")[0]
+        parameters = dict(load_parameters(default_parameter_file(base), base), **DERIVED[name])
+    else:
+        parameters = load_parameters(default_parameter_file(name), name)
     return model, model.prepare(model.values(parameters))
 
 
@@ -90,7 +103,7 @@ def agree(got, want, tolerance):
 
 
 # ---------------------------------------------------------------------------- tests
-@pytest.mark.parametrize("name", list(MODELS))
+@pytest.mark.parametrize("name", NAMES)
 @pytest.mark.parametrize("kernel_name", KERNELS)
 def test_tangent_equals_complex_step_and_value_is_the_kernels_bit_for_bit(name, kernel_name):
     model, m, points = random_points(name, POINTS, seed=35)
@@ -134,7 +147,7 @@ def switch_points(model, m):
     return points
 
 
-@pytest.mark.parametrize("name", list(MODELS))
+@pytest.mark.parametrize("name", NAMES)
 def test_tangents_are_finite_exactly_on_the_switches(name):
     model, m = default_constants(name)
     for kernel_name in KERNELS:
@@ -211,7 +224,7 @@ def test_what_cannot_be_differentiated_is_refused_naming_function_and_line(funct
     assert line == function.__code__.co_firstlineno + 1
 
 
-@pytest.mark.parametrize("name", list(MODELS))
+@pytest.mark.parametrize("name", NAMES)
 def test_the_generated_tangents_translate_to_c(name):
     def kind(value):
         return tuple(kind(e) for e in value) if isinstance(value, tuple) else DOUBLE if isinstance(value, float) else INT
@@ -263,7 +276,7 @@ def test_math_functions_loops_and_helpers_against_central_differences():
         assert agree(flat(derivative), want, 1e-6), (state, x, v, flat(derivative), want)
 
 
-@pytest.mark.parametrize("name", list(MODELS))
+@pytest.mark.parametrize("name", NAMES)
 def test_jump_tangent_equals_complex_step(name):
     """The tangent of ``jump`` in the jump (the state constant), which the native FMU's
     co-simulation dF/dx takes through the displacement jump: the state after the jump bit for bit

@@ -219,3 +219,31 @@ def test_the_band_brake_truth_of_data_is_the_model_with_its_values():
     model = simulate_python_core(params, t, x, v, model="kelvin_voigt+band+rig")
     assert np.max(truth - p["b"]) > p["f"] * p["r_pos"] and np.min(truth - p["b"]) < -p["f"]   # slid both ways
     np.testing.assert_allclose(model, truth, rtol=0, atol=1e-8 * np.max(np.abs(truth)))
+
+
+def test_a_six_axis_fmus_axis_takes_a_band_in_both_fmus(tmp_path):
+    # z a Kelvin-Voigt axis with a band: both six-axis FMUs give the one-axis forward model's force
+    import json
+    import build_fmu
+    from fmpy import simulate_fmu
+    from conftest import DATA
+    from identification.forward.population import simulate_population_held
+    if shutil.which("gcc") is None and shutil.which("cc") is None:
+        pytest.skip("no C compiler for the native FMU")
+    axis = dict(k=300.0, c=1.0, preload=0.0, **BAND)
+    document = json.loads((DATA / "params_six_axis_illustrative.json").read_text())
+    document["axes"]["z"] = {"model": "KelvinVoigtBushing_Band", "parameters": axis}
+    params = tmp_path / "six.json"
+    params.write_text(json.dumps(document))
+    t = np.arange(0.0, 0.8, 1e-3)
+    names = ["dx", "vx", "dy", "vy", "dz", "vz", "rx", "wx", "ry", "wy", "rz", "wz"]
+    signals = np.zeros(t.size, dtype=[("time", float)] + [(name, float) for name in names])
+    w = 2 * np.pi * 3.0
+    signals["time"], signals["dz"], signals["vz"] = t, 2.5e-3 * np.sin(w * t), 2.5e-3 * w * np.cos(w * t)
+    model = get_model("kelvin_voigt+band")
+    want = simulate_population_held([model.check(axis)], t, signals["dz"] * 1e3, signals["vz"] * 1e3, model=model)[0]
+    for fmu in (build_fmu.build_fmu(params, tmp_path / "python", model="six_axis"),
+                build_fmu.build_native_fmu(params, tmp_path / "native", model="six_axis").path):
+        got = simulate_fmu(str(fmu), stop_time=t[-1], step_size=1e-3, output_interval=1e-3, input=signals,
+                           output=["Fz"])["Fz"]
+        np.testing.assert_allclose(got, want[:len(got)], rtol=0, atol=1e-12 * np.max(np.abs(want)))
