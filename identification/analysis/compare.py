@@ -283,7 +283,8 @@ class _Comparison:
             pending = {}
             if not variants:
                 return
-            print(f"weighing {self.recommendation.model} without each option assumed: "
+            print(f"weighing {self.recommendation.model} against its variants (each option assumed left out, each "
+                  f"option tried added): "
                   f"{', '.join(b.name for b, _ in variants)} ...", file=sys.stderr)
             results, stopped = self.results, self.stopped
             more, more_stopped, more_searches = race_models([self.request(b, dict(f)) for b, f in variants], engine,

@@ -167,6 +167,11 @@ def _add_compare(subcommands) -> None:
     compare_parser.add_argument("--validate-multiaxis", action="append", type=Path, default=[], metavar="FILE",
                                 help="multi-axis test held out of the fits (CSV time_s,dx_mm,dy_mm,Fx_N,Fy_N[,dz_mm,"
                                      "Fz_N]); each model predicts it with each --coupling; repeatable")
+    compare_parser.add_argument("--try-options", metavar="LIST",
+                                help="options to weigh on the recommended model, comma-separated (e.g. band,iwan4): "
+                                     "once the race has recommended one, it is fitted again with each of them added, "
+                                     "and the recommendation is made again over all, so an option is kept only "
+                                     "where it earns its parameters")
     compare_parser.add_argument("--out", type=Path, required=True,
                                 help="directory for the fitted parameter files, the table (CSV) and the plots")
     compare_parser.add_argument("--no-race", action="store_true",

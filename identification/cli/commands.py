@@ -410,6 +410,7 @@ def compare_command(args) -> int:
         raise UsageError(f"--kdyn and --validate-kdyn are the same table ({args.kdyn}): a table the models are fitted "
                          "on is not held out; give another table to --validate-kdyn, or leave it out")
     training_table = load_kdyn_table(args.kdyn) if args.kdyn is not None else None
+    tried = _tried_options(args)         # refused before any work
     tests, _ = training_tests_of(args)
     options = model_options_of(args)
     contact, variants = None, []
@@ -423,6 +424,7 @@ def compare_command(args) -> int:
         options = options_of(contact.tokens)
         variants = [options_of([t for t in contact.tokens if t != token]) for token in contact.tokens]
         print(contact.format(), file=sys.stderr)
+    variants += [_with_option(options, token, args) for token in tried]
     tests = options.training(tests)
     models = [name.strip() for name in args.models.split(",") if name.strip()]
     unknown = []
@@ -456,6 +458,29 @@ def compare_command(args) -> int:
                    fixed_by_model=fixed, alternatives=alternatives, first_contact=contact,
                    leave_one_out=args.leave_one_out, **search_settings(args))
     return 0
+
+
+def _tried_options(args) -> list[str]:
+    """The tokens of compare's ``--try-options`` (none where it is not given), each checked."""
+    from fmu_src.model.options import Options
+    text = (getattr(args, "try_options", None) or "").strip()
+    if not text:
+        return []
+    try:
+        return list(Options.parse(part for part in text.split(",") if part.strip()).tokens)
+    except ParameterError as exc:
+        raise UsageError(f"--try-options {args.try_options}: {exc}") from None
+
+
+def _with_option(options, token: str, args):
+    """``options`` (``ModelOptions``) with the option ``token`` added: a variant compare weighs."""
+    from fmu_src.model.options import Options
+    try:
+        added = options.options.union(Options.parse([token]))
+    except ParameterError as exc:
+        raise UsageError(f"--try-options {token}: {exc}") from None
+    static = options.static_test.measurement if options.static_test is not None else None
+    return build_model_options(added, fixed_values(args.fix), static, args.backbone_knots)
 
 
 COMPARED_COUPLINGS = ("none", "radial", "spherical")

@@ -163,3 +163,26 @@ def test_several_records_offsets_are_said_once_with_their_range(tmp_path):
     other = Measurement(sine.time_s, sine.displacement_mm + 1.0, sine.force_N, sine.velocity_mm_s, source="b.csv")
     (rig,) = first_contact([RigTest(sine, "sine"), RigTest(other, "sine")]).assumptions
     assert rig.reason.startswith("the strokes of 2 sines are one-sided (centred at +2 to +3 mm)")
+
+
+def test_compare_weighs_each_tried_option_on_the_recommended_model(tmp_path, capsys):
+    # the synthetic band brake (a play, a self-energizing friction, a load-cell zero of +60 N):
+    # Kelvin-Voigt with the rig assumed, then with the band tried; the band earns its parameters
+    sines = [DATA / f"synthetic_band_sine_{name}.csv" for name in ("2.5mm_0.5Hz", "4mm_2Hz")]
+    out = tmp_path / "compare"
+    assert main(["compare", *[a for s in sines for a in ("--sine", str(s))], "--models", "kelvin_voigt",
+                 "--try-options", "band", "--screening", "64", "--starts", "2", "--no-ensemble", "--quiet",
+                 "--workers", "1", "--out", str(out)]) == 0
+    assert "option tried added" in capsys.readouterr().err
+    with open(out / "comparison.csv") as handle:
+        rows = {row["model"]: row for row in csv.DictReader(handle)}
+    assert {"kelvin_voigt+rig", "kelvin_voigt+band+rig"} <= set(rows)
+    assert rows["kelvin_voigt+band+rig"]["recommended"] == "True"
+
+
+def test_a_tried_option_that_is_not_one_is_refused_before_any_work(tmp_path, capsys):
+    assert main(["compare", "--sine", str(TABLE5_SINE), "--models", "kelvin_voigt", "--try-options", "iwan0",
+                 "--out", str(tmp_path / "c")]) == 2
+    printed = capsys.readouterr().err
+    assert "--try-options iwan0: iwan0: the count must be 1 to 16" in printed and "assumed" not in printed
+    assert not (tmp_path / "c").exists()
