@@ -31,7 +31,7 @@ from identification.measured.measurements import Measurement
 from identification.measured.multiaxis import vector_nrmse
 from identification.fitting.multistart import (AnchoredStarts, PrefixScreening, Problem, StartRecord, failed_starts,
                                                first_records, jacobian, run_stages, screen, simulations_per_jacobian)
-from identification.measured.offsets import held_force
+from identification.measured.offsets import MIN_REST_S, MIN_REST_SAMPLES, held_force, short_rest
 from identification.measured.repeatability import estimate_repeatability
 from identification.measured.noise import NoiseEstimate
 from identification.fitting.objectives import MultiAxisTests, Objective, nrmse
@@ -510,6 +510,13 @@ def resting_notes(tests, rest_forces, bushing: BushingModel) -> list[str]:
             notes.append(f"note: {test.name} holds {rest:+.4g} N at rest before it moves: the {bushing.name} model "
                          + ("starts it there, its elements stuck holding that force" if bushing.resting_state
                             is not None else "holds no force at rest and starts it relaxed"))
+        elif bushing.resting_state is not None and isinstance(test.measurement, Measurement):
+            short = short_rest(test.measurement)
+            if short is not None:
+                notes.append(f"note: {test.name} starts at {short[0]:+.4g} N but rests only {short[1] * 1e3:.3g} ms "
+                             f"before it moves (a held force needs {MIN_REST_SAMPLES} samples and "
+                             f"{MIN_REST_S * 1e3:g} ms at rest): the {bushing.name} model starts it relaxed; a record "
+                             "that starts with a longer rest starts it holding its force")
     return notes
 
 

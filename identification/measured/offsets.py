@@ -40,6 +40,8 @@ REST_MOTION = 0.002
 """The displacement is at rest while it stays within this fraction of its range of the first sample."""
 MIN_REST_SAMPLES = 20
 MIN_REST_S = 0.05
+BRIEF_REST_SAMPLES, BRIEF_REST_S = 5, 0.005
+"""A start at rest shorter than these is a motion's turning point, not a rest too short to count."""
 """A rest shorter than these (samples and seconds) is not read: its force is the start of the motion."""
 OFFSET_FORCE = 0.02
 """A force at rest, or a cycles' mean force, beyond this fraction of the record's force half range..."""
@@ -132,6 +134,24 @@ def offset_floor(measurement: Measurement, offsets: RecordOffsets | None = None)
     except ValueError:
         noise = 0.0
     return max(OFFSET_FORCE * offsets.force_half_range_N, NOISE_LEVELS * noise)
+
+
+def short_rest(measurement: Measurement) -> tuple[float, float] | None:
+    """(the median force [N], how long [s]) of a rest at the start too short to count as one
+    (fewer than MIN_REST_SAMPLES samples or shorter than MIN_REST_S) whose force exceeds the
+    record's offset floor; None where there is no such rest. A start shorter than
+    BRIEF_REST_SAMPLES samples or BRIEF_REST_S is a motion's turning point, not a rest."""
+    x, t = measurement.displacement_mm, measurement.time_s
+    span = float(np.ptp(x))
+    if span <= 0.0:
+        return None
+    moved = np.flatnonzero(np.abs(x - x[0]) > REST_MOTION * span)
+    end = int(moved[0]) if moved.size else x.size
+    rest_s = float(t[end - 1] - t[0]) if end > 0 else 0.0
+    if end < BRIEF_REST_SAMPLES or rest_s < BRIEF_REST_S or (end >= MIN_REST_SAMPLES and rest_s >= MIN_REST_S):
+        return None
+    force = float(np.median(measurement.force_N[:end]))
+    return (force, rest_s) if abs(force) > offset_floor(measurement) else None
 
 
 def held_force(measurement: Measurement) -> float:

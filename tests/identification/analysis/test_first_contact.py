@@ -57,6 +57,21 @@ def test_a_record_that_starts_moving_has_no_rest_force():
     assert math.isnan(record_offsets(resting_sine(rest_s=0.0)).rest_force_N)
 
 
+def test_a_rest_too_short_to_count_is_named_in_the_fits_notes_and_a_long_one_is_held():
+    from fmu_src.model.registry import get_model
+    from identification.fitting.search import resting_notes
+    from identification.measured.offsets import held_force, short_rest
+    brief, long = resting_sine(rest_s=0.01), resting_sine(rest_s=0.5)      # 11 samples at rest, and 501
+    force, rest_s = short_rest(brief)
+    assert math.isnan(held_force(brief)) and force == pytest.approx(-250.0) and rest_s == pytest.approx(0.01, abs=5e-3)
+    assert held_force(long) == pytest.approx(-250.0) and short_rest(long) is None
+    assert short_rest(resting_sine(rest_s=0.0)) is None
+    notes = resting_notes([RigTest(brief), RigTest(long)], [held_force(brief), held_force(long)],
+                          get_model("asymmetric_bouc_wen"))
+    assert "resting_sine.csv starts at -250 N but rests only" in notes[0] and "starts it relaxed" in notes[0]
+    assert "holds -250 N at rest before it moves" in notes[1]
+
+
 def test_the_rig_zeros_are_the_periodic_records_centres_else_the_rests():
     sine = record_offsets(resting_sine())
     assert rig_zeros([sine]) == pytest.approx((3.0, 40.0), abs=0.5)
