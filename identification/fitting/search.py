@@ -313,6 +313,7 @@ class Search:
         objective = Objective(request.tests, request.noise, model=self.space.bushing, table=request.table,
                               search=request.table is not None, multiaxis=multi)
         self.notes += resting_notes(request.tests, objective.rest_forces, self.space.bushing)
+        self.notes += temperature_notes(request.tests, self.space.bushing)
         self.n, self.d = objective.size, len(self.space.names)     # residuals, coordinates
         return Problem(objective, self.space, self.jacobian_kind)
 
@@ -518,6 +519,30 @@ def resting_notes(tests, rest_forces, bushing: BushingModel) -> list[str]:
                              f"{MIN_REST_S * 1e3:g} ms at rest): the {bushing.name} model starts it relaxed; a record "
                              "that starts with a longer rest starts it holding its force")
     return notes
+
+
+TEMPERATURE_SPREAD_K = 5.0
+"""Tests whose mean temperatures differ by more than this [K] are at different conditions."""
+
+
+def temperature_notes(tests, bushing: BushingModel) -> list[str]:
+    """The fit's notes on the tests that carry the rubber's temperature (``Measurement.temperature_K``):
+    no model has a temperature law yet, so each fits them as one device at one condition, and says
+    so (more loudly where the tests' temperatures differ by more than TEMPERATURE_SPREAD_K)."""
+    carried = [(test.name, test.measurement.temperature_K) for test in tests
+               if isinstance(test.measurement, Measurement) and test.measurement.temperature_K is not None]
+    if not carried:
+        return []
+    means = [float(np.mean(t)) for _, t in carried]
+    each = "; ".join(f"{name} {mean - 273.15:.4g} degC" for (name, _), mean in zip(carried, means))
+    spread = max(means) - min(means)
+    if spread > TEMPERATURE_SPREAD_K:
+        return [f"note: the training tests are at different temperatures ({each}; {spread:.3g} K apart): the "
+                f"{bushing.name} model has no temperature law, so it fits them as one device at one condition, "
+                "and its figures mix what the temperature changes with what the model misses; fit each "
+                "temperature's tests on their own"]
+    return [f"note: the training tests carry their temperature ({each}): the {bushing.name} model has no "
+            "temperature law; its parameters hold at about that temperature"]
 
 
 def test_fits(tests, noise, parameters: ParameterSet, steps=None) -> list[RigTestFit]:

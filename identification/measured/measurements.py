@@ -3,12 +3,14 @@
 Format: optional comment lines starting with ``#`` (provenance; synthetic files say so
 there), then a header naming columns with their units, then comma-separated numbers:
 
-    time_s,displacement_mm,force_N[,velocity_mm_s]
+    time_s,displacement_mm,force_N[,velocity_mm_s][,temperature_K]
 
 A file whose name ends in ``.gz`` (``test.csv.gz``) is read through gzip, as numpy and pandas do.
 
 Other declared units are converted: displacement in m, mm, in; force in N, kN, lbf, kip;
-velocity in m_s, mm_s, in_s (per second). Internal units: s, mm, N, mm/s.
+velocity in m_s, mm_s, in_s (per second); temperature in K or C (the rubber's, constant or
+varying). Internal units: s, mm, N, mm/s, K. A temperature at or below absolute zero is refused;
+one outside PLAUSIBLE_TEMPERATURE_K (a Fahrenheit column read as Celsius, Celsius as kelvin) warns.
 
 When the velocity is absent it is derived from the displacement with second-order finite
 differences (``numpy.gradient``: central in the interior, one-sided at both ends), which
@@ -44,6 +46,10 @@ MIN_PLAUSIBLE_FORCE_N = 10.0
 PLAUSIBLE_STIFFNESS_N_PER_MM = (1.0, 1e6)
 PLAUSIBLE_SAMPLE_RATE_HZ = (10.0, 1e6)
 MAX_STEP_OVER_RMS = 0.5
+TEMPERATURE_TO_K = {"K": (1.0, 0.0), "C": (1.0, 273.15)}
+"""(factor, offset) of each temperature unit: T [K] = factor * value + offset."""
+PLAUSIBLE_TEMPERATURE_K = (173.15, 473.15)
+"""-100 to +200 degC: what a rubber test's temperature can be."""
 
 
 @dataclass
@@ -56,6 +62,7 @@ class Measurement:
     source: str = ""
     comments: list[str] = field(default_factory=list)
     has_force: bool = True      # False: an input file without a force column (force_N is zeros)
+    temperature_K: np.ndarray | None = None     # the rubber's temperature [K] at each sample, if the file has it
 
     def __len__(self) -> int:
         return self.time_s.size
@@ -158,6 +165,16 @@ def load_measurement(path: str | Path, force_optional: bool = False) -> Measurem
             f"{path}: header {header!r} (line {header_line}) lacks column(s) {', '.join(missing)}; "
             "expected time_s,displacement_mm,force_N[,velocity_mm_s]")
 
+    temperatures = [i for i, name in enumerate(names) if name.split("_")[0] == "temperature"]
+    if len(temperatures) > 1:
+        raise MeasurementError(f"{path}: more than one temperature column in header {header!r}")
+    temperature_unit = None
+    if temperatures:
+        temperature_unit = names[temperatures[0]][len("temperature_"):]
+        if temperature_unit not in TEMPERATURE_TO_K:
+            raise MeasurementError(f"{path}: column {names[temperatures[0]]!r} has unknown unit {temperature_unit!r}; "
+                                   f"allowed: {', '.join(f'temperature_{u}' for u in TEMPERATURE_TO_K)}")
+
     rows = body[1:]
     if len(rows) < MIN_SAMPLES:
         raise MeasurementError(f"{path}: {len(rows)} samples; at least {MIN_SAMPLES} are needed")
@@ -193,7 +210,22 @@ def load_measurement(path: str | Path, force_optional: bool = False) -> Measurem
     headers = {quantity: names[index] for quantity, (index, _) in columns.items()}
     for message in plausibility_warnings(time_s, displacement, force if has_force else None, headers):
         warnings.warn(f"{path}: {message}", MeasurementWarning, stacklevel=2)
-    return Measurement(time_s, displacement, force, velocity, derived, str(path), comments, has_force)
+    temperature = None
+    if temperature_unit is not None:
+        factor, offset = TEMPERATURE_TO_K[temperature_unit]
+        temperature = data[:, temperatures[0]] * factor + offset
+        cold = np.flatnonzero(temperature <= 0.0)
+        if cold.size:
+            raise MeasurementError(f"{path}, line {rows[int(cold[0])][0]}: {names[temperatures[0]]} = "
+                                   f"{data[int(cold[0]), temperatures[0]]:g} [{temperature_unit}] is at or below "
+                                   "absolute zero; give the rubber's temperature in K or C")
+        low, high = PLAUSIBLE_TEMPERATURE_K
+        if np.min(temperature) < low or np.max(temperature) > high:
+            warnings.warn(f"{path}: column {names[temperatures[0]]}: {np.min(temperature) - 273.15:.4g} to "
+                          f"{np.max(temperature) - 273.15:.4g} degC is outside a rubber test's "
+                          f"{low - 273.15:g} to {high - 273.15:g} degC; Fahrenheit read as Celsius, or Celsius as "
+                          "kelvin?", MeasurementWarning, stacklevel=2)
+    return Measurement(time_s, displacement, force, velocity, derived, str(path), comments, has_force, temperature)
 
 
 def plausibility_warnings(time_s, displacement_mm, force_N=None, headers=None) -> list[str]:
@@ -237,10 +269,16 @@ def plausibility_warnings(time_s, displacement_mm, force_N=None, headers=None) -
     return found
 
 
-def write_measurement(path: str | Path, time_s, displacement_mm, force_N, comments: list[str] = ()) -> None:
-    """Write time_s,displacement_mm,force_N with ``# `` comment lines first."""
-    table = np.column_stack([time_s, displacement_mm, force_N])
+def write_measurement(path: str | Path, time_s, displacement_mm, force_N, comments: list[str] = (),
+                      temperature_K=None) -> None:
+    """Write time_s,displacement_mm,force_N (and temperature_K [K], a number or one a sample, where
+    given) with ``# `` comment lines first."""
+    columns, names, formats = [time_s, displacement_mm, force_N], "time_s,displacement_mm,force_N", ["%.6f", "%.6f", "%.4f"]
+    if temperature_K is not None:
+        columns.append(np.broadcast_to(np.asarray(temperature_K, dtype=float), np.shape(time_s)))
+        names, formats = names + ",temperature_K", formats + ["%.3f"]
+    table = np.column_stack(columns)
     header = "".join(f"# {line}\n" for line in comments)
     with open(path, "w", encoding="utf-8") as stream:
-        stream.write(header + "time_s,displacement_mm,force_N\n")
-        np.savetxt(stream, table, delimiter=",", fmt=["%.6f", "%.6f", "%.4f"])
+        stream.write(header + names + "\n")
+        np.savetxt(stream, table, delimiter=",", fmt=formats)

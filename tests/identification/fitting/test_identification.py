@@ -57,6 +57,54 @@ def test_declared_units_are_converted_and_comments_kept(tmp_path):
     assert not m.velocity_derived and m.comments == ["SYNTHETIC", "made by hand"]
 
 
+@pytest.mark.parametrize("unit, values, kelvin", [("C", (23.0, 60.0), (296.15, 333.15)),
+                                                   ("K", (250.0, 250.5), (250.0, 250.5))])
+def test_a_temperature_column_is_read_in_kelvin_and_written_back(tmp_path, unit, values, kelvin):
+    from identification.measured.measurements import write_measurement
+    text = f"time_s,displacement_mm,force_N,temperature_{unit}\n"
+    text += "".join(f"{k * 0.01},{0.1 * k},{10.0 * k},{values[k % 2]}\n" for k in range(12))
+    m = load_measurement(write(tmp_path, text))
+    assert m.temperature_K[:2] == pytest.approx(kelvin, abs=1e-12)
+    write_measurement(tmp_path / "again.csv", m.time_s, m.displacement_mm, m.force_N, temperature_K=m.temperature_K)
+    assert load_measurement(tmp_path / "again.csv").temperature_K == pytest.approx(m.temperature_K, abs=1e-3)
+    assert load_measurement(write(tmp_path, "time_s,displacement_mm,force_N\n" + rows(12))).temperature_K is None
+
+
+@pytest.mark.parametrize("header, value, fragment", [
+    ("temperature_F", "70", "column 'temperature_F' has unknown unit 'F'; allowed: temperature_K, temperature_C"),
+    ("temperature_C", "-300", "temperature_C = -300 [C] is at or below absolute zero"),
+    ("temperature_K", "0", "temperature_K = 0 [K] is at or below absolute zero"),
+])
+def test_a_bad_temperature_is_refused_with_its_value_unit_and_what_is_allowed(tmp_path, header, value, fragment):
+    text = f"time_s,displacement_mm,force_N,{header}\n" + "".join(f"{k * 0.01},{0.1 * k},{10.0 * k},{value}\n"
+                                                                  for k in range(12))
+    with pytest.raises(MeasurementError, match=re.escape(fragment)):
+        load_measurement(write(tmp_path, text))
+
+
+def test_a_temperature_in_the_wrong_unit_warns(tmp_path):
+    text = "time_s,displacement_mm,force_N,temperature_K\n" + "".join(f"{k * 0.01},{0.1 * k},{10.0 * k},23\n"
+                                                                       for k in range(12))
+    with pytest.warns(MeasurementWarning, match="Celsius as kelvin"):
+        load_measurement(write(tmp_path, text))
+
+
+def test_a_fit_on_tests_at_different_temperatures_says_its_model_has_no_temperature_law():
+    from fmu_src.model.registry import get_model
+    from identification.fitting.search import temperature_notes
+    t = sample_times(0.5, 1000.0)
+    x, v = Sine(2.0, 10.0).signals(t)
+    cold, warm = (RigTest(Measurement(t, x, 100.0 * x, v, source=f"{name}.csv", temperature_K=np.full(t.size, kelvin)))
+                  for name, kelvin in (("cold", 253.15), ("warm", 333.15)))
+    plain = RigTest(Measurement(t, x, 100.0 * x, v, source="plain.csv"))
+    model = get_model("kelvin_voigt")
+    assert temperature_notes([plain], model) == []
+    [one] = temperature_notes([cold, plain], model)
+    assert "cold.csv -20 degC" in one and "no temperature law" in one
+    [both] = temperature_notes([cold, warm], model)
+    assert "80 K apart" in both and "one device at one condition" in both
+
+
 def test_missing_velocity_is_derived_to_second_order(tmp_path):
     t = sample_times(1.0, 1000.0)
     x, v = Sine(2.0, 10.0).signals(t)
