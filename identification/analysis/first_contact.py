@@ -21,6 +21,13 @@ the models need one, and each is recognised here from the data alone:
   sine's loading and unloading branches stiffens towards its ends (the end segments'
   slope beyond ``END_STIFFENING`` times the middle's): a stop each side.
 
+One more is tried rather than assumed: where a sine's loops dissipate more than
+``DISSIPATIVE_LOOP`` of the rectangle their force and stroke span (the energy a cycle takes,
+over 4 F x with F and x the force's and the stroke's half ranges: 1 for Coulomb's friction,
+(pi/4) sin(delta) for a linear element of loss angle delta, under 0.3 for the rubber bushings
+here), the device dissipates as friction (or a fluid) does, and ``band`` (self-energizing
+friction through a play) is tried on the recommended model (``--try-options``).
+
 ``compare`` races every model with what was assumed and then weighs the recommended model
 without each assumed option in turn (``compare.CompareOptions.alternatives``): an option that
 does not earn its parameters is dropped there. ``--options none`` turns every assumption off;
@@ -37,6 +44,7 @@ from scipy.interpolate import PchipInterpolator
 
 from identification.errors import MeasurementError
 from identification.measured.offsets import RecordOffsets, offset_floor, record_offsets
+from identification.measured.repeatability import cycle_starts
 from identification.measured.rig_tests import RigTest
 from identification.measured.static_curve import read_static_curve
 
@@ -50,6 +58,8 @@ RATE_STIFFENING = 0.1
 END_STIFFENING = 3.0
 """A static curve whose end segments are this much stiffer than its middle has stops."""
 KNOT_COUNTS = (9, 17)
+DISSIPATIVE_LOOP = 0.35
+"""A sine whose loops take more than this share of 4 F x a cycle dissipates as friction does."""
 
 
 @dataclass(frozen=True)
@@ -66,18 +76,29 @@ class FirstContact:
     the quasi-static test the backbone is read off (None without one)."""
     assumptions: tuple[Assumption, ...]
     static_test: RigTest | None = None
+    trials: tuple[Assumption, ...] = ()
+    """Options tried on the recommended model (``--try-options``), each with its reason."""
 
     @property
     def tokens(self) -> tuple[str, ...]:
         return tuple(a.option for a in self.assumptions)
 
+    @property
+    def tried(self) -> tuple[str, ...]:
+        return tuple(a.option for a in self.trials)
+
     def format(self) -> str:
         """The summary's lines: what was assumed, why, and how to turn it off."""
         if not self.assumptions:
-            return "assumed: no option (the records show no offset, no quasi-static test and no stop)"
-        lines = [f"assumed: {a.option}: {a.reason}" for a in self.assumptions]
-        lines.append("  (each option assumed was weighed against the recommended model without it; turn them off "
-                     "with --options none, or name the ones you want with --options)")
+            lines = ["assumed: no option (the records show no offset, no quasi-static test and no stop)"]
+        else:
+            lines = [f"assumed: {a.option}: {a.reason}" for a in self.assumptions]
+            lines.append("  (each option assumed was weighed against the recommended model without it; turn them "
+                         "off with --options none, or name the ones you want with --options)")
+        lines += [f"tried: {a.option}: {a.reason}" for a in self.trials]
+        if self.trials:
+            lines.append("  (each option tried was weighed on the recommended model; --try-options none tries "
+                         "nothing, --try-options LIST those instead)")
         return "\n".join(lines)
 
 
@@ -175,6 +196,35 @@ def _stops(test: RigTest) -> str:
     return ""
 
 
+def loop_dissipation(measurement) -> float:
+    """The share of the rectangle 4 F x that a sine's whole cycles dissipate each [1] (module
+    docstring); NaN without two cycle starts."""
+    t, x, force = measurement.time_s, measurement.displacement_mm, measurement.force_N
+    starts = cycle_starts(t, x) if np.ptp(x) > 0 else np.array([])
+    if starts.size < 2:
+        return math.nan
+    inside = (t >= starts[0]) & (t <= starts[-1])
+    xi, fi = x[inside], force[inside]
+    if xi.size < 3 or np.ptp(fi) <= 0.0:
+        return math.nan
+    energy = float(np.sum(0.5 * (fi[1:] + fi[:-1]) * np.diff(xi))) / (starts.size - 1)
+    return energy / (float(np.ptp(fi)) * float(np.ptp(xi)))       # 4 F x with F, x the half ranges
+
+
+def _dissipative(tests: Sequence[RigTest]) -> str:
+    """Why the band is tried ("": it is not): the sine whose loops dissipate most."""
+    shares = [(loop_dissipation(t.measurement), t.name) for t in tests if t.kind == "sine"]
+    shares = [(share, name) for share, name in shares if math.isfinite(share)]
+    if not shares:
+        return ""
+    share, name = max(shares)
+    if share <= DISSIPATIVE_LOOP:
+        return ""
+    return (f"the loops of {name} dissipate {share:.2f} of the rectangle their force and stroke span (Coulomb's "
+            "friction 1, a linear element (pi/4) sin(loss angle), the rubber bushings here under 0.3), as friction "
+            "does: a band brake's self-energizing friction through a play is tried")
+
+
 def first_contact(tests: Sequence[RigTest], static_test: RigTest | None = None) -> FirstContact:
     """What the training ``tests`` (and a quasi-static ``static_test``, if given) ask the models
     to have (module docstring). A quasi-static training test is taken as the static test where none
@@ -204,4 +254,6 @@ def first_contact(tests: Sequence[RigTest], static_test: RigTest | None = None) 
             stops = _stops(largest)
             if stops:
                 assumptions.append(Assumption("limits", stops + ": a travel limit each side"))
-    return FirstContact(tuple(assumptions), static_test)
+    dissipative = _dissipative(tests)
+    trials = (Assumption("band", dissipative),) if dissipative else ()
+    return FirstContact(tuple(assumptions), static_test, trials)

@@ -171,7 +171,9 @@ def _add_compare(subcommands) -> None:
                                 help="options to weigh on the recommended model, comma-separated (e.g. band,iwan4): "
                                      "once the race has recommended one, it is fitted again with each of them added, "
                                      "and the recommendation is made again over all, so an option is kept only "
-                                     "where it earns its parameters")
+                                     "where it earns its parameters (default: what the first contact tries, given "
+                                     "no --options: band where the sines' loops dissipate as friction does; none: "
+                                     "try nothing)")
     compare_parser.add_argument("--out", type=Path, required=True,
                                 help="directory for the fitted parameter files, the table (CSV) and the plots")
     compare_parser.add_argument("--no-race", action="store_true",

@@ -410,7 +410,7 @@ def compare_command(args) -> int:
         raise UsageError(f"--kdyn and --validate-kdyn are the same table ({args.kdyn}): a table the models are fitted "
                          "on is not held out; give another table to --validate-kdyn, or leave it out")
     training_table = load_kdyn_table(args.kdyn) if args.kdyn is not None else None
-    tried = _tried_options(args)         # refused before any work
+    tried = _tried_options(args)         # refused before any work; None: what the first contact tries
     tests, _ = training_tests_of(args)
     options = model_options_of(args)
     contact, variants = None, []
@@ -423,8 +423,10 @@ def compare_command(args) -> int:
             return build_model_options(Options.parse(tokens), fixed_values(args.fix), static, args.backbone_knots)
         options = options_of(contact.tokens)
         variants = [options_of([t for t in contact.tokens if t != token]) for token in contact.tokens]
+        if tried is None:
+            tried = list(contact.tried)
         print(contact.format(), file=sys.stderr)
-    variants += [_with_option(options, token, args) for token in tried]
+    variants += [_with_option(options, token, args) for token in tried or ()]
     tests = options.training(tests)
     models = [name.strip() for name in args.models.split(",") if name.strip()]
     unknown = []
@@ -460,11 +462,14 @@ def compare_command(args) -> int:
     return 0
 
 
-def _tried_options(args) -> list[str]:
-    """The tokens of compare's ``--try-options`` (none where it is not given), each checked."""
+def _tried_options(args) -> list[str] | None:
+    """The tokens of compare's ``--try-options``, each checked; [] for ``none``; None where it is
+    not given (the first contact then says what is tried)."""
     from fmu_src.model.options import Options
     text = (getattr(args, "try_options", None) or "").strip()
     if not text:
+        return None
+    if text.lower() == "none":
         return []
     try:
         return list(Options.parse(part for part in text.split(",") if part.strip()).tokens)

@@ -117,6 +117,40 @@ def measurement_name(source: str | Path) -> str:
     return name
 
 
+def _temperature_column(path: Path, names: list[str], header: str) -> tuple[int, str] | None:
+    """(index, unit) of the header's temperature column, or None; MeasurementError for two or
+    an unknown unit."""
+    found = [i for i, name in enumerate(names) if name.split("_")[0] == "temperature"]
+    if len(found) > 1:
+        raise MeasurementError(f"{path}: more than one temperature column in header {header!r}")
+    if not found:
+        return None
+    unit = names[found[0]][len("temperature_"):]
+    if unit not in TEMPERATURE_TO_K:
+        raise MeasurementError(f"{path}: column {names[found[0]]!r} has unknown unit {unit!r}; "
+                               f"allowed: {', '.join(f'temperature_{u}' for u in TEMPERATURE_TO_K)}")
+    return found[0], unit
+
+
+def _temperature_K(path: Path, name: str, column: tuple[int, str], values: np.ndarray, lines: list[int]) -> np.ndarray:
+    """The column's temperatures [K] (``lines`` the file's line of each sample); refused at or below
+    absolute zero, warned outside PLAUSIBLE_TEMPERATURE_K."""
+    unit = column[1]
+    factor, offset = TEMPERATURE_TO_K[unit]
+    temperature = values * factor + offset
+    cold = np.flatnonzero(temperature <= 0.0)
+    if cold.size:
+        raise MeasurementError(f"{path}, line {lines[int(cold[0])]}: {name} = {values[int(cold[0])]:g} [{unit}] is at "
+                               "or below absolute zero; give the rubber's temperature in K or C")
+    low, high = PLAUSIBLE_TEMPERATURE_K
+    if np.min(temperature) < low or np.max(temperature) > high:
+        warnings.warn(f"{path}: column {name}: {np.min(temperature) - 273.15:.4g} to "
+                      f"{np.max(temperature) - 273.15:.4g} degC is outside a rubber test's {low - 273.15:g} to "
+                      f"{high - 273.15:g} degC; Fahrenheit read as Celsius, or Celsius as kelvin?",
+                      MeasurementWarning, stacklevel=3)
+    return temperature
+
+
 def load_measurement(path: str | Path, force_optional: bool = False) -> Measurement:
     """Load a measured (or synthetic) rig test from a CSV file.
 
@@ -165,15 +199,7 @@ def load_measurement(path: str | Path, force_optional: bool = False) -> Measurem
             f"{path}: header {header!r} (line {header_line}) lacks column(s) {', '.join(missing)}; "
             "expected time_s,displacement_mm,force_N[,velocity_mm_s]")
 
-    temperatures = [i for i, name in enumerate(names) if name.split("_")[0] == "temperature"]
-    if len(temperatures) > 1:
-        raise MeasurementError(f"{path}: more than one temperature column in header {header!r}")
-    temperature_unit = None
-    if temperatures:
-        temperature_unit = names[temperatures[0]][len("temperature_"):]
-        if temperature_unit not in TEMPERATURE_TO_K:
-            raise MeasurementError(f"{path}: column {names[temperatures[0]]!r} has unknown unit {temperature_unit!r}; "
-                                   f"allowed: {', '.join(f'temperature_{u}' for u in TEMPERATURE_TO_K)}")
+    temperature_column = _temperature_column(path, names, header)
 
     rows = body[1:]
     if len(rows) < MIN_SAMPLES:
@@ -211,20 +237,9 @@ def load_measurement(path: str | Path, force_optional: bool = False) -> Measurem
     for message in plausibility_warnings(time_s, displacement, force if has_force else None, headers):
         warnings.warn(f"{path}: {message}", MeasurementWarning, stacklevel=2)
     temperature = None
-    if temperature_unit is not None:
-        factor, offset = TEMPERATURE_TO_K[temperature_unit]
-        temperature = data[:, temperatures[0]] * factor + offset
-        cold = np.flatnonzero(temperature <= 0.0)
-        if cold.size:
-            raise MeasurementError(f"{path}, line {rows[int(cold[0])][0]}: {names[temperatures[0]]} = "
-                                   f"{data[int(cold[0]), temperatures[0]]:g} [{temperature_unit}] is at or below "
-                                   "absolute zero; give the rubber's temperature in K or C")
-        low, high = PLAUSIBLE_TEMPERATURE_K
-        if np.min(temperature) < low or np.max(temperature) > high:
-            warnings.warn(f"{path}: column {names[temperatures[0]]}: {np.min(temperature) - 273.15:.4g} to "
-                          f"{np.max(temperature) - 273.15:.4g} degC is outside a rubber test's "
-                          f"{low - 273.15:g} to {high - 273.15:g} degC; Fahrenheit read as Celsius, or Celsius as "
-                          "kelvin?", MeasurementWarning, stacklevel=2)
+    if temperature_column is not None:
+        temperature = _temperature_K(path, names[temperature_column[0]], temperature_column,
+                                     data[:, temperature_column[0]], [number for number, _ in rows])
     return Measurement(time_s, displacement, force, velocity, derived, str(path), comments, has_force, temperature)
 
 

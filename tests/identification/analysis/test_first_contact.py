@@ -180,6 +180,25 @@ def test_several_records_offsets_are_said_once_with_their_range(tmp_path):
     assert rig.reason.startswith("the strokes of 2 sines are one-sided (centred at +2 to +3 mm)")
 
 
+def test_a_loops_dissipation_is_one_for_coulombs_friction_and_pi_over_4_sin_delta_for_a_linear_element():
+    from identification.analysis.first_contact import loop_dissipation
+    t = np.arange(0.0, 3.0, 1e-4)
+    x, v = 2.0 * np.sin(2 * np.pi * 2.0 * t), 4.0 * np.pi * 2.0 * np.cos(2 * np.pi * 2.0 * t)
+    coulomb = Measurement(t, x, 300.0 * np.sign(v), v)
+    assert loop_dissipation(coulomb) == pytest.approx(1.0, abs=2e-3)
+    k, c = 100.0, 3.0                                   # tan(delta) = c*omega/k
+    delta = math.atan(c * 4.0 * np.pi / k)
+    assert loop_dissipation(Measurement(t, x, k * x + c * v, v)) == pytest.approx(math.pi / 4 * math.sin(delta),
+                                                                                   rel=2e-3)
+
+
+def test_the_first_contact_tries_the_band_where_the_loops_dissipate_as_friction_does():
+    band = [RigTest(load_measurement(DATA / f"synthetic_band_sine_{n}.csv"), "sine") for n in ("2.5mm_0.5Hz", "4mm_2Hz")]
+    contact = first_contact(band)
+    assert contact.tried == ("band",) and "dissipate 0.54" in contact.format()
+    assert first_contact([RigTest(load_measurement(TABLE5_SINE), "sine")]).tried == ()
+
+
 def test_compare_weighs_each_tried_option_on_the_recommended_model(tmp_path, capsys):
     # the synthetic band brake (a play, a self-energizing friction, a load-cell zero of +60 N):
     # Kelvin-Voigt with the rig assumed, then with the band tried; the band earns its parameters
@@ -201,3 +220,21 @@ def test_a_tried_option_that_is_not_one_is_refused_before_any_work(tmp_path, cap
     printed = capsys.readouterr().err
     assert "--try-options iwan0: iwan0: the count must be 1 to 16" in printed and "assumed" not in printed
     assert not (tmp_path / "c").exists()
+
+
+@pytest.mark.parametrize("extra", [[], ["--try-options", "none"]])
+def test_compare_tries_what_the_first_contact_tries_unless_told(tmp_path, capsys, extra):
+    sines = [DATA / f"synthetic_band_sine_{name}.csv" for name in ("2.5mm_0.5Hz", "4mm_2Hz")]
+    out = tmp_path / "compare"
+    assert main(["compare", *[a for s in sines for a in ("--sine", str(s))], "--models", "kelvin_voigt", *extra,
+                 "--screening", "64", "--starts", "2", "--no-ensemble", "--quiet", "--workers", "1",
+                 "--out", str(out)]) == 0
+    printed = capsys.readouterr()
+    with open(out / "comparison.csv") as handle:
+        rows = {row["model"]: row for row in csv.DictReader(handle)}
+    assert {"kelvin_voigt+rig", "kelvin_voigt"} <= set(rows)        # the rig assumed, weighed without it
+    if extra:
+        assert "kelvin_voigt+band+rig" not in rows
+    else:
+        assert "tried: band" in printed.out + printed.err
+        assert rows["kelvin_voigt+band+rig"]["recommended"] == "True"
