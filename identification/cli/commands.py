@@ -426,7 +426,7 @@ def compare_command(args) -> int:
         if tried is None:
             tried = list(contact.tried)
         print(contact.format(), file=sys.stderr)
-    variants += [_with_option(options, token, args) for token in tried or ()]
+    variants += [variant for variant in (_with_option(options, token, args) for token in tried or ()) if variant]
     tests = options.training(tests)
     models = [name.strip() for name in args.models.split(",") if name.strip()]
     unknown = []
@@ -478,12 +478,15 @@ def _tried_options(args) -> list[str] | None:
 
 
 def _with_option(options, token: str, args):
-    """``options`` (``ModelOptions``) with the option ``token`` added: a variant compare weighs."""
+    """``options`` (``ModelOptions``) with the option ``token`` added: a variant compare weighs (None
+    where the options have it already)."""
     from fmu_src.model.options import Options
     try:
         added = options.options.union(Options.parse([token]))
     except ParameterError as exc:
         raise UsageError(f"--try-options {token}: {exc}") from None
+    if added == options.options:        # already there: no variant
+        return None
     static = options.static_test.measurement if options.static_test is not None else None
     return build_model_options(added, fixed_values(args.fix), static, args.backbone_knots)
 

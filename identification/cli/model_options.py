@@ -19,7 +19,7 @@ Every problem is a ``UsageError`` naming the argument and what is allowed.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 from fmu_src.model.derived import derive
 from fmu_src.model.options import Options
@@ -103,7 +103,7 @@ def build_model_options(options: Options, fixed: dict, static=None, knots=None) 
                              "[mm], increasing")
         if options.count(BACKBONE) and options.count(BACKBONE) != len(knots):
             raise UsageError(f"--options backbone{options.count(BACKBONE)} and {len(knots)} backbone knots: give one count")
-        options = replace(options, knots=len(knots))
+        options = options.without(BACKBONE).union(Options(((BACKBONE, len(knots)),)))
         fixed.update({f"backbone_x{i + 1}": float(k) for i, k in enumerate(knots)})
     if curve is not None:
         forces = curve.parameters(pinned_at_zero=RIG in options)

@@ -227,7 +227,8 @@ class Objective:
             k = min(len(m), max(MIN_PREFIX_SAMPLES, math.ceil(fraction * len(m))))
             # a prefix of a step may end inside its ramp: as a plain time series, whose kind checks nothing
             cut.append(RigTest(replace(m, time_s=m.time_s[:k], displacement_mm=m.displacement_mm[:k],
-                                       force_N=m.force_N[:k], velocity_mm_s=m.velocity_mm_s[:k])))
+                                       force_N=m.force_N[:k], velocity_mm_s=m.velocity_mm_s[:k],
+                                       temperature_K=None if m.temperature_K is None else m.temperature_K[:k])))
         prefix = Objective(cut, self.noise, self.steps_per_sample, self.bushing)
         # the whole tests' forces at rest and strides (a prefix's own would judge them on less:
         # a cycle of a slow sine is longer than its prefix), its tests prepared again with them

@@ -504,14 +504,16 @@ def _check_steps(problem: Problem, records, n: int, d: int):
 
 def resting_notes(tests, rest_forces, bushing: BushingModel) -> list[str]:
     """The fit's notes on the tests that start at rest holding a force (``offsets.held_force``): the
-    model starts them there (its ``resting_state``), or cannot hold one and starts them relaxed."""
+    model starts them there (its ``resting_state``), or cannot hold one and starts them relaxed; and
+    on a step or random test whose rest is too short to count (``offsets.short_rest``)."""
     notes = []
     for test, rest in zip(tests, rest_forces):
         if math.isfinite(rest):
             notes.append(f"note: {test.name} holds {rest:+.4g} N at rest before it moves: the {bushing.name} model "
                          + ("starts it there, its elements stuck holding that force" if bushing.resting_state
                             is not None else "holds no force at rest and starts it relaxed"))
-        elif bushing.resting_state is not None and isinstance(test.measurement, Measurement):
+        elif bushing.resting_state is not None and test.kind != "sine" and isinstance(test.measurement, Measurement):
+            # a sine that starts at a turning point lingers there as a rest would: no note for it
             short = short_rest(test.measurement)
             if short is not None:
                 notes.append(f"note: {test.name} starts at {short[0]:+.4g} N but rests only {short[1] * 1e3:.3g} ms "

@@ -40,9 +40,9 @@ REST_MOTION = 0.002
 """The displacement is at rest while it stays within this fraction of its range of the first sample."""
 MIN_REST_SAMPLES = 20
 MIN_REST_S = 0.05
-BRIEF_REST_SAMPLES, BRIEF_REST_S = 5, 0.005
-"""A start at rest shorter than these is a motion's turning point, not a rest too short to count."""
 """A rest shorter than these (samples and seconds) is not read: its force is the start of the motion."""
+BRIEF_REST_SAMPLES, BRIEF_REST_S = 5, 0.005
+"""A start at rest shorter than these is no rest at all (a motion's first samples)."""
 OFFSET_FORCE = 0.02
 """A force at rest, or a cycles' mean force, beyond this fraction of the record's force half range..."""
 NOISE_LEVELS = 5.0

@@ -33,8 +33,10 @@ side's level at the step's end: exact where the level grows more slowly with the
 contact's force does (its slope; always with ratios 1), else first order in the step. In model
 exchange the engagement rises at v until the contact meets the level, then at the rate the growing
 level lets it (the state ``band_sliding`` [1] says which); the play's edges (``band_upper``,
-``band_lower``) and the slip's start and end (``band_slip``) are switches, whose events release
-the band in the play and start and stop the slide.
+``band_lower``), the slip's start and end (``band_slip``: a reversal, or the level outgrowing the
+contact) and the full wrap (``band_wrap``, where the level stops growing) are switches, whose
+events release the band in the play and start and stop the slide. At the neutral values (no
+contact, no level) the slip's switch is 0 throughout and never fires.
 """
 from __future__ import annotations
 
@@ -54,14 +56,14 @@ def band_specs(count: int = 0) -> tuple[ParameterSpec, ...]:
                       why="a negative stiffness is unstable"),
         ParameterSpec("band_depth", "mm", "the engagement over which the band's contact stiffness rises from 0 "
                       "to band_k (0: a linear contact)", minimum=0.0, why="a depth is a magnitude"),
-        ParameterSpec("band_f", "N", "the band's sliding level at a reversal", minimum=0.0,
+        ParameterSpec("band_f", "N", "the band's sliding level as a side engages", minimum=0.0,
                       why="a friction level is a magnitude", bound_powers=(0, 0)),
         ParameterSpec("band_ratio_pos", "1", "how many times band_f the level grows to over band_travel "
                       "moving the positive way (the capstan's exp(mu*theta); 1: Coulomb)", minimum=1.0,
                       why="below 1 the band would release as it wraps"),
         ParameterSpec("band_ratio_neg", "1", "how many times band_f the level grows to over band_travel "
                       "moving the negative way", minimum=1.0, why="below 1 the band would release as it wraps"),
-        ParameterSpec("band_travel", "mm", "the travel after a reversal over which the level grows to its "
+        ParameterSpec("band_travel", "mm", "the travel into an engaged side over which the level grows to its "
                       "ratio (0: at once)", minimum=0.0, why="a travel is a magnitude"),
     )
 
@@ -189,17 +191,28 @@ def band_travel_rate(c, e, v):
 
 def band_slip_switch(c, e, travel_since, sliding, v):
     \"\"\"The slip's switch (model exchange): while it sticks, the contact's force less its side's
-    level [N] (it rises through 0 where the slider starts to slide); while it slides, e*v
-    [mm^2/s] (it falls through 0 where the motion turns back out of the side).\"\"\"
+    level [N] (it rises through 0 where the slider starts to slide); while it slides, the least of
+    e*v [mm^2/s] (it falls through 0 where the motion turns back out of the side) and the contact's
+    slope less the level's growth with the travel [N/mm] (through 0 where the level outgrows the
+    contact, which then sticks).\"\"\"
     if sliding != 0.0:
-        return e * v
+        return min(e * v, band_slope(c, e) - band_level_rate(c, travel_since, e))
     return abs(band_contact(c, e)) - band_level(c, travel_since, e)
+
+
+def band_wrap_switch(c, travel_since):
+    \"\"\"The wrap's switch (model exchange): the travel less band_travel [mm]; where it rises
+    through 0 the level stops growing (the engagement's rate while sliding falls to 0).\"\"\"
+    return abs(travel_since) - c[6]
 
 
 def band_sliding_after(c, e, travel_since, sliding, v):
     \"\"\"Whether it slides [1] after an event (model exchange): it starts where the contact meets
-    its side's level moving on into it, and stops where the motion turns back.\"\"\"
+    its side's level moving on into it, with a slope the level's growth does not outrun, and stops
+    where the motion turns back or the level outgrows the contact.\"\"\"
     if e * v <= 0.0 or c[1] <= 0.0 or abs(e) <= c[0]:
+        return 0.0
+    if band_slope(c, e) <= band_level_rate(c, travel_since, e):
         return 0.0
     if sliding != 0.0 or abs(band_contact(c, e)) >= band_level(c, travel_since, e):
         return 1.0
@@ -263,8 +276,11 @@ ELEMENT = OptionElement(
     switches=lambda count: (
         ElementState("band_upper", "m", "band_engagement - band_gap: the positive side's edge"),
         ElementState("band_lower", "m", "band_engagement + band_gap: the negative side's edge"),
-        ElementState("band_slip", "1", "sticking: the contact force less its level; sliding: e*v")),
+        ElementState("band_slip", "1", "sticking: the contact force less its level; sliding: the least of e*v "
+                     "and the contact's slope less the level's growth"),
+        ElementState("band_wrap", "m", "band_travel_since less band_travel: where the level stops growing")),
     switch_values=lambda slot: (f"{slot.states[0]} - {slot.m}[0]", f"{slot.states[0]} + {slot.m}[0]",
-                                f"band_slip_switch({slot.m}, {', '.join(slot.states)}, v)"),
+                                f"band_slip_switch({slot.m}, {', '.join(slot.states)}, v)",
+                                f"band_wrap_switch({slot.m}, {slot.states[1]})"),
     neutral=(("band_gap", 0.0), ("band_k", 0.0), ("band_depth", 0.0), ("band_f", 0.0), ("band_ratio_pos", 1.0),
              ("band_ratio_neg", 1.0), ("band_travel", 0.0)))

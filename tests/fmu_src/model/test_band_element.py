@@ -64,7 +64,9 @@ def test_a_ramp_and_its_reversal_follow_the_contact_and_the_growing_level():
     into_negative = np.maximum(back - (peak_engagement + gap), 0.0)     # travel past the negative edge
     falling = np.maximum(contact(peak_engagement - back), -level(into_negative, 2.0))
     want = np.concatenate([rising, falling])
-    assert np.any(rising == level(x[:up.size], 4.0)) and rising[-1] == pytest.approx(400.0)
+    growing = (x[:up.size] - gap > 0.25) & (x[:up.size] - gap < 1.9)      # slid on the level as it grew
+    assert np.all(np.isclose(force[:up.size][growing], level(x[:up.size][growing] - gap, 4.0), rtol=1e-9))
+    assert rising[-1] == pytest.approx(400.0)
     assert falling[-1] == pytest.approx(-200.0) and np.any(-falling == level(into_negative, 2.0))
     np.testing.assert_allclose(force, want, rtol=0, atol=1e-9 * 400.0)
 
@@ -247,3 +249,43 @@ def test_a_six_axis_fmus_axis_takes_a_band_in_both_fmus(tmp_path):
         got = simulate_fmu(str(fmu), stop_time=t[-1], step_size=1e-3, output_interval=1e-3, input=signals,
                            output=["Fz"])["Fz"]
         np.testing.assert_allclose(got, want[:len(got)], rtol=0, atol=1e-12 * np.max(np.abs(want)))
+
+
+FAST = dict(PURE, band_gap=0.0, band_k=1000.0, band_depth=0.0, band_f=1.0, band_ratio_pos=100.0,
+            band_ratio_neg=100.0, band_travel=0.1)
+"""A level that outgrows the contact: at 100 N it grows at 100 ln(100)/0.1 = 4600 N/mm, the contact 1000 N/mm."""
+
+
+def ramp_in_continuous_time(s, p):
+    """The force [N] of a ramp into the contact (gap 0) at the travels s [mm], exactly: the slider
+    slides only where the contact meets the level, so F(s) = min(k s, min over s' <= s of
+    L(s') + k (s - s')) (the slip is the largest s' - L(s')/k so far)."""
+    k = p["band_k"]
+    levels = p["band_f"] * p["band_ratio_pos"] ** (np.minimum(s, p["band_travel"]) / p["band_travel"])
+    return np.minimum(k * s, np.minimum.accumulate(levels - k * s) + k * s)
+
+
+def test_where_the_level_outgrows_the_contact_the_band_sticks_until_the_wrap_is_full():
+    t = np.linspace(0.0, 0.3, 30001)                  # 1e-5 mm a step
+    t, x, v = path(t, dt=1e-5)
+    force = simulate_python_core(FAST, t, x, v, model="kelvin_voigt+band")
+    want = ramp_in_continuous_time(x, FAST)
+    assert want[-1] == pytest.approx(100.0) and np.any((want < 99.0) & (x > 0.1))   # it stuck below the wrap's level
+    np.testing.assert_allclose(force, want, rtol=0, atol=0.05)
+
+
+def test_model_exchange_where_the_level_outgrows_the_contact(tmp_path):
+    # the slide ends at an event where the level outgrows the contact, and the contact catches the
+    # level once the wrap is full: as the ramp in continuous time
+    import build_fmu
+    from model_exchange import simulate_model_exchange
+    if shutil.which("gcc") is None and shutil.which("cc") is None:
+        pytest.skip("no C compiler for the native FMU")
+    model = get_model("kelvin_voigt+band")
+    fmu = build_fmu.build_native_fmu(save_parameters(tmp_path / "fast.json", FAST, model.name), tmp_path,
+                                     model=model.name).path
+    t = np.linspace(0.0, 0.3, 31)
+    run = simulate_model_exchange(fmu, t, lambda s: s * 1e-3, lambda s: 1e-3)
+    fine = np.linspace(0.0, 0.3, 300001)              # the minimum over the path on a 1e-6 mm grid
+    want = np.interp(t, fine, ramp_in_continuous_time(fine, FAST))
+    np.testing.assert_allclose(run.force_N, want, rtol=0, atol=1e-3 * 100.0)

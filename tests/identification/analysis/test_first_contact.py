@@ -66,10 +66,14 @@ def test_a_rest_too_short_to_count_is_named_in_the_fits_notes_and_a_long_one_is_
     assert math.isnan(held_force(brief)) and force == pytest.approx(-250.0) and rest_s == pytest.approx(0.01, abs=5e-3)
     assert held_force(long) == pytest.approx(-250.0) and short_rest(long) is None
     assert short_rest(resting_sine(rest_s=0.0)) is None
-    notes = resting_notes([RigTest(brief), RigTest(long)], [held_force(brief), held_force(long)],
-                          get_model("asymmetric_bouc_wen"))
+    model = get_model("asymmetric_bouc_wen")
+    notes = resting_notes([RigTest(brief), RigTest(long)], [held_force(brief), held_force(long)], model)
     assert "resting_sine.csv starts at -250 N but rests only" in notes[0] and "starts it relaxed" in notes[0]
     assert "holds -250 N at rest before it moves" in notes[1]
+    # a slow sine from its turning point lingers there for 28 ms at 0.5 Hz: not a rest
+    t = np.arange(0.0, 4.0, 1e-3)
+    turning = Measurement(t, 2.0 * np.cos(np.pi * t), 100.0 * np.cos(np.pi * t), -2.0 * np.pi * np.sin(np.pi * t))
+    assert resting_notes([RigTest(turning, "sine")], [held_force(turning)], model) == []
 
 
 def test_the_rig_zeros_are_the_periodic_records_centres_else_the_rests():
@@ -238,3 +242,28 @@ def test_compare_tries_what_the_first_contact_tries_unless_told(tmp_path, capsys
     else:
         assert "tried: band" in printed.out + printed.err
         assert rows["kelvin_voigt+band+rig"]["recommended"] == "True"
+
+
+def test_a_static_curve_gives_every_model_its_backbone_held_at_the_curve():
+    from fmu_src.model.options import Options
+    from identification.cli.model_options import build_model_options
+    triangle = load_measurement(VOIDED["triangle_4.2mm_0.05Hz"])
+    options = build_model_options(Options.parse(["backbone9", "rig"]), {}, triangle)
+    assert options.options.tokens == ("backbone9", "rig")
+    knots = [options.fixed[f"backbone_x{i}"] for i in range(1, 10)]
+    assert all(b > a for a, b in zip(knots, knots[1:])) and {f"backbone_F{i}" for i in range(1, 10)} <= set(options.fixed)
+    assert options.fixed["rig_displacement_zero"] == 0.0
+    # knots given, no backbone named: the backbone takes their count
+    given = build_model_options(Options.parse(["maxwell"]), {}, triangle, knots=[-3.0, 0.0, 3.0])
+    assert given.options.tokens == ("backbone3", "maxwell")
+    assert [given.fixed[f"backbone_x{i}"] for i in (1, 2, 3)] == [-3.0, 0.0, 3.0]
+
+
+def test_compare_on_a_slow_triangle_assumes_its_backbone_and_fits(tmp_path, capsys):
+    out = tmp_path / "compare"
+    assert main(["compare", "--sine", str(VOIDED["triangle_4.2mm_0.05Hz"]), "--sine", str(VOIDED["sine_2mm_5Hz"]),
+                 "--models", "kelvin_voigt", "--screening", "32", "--starts", "2", "--no-ensemble", "--quiet",
+                 "--workers", "1", "--out", str(out)]) == 0
+    assert "assumed: backbone" in capsys.readouterr().out
+    with open(out / "comparison.csv") as handle:
+        assert any(row["model"].startswith("kelvin_voigt+backbone") for row in csv.DictReader(handle))
