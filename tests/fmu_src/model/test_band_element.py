@@ -92,28 +92,16 @@ def test_with_no_wrap_travel_it_is_the_classical_band_brake_of_two_levels():
 
 
 def reference_band(x, p):
-    """The band's force [N] along x [mm], stepped sample to sample from its definition: the
-    engagement's trial; the travel into the engaged side (from its edge where it engages, the
-    motion into it added while it stays engaged, 0 in the play); a slide back to where the contact
-    force meets that side's level (found with scipy's brentq)."""
-    gap = p["band_gap"]
-    e, s = 0.0, 0.0                   # engagement [mm], travel into the engaged side [mm] (>= 0)
-    out = np.zeros(x.size)
-    for i in range(1, x.size):
-        trial = e + (x[i] - x[i - 1])
-        side = math.copysign(1.0, trial)
-        if abs(trial) <= gap:
-            s = 0.0
-        elif abs(e) > gap and math.copysign(1.0, e) == side:
-            s += max(side * (trial - e), 0.0)
-        else:
-            s = abs(trial) - gap
-        e = trial
-        limit = float(level(s, p["band_ratio_pos"] if side > 0 else p["band_ratio_neg"], p))
-        if abs(trial) > gap and side * float(contact(e, p)) > limit:
-            e = side * brentq(lambda a: float(contact(a, p)) - limit, gap, gap + 1e3, xtol=1e-15, rtol=1e-15)
-        out[i] = float(contact(e, p))
-    return out
+    """The band's force [N] along x [mm], stepped sample to sample from its definition by
+    tests/references/band_brake.py (the engagement's trial; the travel into the engaged side;
+    a slide back to where the contact force meets that side's level, found with scipy's brentq)."""
+    import sys
+    from conftest import REPO
+    sys.path.insert(0, str(REPO / "tests" / "references"))
+    import band_brake
+    laws = dict(gap=p["band_gap"], kc=p["band_k"], d=p["band_depth"], f=p["band_f"], r_pos=p["band_ratio_pos"],
+                r_neg=p["band_ratio_neg"], S=p["band_travel"])
+    return band_brake.band_force(laws, x)
 
 
 def test_a_random_path_is_its_definition_stepped_with_numpy_and_scipys_roots():
