@@ -26,7 +26,12 @@ One more is tried rather than assumed: where a sine's loops dissipate more than
 over 4 F x with F and x the force's and the stroke's half ranges: 1 for Coulomb's friction,
 (pi/4) sin(delta) for a linear element of loss angle delta, under 0.3 for the rubber bushings
 here), the device dissipates as friction (or a fluid) does, and ``band`` (self-energizing
-friction through a play) is tried on the recommended model (``--try-options``).
+friction through a play) is tried on the recommended model (``--try-options``), unless the
+training shows its dissipation depends on the rate, as a fluid's or rubber's does and friction's
+does not: a training data sheet whose loss angle spans more than ``RATE_DEPENDENT_LOSS_DEG`` over
+frequency at one amplitude, or two sines of one amplitude (within ``SAME_AMPLITUDE``) whose
+loops' shares differ by more than ``RATE_DEPENDENT_SHARE`` of the larger, itself beyond
+``DISSIPATIVE_LOOP`` (a linear viscous element's share doubles with the frequency).
 
 ``compare`` races every model with what was assumed and then weighs the recommended model
 without each assumed option in turn (``compare.CompareOptions.alternatives``): an option that
@@ -60,6 +65,11 @@ END_STIFFENING = 3.0
 KNOT_COUNTS = (9, 17)
 DISSIPATIVE_LOOP = 0.35
 """A sine whose loops take more than this share of 4 F x a cycle dissipates as friction does."""
+RATE_DEPENDENT_LOSS_DEG = 10.0
+"""A data sheet whose loss angle spans more than this over frequency at one amplitude is rate-dependent."""
+SAME_AMPLITUDE, RATE_DEPENDENT_SHARE = 0.2, 0.4
+"""Two sines within this fraction of one amplitude whose loops' shares differ by more than this
+fraction of the larger dissipate by the rate."""
 
 
 @dataclass(frozen=True)
@@ -211,11 +221,31 @@ def loop_dissipation(measurement) -> float:
     return energy / (float(np.ptp(fi)) * float(np.ptp(xi)))       # 4 F x with F, x the half ranges
 
 
-def _dissipative(tests: Sequence[RigTest]) -> str:
-    """Why the band is tried ("": it is not): the sine whose loops dissipate most."""
+def _rate_dependent(tests: Sequence[RigTest], table) -> bool:
+    """Whether the training shows a dissipation that depends on the rate (module docstring)."""
+    if table is not None:
+        for amplitude in np.unique(table.amplitude_mm):
+            angles = table.loss_angle_deg[table.amplitude_mm == amplitude]
+            if angles.size > 1 and float(np.ptp(angles)) > RATE_DEPENDENT_LOSS_DEG:
+                return True
+    sines = [(0.5 * float(np.ptp(t.measurement.displacement_mm)), loop_dissipation(t.measurement))
+             for t in tests if t.kind == "sine"]
+    sines = [(a, share) for a, share in sines if math.isfinite(share) and a > 0]
+    for i, (a, share) in enumerate(sines):
+        for b, other in sines[i + 1:]:
+            larger = max(share, other)      # only loops that dissipate count: a small share is mostly noise
+            if abs(a - b) <= SAME_AMPLITUDE * max(a, b) and larger > DISSIPATIVE_LOOP and \
+                    abs(share - other) > RATE_DEPENDENT_SHARE * larger:
+                return True
+    return False
+
+
+def _dissipative(tests: Sequence[RigTest], table=None) -> str:
+    """Why the band is tried ("": it is not): the sine whose loops dissipate most, where the
+    training shows no rate-dependent dissipation."""
     shares = [(loop_dissipation(t.measurement), t.name) for t in tests if t.kind == "sine"]
     shares = [(share, name) for share, name in shares if math.isfinite(share)]
-    if not shares:
+    if not shares or _rate_dependent(tests, table):
         return ""
     share, name = max(shares)
     if share <= DISSIPATIVE_LOOP:
@@ -225,10 +255,10 @@ def _dissipative(tests: Sequence[RigTest]) -> str:
             "does: a band brake's self-energizing friction through a play is tried")
 
 
-def first_contact(tests: Sequence[RigTest], static_test: RigTest | None = None) -> FirstContact:
-    """What the training ``tests`` (and a quasi-static ``static_test``, if given) ask the models
-    to have (module docstring). A quasi-static training test is taken as the static test where none
-    is given."""
+def first_contact(tests: Sequence[RigTest], static_test: RigTest | None = None, table=None) -> FirstContact:
+    """What the training ``tests`` (and a quasi-static ``static_test``, and a training data sheet
+    ``table``, if given) ask the models to have (module docstring). A quasi-static training test is
+    taken as the static test where none is given."""
     tests = list(tests)
     offsets = [record_offsets(t.measurement) for t in tests]
     if static_test is None:
@@ -254,6 +284,6 @@ def first_contact(tests: Sequence[RigTest], static_test: RigTest | None = None) 
             stops = _stops(largest)
             if stops:
                 assumptions.append(Assumption("limits", stops + ": a travel limit each side"))
-    dissipative = _dissipative(tests)
+    dissipative = _dissipative(tests, table)
     trials = (Assumption("band", dissipative),) if dissipative else ()
     return FirstContact(tuple(assumptions), static_test, trials)

@@ -415,7 +415,7 @@ def compare_command(args) -> int:
     options = model_options_of(args)
     contact, variants = None, []
     if args.options is None:        # a new device's first contact: the options its tests ask for
-        contact = first_contact(tests, options.static_test)
+        contact = first_contact(tests, options.static_test, training_table)
         static = contact.static_test.measurement if contact.static_test is not None else None
 
         def options_of(tokens):

@@ -267,3 +267,18 @@ def test_compare_on_a_slow_triangle_assumes_its_backbone_and_fits(tmp_path, caps
     assert "assumed: backbone" in capsys.readouterr().out
     with open(out / "comparison.csv") as handle:
         assert any(row["model"].startswith("kelvin_voigt+backbone") for row in csv.DictReader(handle))
+
+
+def test_the_band_is_not_tried_where_the_dissipation_depends_on_the_rate():
+    # a dashpot's loops dissipate much of 4 F x, but twice the share at twice the frequency: not friction
+    def viscous(hz):
+        t = np.arange(0.0, 4.0 / hz, 1e-3)
+        x, v = 2.0 * np.sin(2 * np.pi * hz * t), 4.0 * np.pi * hz * np.cos(2 * np.pi * hz * t)
+        return RigTest(Measurement(t, x, 100.0 * x + 5.0 * v, v, source=f"viscous_{hz}Hz.csv"), "sine")
+    one, two = viscous(1.0), viscous(2.0)
+    assert first_contact([two]).tried == ("band",)            # one sine alone does not tell
+    assert first_contact([one, two]).tried == ()
+    from identification.measured.kdyn_table import load_kdyn_table
+    sheet = load_kdyn_table(DATA / "kdyn_synthetic_hydraulic_train.csv")        # its loss angle peaks over frequency
+    hydraulic = RigTest(load_measurement(DATA / "synthetic_hydraulic_sine_1mm_8Hz.csv"), "sine")
+    assert first_contact([hydraulic]).tried == ("band",) and first_contact([hydraulic], None, sheet).tried == ()
