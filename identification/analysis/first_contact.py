@@ -221,16 +221,16 @@ def loop_dissipation(measurement) -> float:
     return energy / (float(np.ptp(fi)) * float(np.ptp(xi)))       # 4 F x with F, x the half ranges
 
 
-def _rate_dependent(tests: Sequence[RigTest], table) -> bool:
-    """Whether the training shows a dissipation that depends on the rate (module docstring)."""
+def _rate_dependent(sines, table) -> bool:
+    """Whether the training shows a dissipation that depends on the rate (module docstring):
+    ``sines`` the (loop dissipation, amplitude [mm]) of the training sines, ``table`` a training
+    data sheet or None."""
     if table is not None:
         for amplitude in np.unique(table.amplitude_mm):
             angles = table.loss_angle_deg[table.amplitude_mm == amplitude]
             if angles.size > 1 and float(np.ptp(angles)) > RATE_DEPENDENT_LOSS_DEG:
                 return True
-    sines = [(0.5 * float(np.ptp(t.measurement.displacement_mm)), loop_dissipation(t.measurement))
-             for t in tests if t.kind == "sine"]
-    sines = [(a, share) for a, share in sines if math.isfinite(share) and a > 0]
+    sines = [(a, share) for share, a in sines if a > 0]
     for i, (a, share) in enumerate(sines):
         for b, other in sines[i + 1:]:
             larger = max(share, other)      # only loops that dissipate count: a small share is mostly noise
@@ -243,11 +243,12 @@ def _rate_dependent(tests: Sequence[RigTest], table) -> bool:
 def _dissipative(tests: Sequence[RigTest], table=None) -> str:
     """Why the band is tried ("": it is not): the sine whose loops dissipate most, where the
     training shows no rate-dependent dissipation."""
-    shares = [(loop_dissipation(t.measurement), t.name) for t in tests if t.kind == "sine"]
-    shares = [(share, name) for share, name in shares if math.isfinite(share)]
-    if not shares or _rate_dependent(tests, table):
+    shares = [(loop_dissipation(t.measurement), t.name, 0.5 * float(np.ptp(t.measurement.displacement_mm)))
+              for t in tests if t.kind == "sine"]
+    shares = [entry for entry in shares if math.isfinite(entry[0])]
+    if not shares or _rate_dependent([(share, a) for share, _, a in shares], table):
         return ""
-    share, name = max(shares)
+    share, name, _ = max(shares)
     if share <= DISSIPATIVE_LOOP:
         return ""
     return (f"the loops of {name} dissipate {share:.2f} of the rectangle their force and stroke span (Coulomb's "

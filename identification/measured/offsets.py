@@ -79,14 +79,20 @@ class RecordOffsets:
         return math.isfinite(self.frequency_hz) and self.frequency_hz <= QUASI_STATIC_HZ
 
 
-def rest_at_start(measurement: Measurement) -> tuple[float, float]:
-    """(the median force [N] while the displacement rests at its first value, how long [s]), or
-    (NaN, the rest's length) where the rest is shorter than MIN_REST_SAMPLES and MIN_REST_S."""
+def _rest(measurement: Measurement) -> tuple[int, float]:
+    """(the samples, how long [s]) the displacement rests at its first value (within REST_MOTION
+    of its range): the whole record where it never moves."""
     x, t = measurement.displacement_mm, measurement.time_s
     span = float(np.ptp(x))
     moved = np.flatnonzero(np.abs(x - x[0]) > REST_MOTION * span) if span > 0 else np.array([], dtype=int)
     end = int(moved[0]) if moved.size else x.size
-    rest_s = float(t[end - 1] - t[0]) if end > 0 else 0.0
+    return end, float(t[end - 1] - t[0]) if end > 0 else 0.0
+
+
+def rest_at_start(measurement: Measurement) -> tuple[float, float]:
+    """(the median force [N] while the displacement rests at its first value, how long [s]), or
+    (NaN, the rest's length) where the rest is shorter than MIN_REST_SAMPLES and MIN_REST_S."""
+    end, rest_s = _rest(measurement)
     if end < MIN_REST_SAMPLES or rest_s < MIN_REST_S:
         return math.nan, rest_s
     return float(np.median(measurement.force_N[:end])), rest_s
@@ -139,15 +145,11 @@ def offset_floor(measurement: Measurement, offsets: RecordOffsets | None = None)
 def short_rest(measurement: Measurement) -> tuple[float, float] | None:
     """(the median force [N], how long [s]) of a rest at the start too short to count as one
     (fewer than MIN_REST_SAMPLES samples or shorter than MIN_REST_S) whose force exceeds the
-    record's offset floor; None where there is no such rest. A start shorter than
-    BRIEF_REST_SAMPLES samples or BRIEF_REST_S is a motion's turning point, not a rest."""
-    x, t = measurement.displacement_mm, measurement.time_s
-    span = float(np.ptp(x))
-    if span <= 0.0:
+    record's offset floor; None where there is no such rest, or no motion. A start shorter than
+    BRIEF_REST_SAMPLES samples or BRIEF_REST_S is no rest at all."""
+    if float(np.ptp(measurement.displacement_mm)) <= 0.0:
         return None
-    moved = np.flatnonzero(np.abs(x - x[0]) > REST_MOTION * span)
-    end = int(moved[0]) if moved.size else x.size
-    rest_s = float(t[end - 1] - t[0]) if end > 0 else 0.0
+    end, rest_s = _rest(measurement)
     if end < BRIEF_REST_SAMPLES or rest_s < BRIEF_REST_S or (end >= MIN_REST_SAMPLES and rest_s >= MIN_REST_S):
         return None
     force = float(np.median(measurement.force_N[:end]))

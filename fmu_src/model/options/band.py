@@ -105,25 +105,29 @@ def band_slope(c, e):
     return k
 
 
+def band_travel_on(travel_since, side):
+    \"\"\"The travel [mm] into the side of side's sign: travel_since (signed: its sign the engaged
+    side's) where it belongs to that side, else 0.\"\"\"
+    if (travel_since > 0.0) != (side > 0.0):
+        return 0.0
+    return abs(travel_since)
+
+
 def band_level(c, travel_since, side):
-    \"\"\"The slider's level [N] on the side of side's sign, travel_since [mm] (signed: its sign the
-    engaged side's) after that side engaged: band_f on a side the travel does not belong to.\"\"\"
+    \"\"\"The slider's level [N] on the side of side's sign, travel_since [mm] (signed) after that
+    side engaged: band_f on a side the travel does not belong to.\"\"\"
     gap, k, depth, f, ratio_pos, ratio_neg, travel = c
     ratio = ratio_pos if side > 0.0 else ratio_neg
-    if (travel_since > 0.0) != (side > 0.0):
-        travel_since = 0.0
-    travel_since = abs(travel_since)
-    if travel_since >= travel:
+    s = band_travel_on(travel_since, side)
+    if s >= travel:
         return f * ratio
-    return f * math.exp(math.log(ratio) * travel_since / travel)
+    return f * math.exp(math.log(ratio) * s / travel)
 
 
 def band_level_rate(c, travel_since, side):
     \"\"\"d band_level/d travel [N/mm]: 0 once the level has grown to its ratio.\"\"\"
     gap, k, depth, f, ratio_pos, ratio_neg, travel = c
-    if (travel_since > 0.0) != (side > 0.0):
-        travel_since = 0.0
-    if abs(travel_since) >= travel:
+    if band_travel_on(travel_since, side) >= travel:
         return 0.0
     ratio = ratio_pos if side > 0.0 else ratio_neg
     return band_level(c, travel_since, side) * math.log(ratio) / travel
