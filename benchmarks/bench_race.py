@@ -1,7 +1,7 @@
 """``compare``'s race on the project's comparison cases (issue 50): the time, the recommendation,
 and how far each model's least-squares stages lowered its best screened misfit.
 
-    python benchmarks/bench_race.py [CASE ...] [--workers N] [--only race|all]
+    python benchmarks/bench_race.py [CASE ...] [--workers N] [--only race|all|stages]
 
 Every case runs ``python -m identification compare`` twice, side by side in one run, with the
 compiled models' cache as it is (run once before to fill it):
@@ -9,12 +9,15 @@ compiled models' cache as it is (run once before to fill it):
 - ``all``: every model runs its stages and every ensemble is sampled (``--no-race
   --every-ensemble``: compare before the race);
 - ``race``: the default (a model that cannot win stops after its screening; the ensemble of the
-  recommended model only).
+  recommended model only);
+- ``stages`` (only with ``--only stages``): every model runs its stages, no ensemble but the
+  recommended model's (``--no-race``): the factors below without the ensembles' time.
 
-Prints per case the two wall times and recommendations, and per model of the ``all`` run its best
-chi^2/n after the screening, after the first least-squares stage and at the end, and the factor
-the later stages closed (first stage over final: ``identification.analysis.race.RACE_CLOSING``
-must stay above the largest, with a margin), and which models the race stopped.
+Prints per case the two wall times and recommendations, and per model of the ``all`` (or
+``stages``) run its best chi^2/n after the screening, after the first least-squares stage, before
+the last stage and at the end, and the factors the later stages closed (first stage over final:
+``identification.analysis.race.RACE_CLOSING`` must stay above the largest, with a margin; before
+the last stage over final: ``RACE_CLOSING_LAST``), and which models the race stopped.
 
 The cases (data/): ``table5`` the paper's synthetic Table 5 sine and step (held out: its random
 input and the Table 6 grid); ``filled-rubber`` the synthetic filled rubber's two sines and step
@@ -59,11 +62,13 @@ CASES = {
                           for a in ("--validate", str(path))],
 }
 RUNS = {"all": ["--no-race", "--every-ensemble"], "race": []}
+EVERY_STAGE = {"stages": ["--no-race"]}
 
 
 def compare(case: str, run: str, workers: int, out: Path) -> tuple[float, str, dict]:
     """(wall time [s], the recommendation, comparison.csv's rows by model) of one compare."""
-    arguments = [sys.executable, "-m", "identification", "compare", *CASES[case], *RUNS[run], "--workers",
+    arguments = [sys.executable, "-m", "identification", "compare", *CASES[case], *{**RUNS, **EVERY_STAGE}[run],
+                 "--workers",
                  str(workers), "--quiet", "--out", str(out)]
     started = time.perf_counter()
     done = subprocess.run(arguments, cwd=REPO, capture_output=True, text=True)
@@ -79,13 +84,13 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("cases", nargs="*", metavar="CASE", help=f"of {', '.join(CASES)} (default: all)")
     parser.add_argument("--workers", type=int, default=2)
-    parser.add_argument("--only", choices=list(RUNS), help="one of the two runs per case")
+    parser.add_argument("--only", choices=list(RUNS) + list(EVERY_STAGE), help="one of the runs per case")
     args = parser.parse_args()
     unknown = [case for case in args.cases if case not in CASES]
     if unknown:
         parser.error(f"unknown cases {', '.join(unknown)}: choose from {', '.join(CASES)}")
     print(harness.provenance(), flush=True)
-    closing = []
+    closing, closing_last = [], []
     for case in args.cases or list(CASES):
         with tempfile.TemporaryDirectory() as folder:
             outcome = {run: compare(case, run, args.workers, Path(folder) / run)
@@ -94,15 +99,17 @@ def main() -> None:
             stopped = [model for model, row in rows.items() if row["stopped_after_screening"]]
             print(f"{case:15s} {run:4s}: {wall:6.1f} s wall; {recommended}"
                   + (f"; stopped after screening: {', '.join(stopped)}" if stopped else ""), flush=True)
-        if "all" in outcome:
-            for model, row in outcome["all"][2].items():
+        for run in ("all", "stages"):
+            for model, row in outcome.get(run, (0, "", {}))[2].items():
                 if row["first_stage_misfit_chi2_per_residual"]:
-                    screened, first, final = (float(row[column]) for column in (
+                    screened, first, before_last, final = (float(row[column]) for column in (
                         "screened_misfit_chi2_per_residual", "first_stage_misfit_chi2_per_residual",
-                        "misfit_chi2_per_residual"))
+                        "before_last_stage_misfit_chi2_per_residual", "misfit_chi2_per_residual"))
                     closing.append((first / final, case, model))
-                    print(f"    {model:26s} chi2/n screened {screened:10.4g}  first stage {first:10.4g}  final "
-                          f"{final:10.4g}  later stages closed {first / final:7.3g}x", flush=True)
+                    closing_last.append((before_last / final, case, model))
+                    print(f"    {model:26s} chi2/n screened {screened:10.4g}  first stage {first:10.4g}  before the "
+                          f"last {before_last:10.4g}  final {final:10.4g}  later stages closed {first / final:7.3g}x, "
+                          f"the last {before_last / final:7.3g}x", flush=True)
         if len(outcome) == 2:
             same = outcome["all"][1] == outcome["race"][1]
             print(f"    race / all: {outcome['race'][0] / outcome['all'][0]:.2f} of the time; "
@@ -110,6 +117,8 @@ def main() -> None:
     if closing:
         factor, case, model = max(closing)
         print(f"the largest factor the stages after the first closed: {factor:.3g}x ({model}, {case})")
+        factor, case, model = max(closing_last)
+        print(f"the largest factor the last stage closed: {factor:.3g}x ({model}, {case})")
 
 
 if __name__ == "__main__":

@@ -80,6 +80,7 @@ class Assessment:
     floor: str = "the noise"                # what sets the worst training test's floor (RigTestFit.floor_words)
     screened_misfit: float | None = None    # the best chi^2/n of its screening (None: a linear model)
     first_stage_misfit: float | None = None  # the best chi^2/n after its first least-squares stage
+    before_last_misfit: float | None = None  # the best chi^2/n after every stage but the last
     validation: dict[str, tuple[float, float]] = field(default_factory=dict)   # held-out file: (NRMSE, eq. 10)
     table: TableFit | None = None          # the held-out table at the fitted parameters
 
@@ -105,7 +106,7 @@ class Assessment:
         floor = worst.floor_words if worst is not None and worst.ratio == max(ratios) else "the noise"
         return cls(result.model, result.free_parameters, result.residuals, result.misfit,
                    max(ratios, default=math.nan), result.at_floor, result.converged, result.seconds, floor,
-                   result.screened_misfit, result.first_stage_misfit)
+                   result.screened_misfit, result.first_stage_misfit, result.before_last_misfit)
 
 
 @dataclass(frozen=True)
@@ -538,7 +539,7 @@ def format_assessments(assessments: Sequence[Assessment], recommendation: Recomm
                      f"{'yes' if a.at_floor else 'NO':>5s} {a.misfit:9.3f} {a.information_criterion - best_bic:9.1f} "
                      f"{held:>14s} {table:>13s}{mark}")
     for s in stopped:
-        lines.append(f"{s.model:{width}s} {s.free_parameters:6d}  stopped after its screening: {s.reason}")
+        lines.append(f"{s.model:{width}s} {s.free_parameters:6d}  stopped {s.when}: {s.reason}")
     lines.append(f"floor: every training test's NRMSE within {FLOOR_FACTOR}x its noise level or, for a sine whose "
                  "device repeats less than that from cycle to cycle, its repeatability (a training table's "
                  f"rms error within {FLOOR_FACTOR}x its uncertainty; the column is the worst of them); dBIC: BIC = chi^2 + "
@@ -626,7 +627,8 @@ def _write_comparison(out_dir: Path, assessments, recommendation: Recommendation
                          "misfit_chi2_per_residual", "residuals", "bic", "delta_bic", "held_out_mean_nrmse",
                          "table_error_over_uncertainty", "table_largest_kdyn_error", "table_largest_loss_angle_error_deg",
                          "seconds", "recommended", "screened_misfit_chi2_per_residual",
-                         "first_stage_misfit_chi2_per_residual", "stopped_after_screening"])
+                         "first_stage_misfit_chi2_per_residual", "before_last_stage_misfit_chi2_per_residual",
+                         "stopped_after_screening"])
         for a in assessments:
             kdyn = np.max(np.abs(a.table.kdyn_errors)) if a.table is not None else None
             angle = np.max(np.abs(a.table.angle_errors_deg)) if a.table is not None else None
@@ -636,11 +638,11 @@ def _write_comparison(out_dir: Path, assessments, recommendation: Recommendation
                              _cell(a.table_error), _cell(kdyn), _cell(angle), f"{a.seconds:.1f}",
                              "" if recommendation is None else a.model == recommendation.model,
                              _cell(a.screened_misfit),
-                             _cell(a.first_stage_misfit), ""])
+                             _cell(a.first_stage_misfit), _cell(a.before_last_misfit), ""])
         for s in stopped:
             writer.writerow([s.model, s.free_parameters, "", False, False, "", "", "", "", "", "", "", "",
                              f"{s.seconds:.1f}", False, _cell(s.screened_misfit), _cell(s.first_stage_misfit),
-                             s.reason])
+                             _cell(s.before_last_misfit), s.reason])
 
 
 def _cell(value) -> str:

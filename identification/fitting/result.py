@@ -243,6 +243,7 @@ class FitResult(FittedParameters):
     coupling: str | None = None            # how the model ran on the multi-axis tests (None: there were none)
     screened_misfit: float | None = None   # the global phase's best chi^2/n (None: no search, a linear model)
     first_stage_misfit: float | None = None  # the best chi^2/n after the first least-squares stage
+    before_last_misfit: float | None = None  # the best chi^2/n after every stage but the last
 
     @property
     def free_parameters(self) -> int:

@@ -199,6 +199,8 @@ class Search:
         self.first_records = None    # the starts after the first least-squares stage
         self.first_stage_misfit = None  # the best chi^2/n after the first least-squares stage (the
         # screened one where the preset has a single stage, which is the last)
+        self.early_records = None    # the starts after every stage but the last
+        self.before_last_misfit = None  # the best chi^2/n of those (the first stage's with two stages or one)
         self.problem = None
         self.final_state = None      # what the stages left for the result
         self.result = None
@@ -255,6 +257,25 @@ class Search:
         # read now: the later stages go on with these records
         self.first_stage_misfit = min((r.misfit for r in self.first_records if not r.failed),
                                        default=self.screened_misfit)
+
+    def early_stages(self) -> float:
+        """Every least-squares stage but the last (the first, where :meth:`first_stage` has not
+        run it); the best misfit (chi^2/n) they reached. :meth:`finish` runs the last from there."""
+        began = time.perf_counter()
+        self._early_stages()
+        self.bars.close()
+        self.seconds += time.perf_counter() - began
+        return self.before_last_misfit
+
+    def _early_stages(self) -> None:
+        if self.early_records is not None:
+            return
+        self._first_stage()
+        early = self.request.settings.stages[:-1]
+        self.early_records = run_stages(self.problem, self.engine, self.first_records, early[1:], self.bars.stage,
+                                        first_stage=1)
+        self.before_last_misfit = min((r.misfit for r in self.early_records if not r.failed),
+                                      default=self.first_stage_misfit)
 
     def start_jacobian_compile(self) -> None:
         """Start compiling (or loading) the exact Jacobian's module on a thread, once, where the
@@ -365,10 +386,10 @@ class Search:
         reports (identification.fitting.refinement). A lone best start gets company before the
         check at the best fit (_extend_if_alone)."""
         space, engine, bars = self.space, self.engine, self.bars
-        self._first_stage()
+        self._early_stages()
         *early, last = self.request.settings.stages
         n, d = self.n, self.d
-        records = run_stages(self.problem, engine, self.first_records, early[1:], bars.stage, first_stage=1)
+        records = self.early_records
         refinement = _check_steps(self.problem, records, n, d)
         problem = Problem(refinement.objective.with_fit_loop(), space, self.jacobian_kind)
         records = run_stages(problem, engine, records, [last], bars.stage, first_stage=len(early))
@@ -449,7 +470,8 @@ class Search:
                            agreed_before_added=agreeing, ensemble_sampled=sample, residuals=n,
                            failed_starts=failed_starts(records) + failed_profiles,
                            coupling=request.multi.coupling if request.multi.measurements else None,
-                           screened_misfit=self.screened_misfit, first_stage_misfit=self.first_stage_misfit)
+                           screened_misfit=self.screened_misfit, first_stage_misfit=self.first_stage_misfit,
+                           before_last_misfit=self.before_last_misfit)
         result.parameters.provenance = result.provenance()
         return result
 

@@ -77,6 +77,81 @@ def test_the_default_closing_is_the_measured_constant(monkeypatch):
     assert out_of_race(15.7, 6, 1000, [Finished("leader", 1.0, True)]) is None
 
 
+def test_before_its_last_stage_a_model_is_weighed_with_the_last_stages_factor():
+    leader = Finished("leader", 1.0, True)
+    # 8 / 2 = 4 > 1.25^2: the last stage cannot bring it to the floor the leader reached
+    reason = out_of_race(8.0, 6, 1000, [leader], closing=2.0, reached=race.BEFORE_LAST_STAGE)
+    assert reason is not None and "before its last stage" in reason and "2x" in reason
+    assert out_of_race(3.0, 6, 1000, [leader], closing=2.0, reached=race.BEFORE_LAST_STAGE) is None
+
+
+class StandInSearch:
+    """What race_models asks of a search, with the misfits each step reaches given."""
+    jacobian_kind = "none"      # nothing for the module pipeline to compile
+    problem = None
+    d, n = 6, 1000
+
+    def __init__(self, name, screened, first, before_last, final):
+        self.request = type("Request", (), {"model": type("Model", (), {"title": name, "name": name})()})()
+        self.name, self.misfits, self.seconds, self.steps = name, (screened, first, before_last, final), 0.0, []
+
+    def prepare(self):
+        pass
+
+    def screen(self, compile_beside=True, since=None):
+        self.steps.append("screen")
+        return self.misfits[0]
+
+    @property
+    def screened_misfit(self):
+        return self.misfits[0]
+
+    def first_stage(self):
+        self.steps.append("first stage")
+        return self.misfits[1]
+
+    @property
+    def first_stage_misfit(self):
+        return self.misfits[1]
+
+    def early_stages(self):
+        self.steps.append("early stages")
+        return self.misfits[2]
+
+    def finish(self, ensemble=None):
+        self.steps.append("last stage")
+        result = Finished(self.name, self.misfits[3], self.misfits[3] <= 1.25 ** 2)
+        result.converged, result.seconds = True, 0.0
+        return result
+
+
+@pytest.mark.parametrize("race_on", [True, False])
+def test_a_model_far_from_the_leader_after_its_middle_stage_skips_its_last(monkeypatch, race_on):
+    # the leader reaches the floor; the other's first stage (9) could still come down to it
+    # (9 / 10 < 1.5625), its middle stage (8) cannot with the last stage's factor (8 / 2 > 1.5625)
+    searches = {"leader": StandInSearch("leader", 2.0, 1.2, 1.1, 1.0),
+                "other": StandInSearch("other", 12.0, 9.0, 8.0, 7.5)}
+    monkeypatch.setattr(race, "begin", lambda request, *rest: searches[request.model.name])
+    monkeypatch.setattr(race, "RACE_CLOSING", 10.0)
+    monkeypatch.setattr(race, "RACE_CLOSING_LAST", 2.0)
+    requests = [type("Request", (), {"model": type("Model", (), {"name": name, "linear": None})()})()
+                for name in ("other", "leader")]
+    settled = []
+    results, stopped, _ = race.race_models(requests, engine=None, race=race_on, progress=False,
+                                           on_settled=lambda r, s: settled.append((sorted(r), len(s))))
+    # without the race the stages run through (finish runs the early ones itself)
+    assert searches["leader"].steps == (["screen", "first stage", "early stages", "last stage"] if race_on
+                                        else ["screen", "first stage", "last stage"])
+    if race_on:
+        assert sorted(results) == ["leader"] and [s.model for s in stopped] == ["other"]
+        assert searches["other"].steps == ["screen", "first stage", "early stages"]
+        assert stopped[0].when == "before its last stage" and stopped[0].before_last_misfit == 8.0
+        assert settled == [(["leader"], 0), (["leader"], 1)]
+    else:
+        assert sorted(results) == ["leader", "other"] and not stopped
+        assert searches["other"].steps[-1] == "last stage"
+
+
 def test_two_threads_asking_for_one_sensitivity_module_compile_it_once(monkeypatch):
     made = []
 
