@@ -89,6 +89,7 @@ def main() -> None:
 
     import warnings
     from identification import fit, training_tests
+    from fmu_src.model.registry import get_model
     from identification.forward.parameter_jacobian import sensitivity_module
     from identification.fitting.result import FitNotConvergedWarning
     from identification.fitting.multistart import Problem, difference_jacobian, jacobian
@@ -100,7 +101,7 @@ def main() -> None:
     print(f"tests: {Path(args.sine).name}, {Path(args.step).name} (rise {args.rise_time} s); default preset, "
           f"seed {args.seed}, {args.workers} workers, ensemble {'off' if args.no_ensemble else 'on'}")
     started = time.perf_counter()
-    sensitivity_module("proposed", 14)
+    sensitivity_module(get_model("proposed"), 14)
     print(f"sensitivity module compiled or loaded in this process: {time.perf_counter() - started:.1f} s")
 
     print(f"{'jacobian':11s} {'wall s':>8s} {'CPU s':>8s} {'chi2/n':>9s}   {'NRMSE/noise':14s} {'floor':5s} "

@@ -17,7 +17,9 @@ model is adding such a module; this registry, the FMUs, parameter files, the fit
 """
 from __future__ import annotations
 
+import copyreg
 import importlib
+import pickle
 import pkgutil
 
 from .parameter_specs import ParameterError
@@ -81,3 +83,31 @@ def resolve_model(model: str | BushingModel) -> BushingModel:
     """``model`` itself if it is a ``BushingModel``, else the model of that name (:func:`get_model`):
     what a front door that takes either resolves once, to pass the model on."""
     return model if isinstance(model, BushingModel) else get_model(model)
+
+
+DEFAULT_BUSHING = MODELS[DEFAULT_MODEL]
+"""The model of ``DEFAULT_MODEL``: the default of the functions that take a model, not a name."""
+
+
+def required_model(model: BushingModel) -> BushingModel:
+    """``model``, which must be a ``BushingModel``: the inner functions take the model their front
+    door resolved (:func:`resolve_model`, once), never a name to resolve again."""
+    if not isinstance(model, BushingModel):
+        raise TypeError(f"model = {model!r}: give the model (fmu_src.model.registry.get_model({model!r})), "
+                        "not its name")
+    return model
+
+
+def _by_name(model: BushingModel):
+    """A model pickles as its name, and the process that loads it finds it again by that name
+    (:func:`get_model`, which derives a model with options from its name): its kernels are
+    functions made at import or generated on demand, which do not pickle. A model that is not the
+    one its name finds (``dataclasses.replace`` of a registered one) refuses to pickle rather than
+    arrive as another."""
+    if get_model(model.name) is not model:
+        raise pickle.PicklingError(f"the model {model.name!r} here is not the registered model of that name "
+                                   "(made by dataclasses.replace?): it cannot be sent by name")
+    return get_model, (model.name,)
+
+
+copyreg.pickle(BushingModel, _by_name)

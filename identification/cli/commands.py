@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from fmu_src.model.parameter_specs import ParameterError
-from fmu_src.model.registry import DEFAULT_MODEL, MODEL_NAMES, get_model
+from fmu_src.model.registry import DEFAULT_MODEL, MODEL_NAMES
 from identification.cli.model_options import build_model_options, fixed_values, model_options_of
 from fmu_src.parameter_files import read_parameter_set
 from identification.errors import FitNotConvergedWarning, UsageError
@@ -117,12 +117,11 @@ def fit_command(args) -> int:
         raise UsageError(f"--ensemble {args.ensemble} needs the ensemble that --no-ensemble skips: give one of them")
     tests, manifest_model = training_tests_of(args)
     model = args.model or manifest_model or DEFAULT_MODEL
+    options = model_options_of(args)
     try:
-        get_model(model)
+        bushing = options.model(model)          # resolved once; an alias (bouc_wen) under its name
     except ParameterError:
         raise UsageError(f"the manifest's model {model!r} is not one of {', '.join(MODEL_NAMES)}") from None
-    options = model_options_of(args)
-    bushing = options.model(model)          # resolved once; an alias (bouc_wen) under its name
     model = bushing.name
     tests = options.training(tests)
     fixed = options.fixed_for(bushing)
@@ -429,16 +428,16 @@ def compare_command(args) -> int:
     variants += [variant for variant in (_with_option(options, token, args) for token in tried or ()) if variant]
     tests = options.training(tests)
     models = [name.strip() for name in args.models.split(",") if name.strip()]
-    unknown = []
+    unknown, resolved = [], []
     for name in models:
         try:
-            get_model(name)
+            resolved.append(options.model(name))          # resolved once, passed on
         except ParameterError:
             unknown.append(name)
     if unknown:
         raise UsageError(f"unknown models {unknown}; choose from {', '.join(MODEL_NAMES)}, with options where wanted "
                          "(berg+limits)")
-    named, models = models, [options.model(name) for name in models]          # resolved once, passed on
+    named, models = models, resolved
     fixed = {bushing.name: options.fixed_for(bushing) for bushing in models}
     alternatives = {bushing.name: [(variant.model(name), variant.fixed_for(variant.model(name)))
                                    for variant in variants] for name, bushing in zip(named, models)}

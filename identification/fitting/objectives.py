@@ -35,7 +35,7 @@ from typing import Sequence
 
 import numpy as np
 
-from fmu_src.model.registry import BushingModel, DEFAULT_MODEL, resolve_model
+from fmu_src.model.registry import BushingModel, DEFAULT_BUSHING, required_model
 from identification.forward.input_path import DrivenInput, DrivenVectorInput, prepare_input, prepare_vector_input
 from identification.measured.kdyn_table import (FIT_CYCLES, FIT_STEPS_PER_CYCLE, KDYN_UNCERTAINTY, LOSS_ANGLE_UNCERTAINTY_DEG,
                                                 SEARCH_CYCLES, SEARCH_STEPS_PER_CYCLE, KdynTable)
@@ -117,13 +117,13 @@ class PreparedTable:
     cycles: np.ndarray
 
     @classmethod
-    def of(cls, table: KdynTable, model: str | BushingModel, search: bool = False) -> "PreparedTable":
+    def of(cls, table: KdynTable, model: BushingModel, search: bool = False) -> "PreparedTable":
         """With the fit's loop, or the search's coarser one (``search``): FIT_CYCLES (SEARCH_CYCLES)
         per row, or more where the model takes longer to settle (``BushingModel.settling_s``; the
         search, which only chooses the basins the fit loop refines, SEARCH_SETTLING of that time)."""
         steps, cycles = (SEARCH_STEPS_PER_CYCLE, SEARCH_CYCLES) if search else (FIT_STEPS_PER_CYCLE, FIT_CYCLES)
         rows = table.kept()
-        settling = resolve_model(model).settling_s * (SEARCH_SETTLING if search else 1.0)
+        settling = model.settling_s * (SEARCH_SETTLING if search else 1.0)
         return cls(rows, steps, np.maximum(cycles, np.ceil(settling * rows.frequency_hz)).astype(np.int64))
 
     @property
@@ -167,15 +167,15 @@ class Objective:
     """Misfit (chi^2/n) of candidate parameter sets of ``model``; see the module docstring."""
 
     def __init__(self, tests: Sequence[RigTest], noise: Sequence[NoiseEstimate] | None = None,
-                 steps: Sequence[int | None] | None = None, model: str | BushingModel = DEFAULT_MODEL,
+                 steps: Sequence[int | None] | None = None, model: BushingModel = DEFAULT_BUSHING,
                  table: KdynTable | None = None, search: bool = False, multiaxis: MultiAxisTests = MultiAxisTests()):
         """``steps``: communication steps per sample of each test (None: chosen from the
         signal, ``input_path.steps_per_sample``); ``identification.fitting.refinement`` raises them
         where a candidate's response needs it. ``table``: a dynamic-stiffness table whose rows
         add two residuals each (``identification.measured.kdyn_table``), with the search's coarser loop
         if ``search``. Candidates are (P, m) matrices of ``model``'s parameters in its order
-        (``population.parameter_matrix``). ``model``: the model or its name, resolved here
-        (``bushing``; ``model`` is its name); a worker receives the name and resolves it once.
+        (``population.parameter_matrix``). ``model``: the model (``bushing``; ``model`` is its
+        name), which a worker receives by its name (the registry pickles a model as its name).
         ``multiaxis``: multi-axis tests (``MultiAxisTests``), each axis's force a residual in that
         axis's noise units, the model run on them with their coupling; their steps per sample are
         the signal's (the refinement does not change them). A model that can hold a force at rest
@@ -193,8 +193,8 @@ class Objective:
         self.rest_forces = [held_force(t.measurement) for t in tests]
         self.strides = [fit_stride(t) for t in tests]
         self.noise = noise
-        self.bushing = resolve_model(model)
-        self.model = model if isinstance(model, str) else self.bushing.name
+        self.bushing = required_model(model)
+        self.model = self.bushing.name
         self.tests = _prepared_tests(tests, noise, steps, self.rest_forces, self.strides)
         self.rig_tests = list(tests)     # what it was made of: with_steps, prefix, with_fit_loop derive from them
         self._source_table = table
@@ -246,13 +246,12 @@ class Objective:
                          False, self._source_multiaxis)
 
     def __getstate__(self):
-        """Everything but the model, which does not pickle (a worker resolves its name), and the
-        tests it was made of (a worker evaluates; only the process that made it derives others)."""
-        return {name: value for name, value in self.__dict__.items() if name not in ("bushing", "rig_tests")}
+        """Everything but the tests it was made of (a worker evaluates; only the process that made
+        it derives others); the model goes by its name (the registry pickles it so)."""
+        return {name: value for name, value in self.__dict__.items() if name != "rig_tests"}
 
     def __setstate__(self, state):
         self.__dict__.update(state)
-        self.bushing = resolve_model(self.model)
         self.rig_tests = None
 
     @property

@@ -85,8 +85,8 @@ def _rig_zeros(measurements, steps, model: BushingModel, fixed: dict) -> tuple[f
 @dataclass(frozen=True)
 class SearchSpace:
     """The box of one model scaled by the data. ``model``: the model's name, or the model (a
-    ``BushingModel``, kept under its name): resolved once, here, as ``bushing``; sent to a worker
-    by name (a model does not pickle), which resolves it there once."""
+    ``BushingModel``, kept under its name): resolved once, here, as ``bushing``, which a worker
+    receives by its name (the registry pickles a model so)."""
     k_ref: float                  # N/mm
     c_ref: float                  # N*s/mm
     F_ref: float                  # N
@@ -114,14 +114,6 @@ class SearchSpace:
         bad = [f"{name} = {value}" for name, value in self.fixed if not math.isfinite(value)]
         if bad:
             raise IdentificationError(f"fixed parameters must be finite numbers: {', '.join(bad)}")
-
-    def __getstate__(self):
-        return {name: value for name, value in self.__dict__.items() if name != "_bushing"}
-
-    def __setstate__(self, state):
-        for name, value in state.items():
-            object.__setattr__(self, name, value)
-        object.__setattr__(self, "_bushing", resolve_model(self.model))
 
     @classmethod
     def from_measurements(cls, measurements: Sequence[Measurement], model: str | BushingModel = DEFAULT_MODEL,

@@ -41,7 +41,7 @@ import numpy as np
 
 from fmu_src.kernels import numba_binding as _kernels, tangents
 from fmu_src.model import elements, integration
-from fmu_src.model.registry import BushingModel, DEFAULT_MODEL, resolve_model
+from fmu_src.model.registry import BushingModel, DEFAULT_BUSHING, required_model
 from fmu_src.kernels.jit import numba
 from fmu_src.syntax_trees import parse
 from identification.forward.population import (CommunicationPoints, _input_arrays, _population_loop, _step_sizes,
@@ -151,11 +151,11 @@ COMPILE_SECONDS_PER_KB = 0.11
 constants"). An estimate for the progress shown while it compiles."""
 
 
-def expected_compile_seconds(model: str | BushingModel, lanes: int) -> float | None:
+def expected_compile_seconds(model: BushingModel, lanes: int) -> float | None:
     """About how long the module of ``model`` in ``lanes`` directions takes to compile (from its
     source's size, ``COMPILE_SECONDS_PER_KB``); None before its source is generated in this
     process."""
-    size = _source_sizes.get((resolve_model(model).name, lanes))
+    size = _source_sizes.get((required_model(model).name, lanes))
     return None if size is None else size / 1000.0 * COMPILE_SECONDS_PER_KB
 
 
@@ -170,14 +170,14 @@ def _generated_module(model: BushingModel, lanes: int) -> types.ModuleType:
     return _kernels.load_generated(_kernels.module_name(f"bushing_jacobian{lanes}_{model.name}", source), source)
 
 
-def sensitivity_module(model: str | BushingModel, lanes: int) -> types.ModuleType:
+def sensitivity_module(model: BushingModel, lanes: int) -> types.ModuleType:
     """The generated module of ``model`` with the forces' sensitivities in ``lanes`` directions,
     its population loop compiled (or loaded from numba's disk cache) by a first call on a
     two-sample input: once per process. The first process on a machine compiles (about 25 s for
     the proposed model's 14 directions: every tangent statement is written 14 times); later ones
     generate the source again and load the machine code, and one that asks while another compiles
     waits for it (``numba_binding.compile_lock``)."""
-    bushing = resolve_model(model)
+    bushing = required_model(model)
     key = (bushing.name, lanes)
     if key in _compiled:
         return _compiled[key]
@@ -195,12 +195,12 @@ def sensitivity_module(model: str | BushingModel, lanes: int) -> types.ModuleTyp
     return _compiled[key]
 
 
-def python_sensitivities(model: str | BushingModel, lanes: int) -> Callable:
+def python_sensitivities(model: BushingModel, lanes: int) -> Callable:
     """The population loop (``population._population_loop``, same arguments) with the vector
     tangents of ``model``'s kernels as plain Python, uncompiled: the very source the compiled
     module holds, for tests that check every model without compiling each (interpreted, some 100
     times slower; plain Python raises where numba gives inf or NaN)."""
-    bushing = resolve_model(model)
+    bushing = required_model(model)
     generator = tangents.Generator(lanes)
     loop_names = _tangent_names(bushing, generator)
     source = generator.lane_source()
@@ -221,7 +221,7 @@ def python_sensitivities(model: str | BushingModel, lanes: int) -> Callable:
 
 
 def population_sensitivities(parameter_sets, seeds, points: CommunicationPoints, max_substeps: int = _MAX_SUBSTEPS,
-                             model: str | BushingModel = DEFAULT_MODEL) -> tuple[np.ndarray, np.ndarray]:
+                             model: BushingModel = DEFAULT_BUSHING) -> tuple[np.ndarray, np.ndarray]:
     """Forces [N], shape (P, outputs), as ``population.simulate_population_at`` gives them on
     ``points`` (the same bits), and their derivatives, shape (P, outputs, K), in the K directions
     ``seeds`` (P, m, K): the derivatives of each row's m parameters (in the model's order) along
@@ -229,7 +229,7 @@ def population_sensitivities(parameter_sets, seeds, points: CommunicationPoints,
     chunks (:func:`lane_chunk`)."""
     t, x, v = _input_arrays(points.time_s, points.displacement_mm, points.velocity_mm_s)
     out_index, out_velocity = output_points(t, points.output_index, points.output_velocity_mm_s)
-    bushing = resolve_model(model)
+    bushing = required_model(model)
     matrix = parameter_matrix(parameter_sets, bushing)
     seeds = np.ascontiguousarray(seeds, dtype=float)
     if seeds.ndim != 3 or seeds.shape[:2] != matrix.shape:

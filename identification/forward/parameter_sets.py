@@ -11,7 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Mapping
 
-from fmu_src.model.registry import BushingModel, DEFAULT_MODEL, get_model, resolve_model
+from fmu_src.model.registry import BushingModel, DEFAULT_BUSHING, resolve_model
 from fmu_src.parameter_files import ParameterEnsemble, ParameterSet, read_ensemble
 from identification.errors import IdentificationError
 
@@ -45,14 +45,16 @@ def parameter_sets(parameters, model: str | BushingModel | None = None) -> tuple
     elif isinstance(parameters, ParameterSet):
         bushing, sets = parameters.model, [parameters.parameters]
     elif isinstance(parameters, Mapping):
-        bushing, sets = expected or get_model(DEFAULT_MODEL), [parameters]
+        bushing, sets = expected, [parameters]
     else:
         sets = list(parameters) if isinstance(parameters, (list, tuple)) else []
         if not sets or not all(isinstance(s, Mapping) for s in sets):
             raise TypeError(f"parameters: give a mapping of names to values, a ParameterSet, a ParameterEnsemble, "
                             f"a FitResult, a parameter file's path or a list of mappings, not "
                             f"{type(parameters).__name__}")
-        bushing = expected or get_model(DEFAULT_MODEL)
+        bushing = expected
+    if bushing is None:         # bare values: the default model's
+        bushing = DEFAULT_BUSHING
     if expected is not None and expected is not bushing:
         raise IdentificationError(f"the parameters are for the {bushing.name} model, not "
                                   f"{model if isinstance(model, str) else expected.name}")

@@ -26,7 +26,7 @@ import numpy as np
 
 from fmu_src.kernels import numba_binding as _kernels
 from fmu_src.model import integration
-from fmu_src.model.registry import BushingModel, DEFAULT_MODEL, resolve_model
+from fmu_src.model.registry import BushingModel, DEFAULT_BUSHING, required_model, resolve_model
 from identification.forward import steady_state
 
 _MAX_SUBSTEPS = integration.DEFAULT_MAX_SUBSTEPS
@@ -201,9 +201,9 @@ def _forces(module, matrix, *arguments) -> np.ndarray:
 _compiled_models: dict[str, types.ModuleType] = {}
 
 
-def compiled_model(model: str | BushingModel = DEFAULT_MODEL) -> types.ModuleType:
+def compiled_model(model: BushingModel = DEFAULT_BUSHING) -> types.ModuleType:
     """The generated, compiled module of ``model``'s population loops (loaded on first use)."""
-    bushing = resolve_model(model)
+    bushing = required_model(model)
     if bushing.name not in _compiled_models:
         source = _population_source(bushing)
         _compiled_models[bushing.name] = _kernels.load_generated(
@@ -213,7 +213,7 @@ def compiled_model(model: str | BushingModel = DEFAULT_MODEL) -> types.ModuleTyp
 
 def simulate_population_held(parameter_sets, time_s, displacement_mm, velocity_mm_s,
                              max_substeps: int = _MAX_SUBSTEPS,
-                             model: str | BushingModel = DEFAULT_MODEL, rest_force_N: float = math.nan) -> np.ndarray:
+                             model: BushingModel = DEFAULT_BUSHING, rest_force_N: float = math.nan) -> np.ndarray:
     """Forces [N], shape (P, samples), of P parameter sets of ``model`` under the FMU's input
     convention.
 
@@ -229,7 +229,6 @@ def simulate_population_held(parameter_sets, time_s, displacement_mm, velocity_m
     """
     t, x, v = _input_arrays(time_s, displacement_mm, velocity_mm_s)
     out_velocity = np.concatenate([v[:1], v[:-1]])
-    model = resolve_model(model)
     return _forces(compiled_model(model), parameter_matrix(parameter_sets, model), t, x, v, np.arange(t.size),
                    out_velocity, max_substeps, *_step_sizes(t), rest_force_N)
 
@@ -258,19 +257,18 @@ def rest_force(points) -> float:
 
 
 def simulate_population_at(parameter_sets, points: CommunicationPoints, max_substeps: int = _MAX_SUBSTEPS,
-                           model: str | BushingModel = DEFAULT_MODEL) -> np.ndarray:
+                           model: BushingModel = DEFAULT_BUSHING) -> np.ndarray:
     """Forces [N], shape (P, outputs), at the output points of ``points``
     (``CommunicationPoints``); the input between communication points as in
     :func:`simulate_population_held`, the start at rest holding ``points.rest_force_N`` where given."""
     t, x, v = _input_arrays(points.time_s, points.displacement_mm, points.velocity_mm_s)
     out_index, out_velocity = output_points(t, points.output_index, points.output_velocity_mm_s)
-    model = resolve_model(model)
     return _forces(compiled_model(model), parameter_matrix(parameter_sets, model), t, x, v, out_index, out_velocity,
                    max_substeps, *_step_sizes(t), rest_force(points))
 
 
 def simulate_coupled_held(parameter_sets, time_s, displacement_mm, velocity_mm_s,
-                          max_substeps: int = _MAX_SUBSTEPS, model: str | BushingModel = DEFAULT_MODEL) -> np.ndarray:
+                          max_substeps: int = _MAX_SUBSTEPS, model: BushingModel = DEFAULT_BUSHING) -> np.ndarray:
     """Force vectors [N], shape (P, samples, d), of P parameter sets of ``model``'s coupled form on
     the path ``displacement_mm`` (samples, d = 2 or 3) [mm] with the steps' velocities
     ``velocity_mm_s`` (samples, d) [mm/s], under the FMU's input convention (as
@@ -282,13 +280,12 @@ def simulate_coupled_held(parameter_sets, time_s, displacement_mm, velocity_mm_s
 
 
 def simulate_coupled_at(parameter_sets, points: CommunicationPoints, max_substeps: int = _MAX_SUBSTEPS,
-                        model: str | BushingModel = DEFAULT_MODEL) -> np.ndarray:
+                        model: BushingModel = DEFAULT_BUSHING) -> np.ndarray:
     """Force vectors [N], shape (P, outputs, d), of P parameter sets of ``model``'s coupled form at
     the output points of ``points`` (``CommunicationPoints``: the displacement and the steps'
     velocities (points, d = 2 or 3), the output velocities (outputs, d)): the coupled counterpart
     of :func:`simulate_population_at`. Runs on all cores."""
-    model = resolve_model(model)
-    if model.coupled is None:
+    if required_model(model).coupled is None:
         raise ValueError(f"the {model.name} model has no coupled form")
     t = np.ascontiguousarray(points.time_s, dtype=float)
     x = np.atleast_2d(np.asarray(points.displacement_mm, dtype=float))
@@ -343,10 +340,10 @@ def _input_arrays(time_s, displacement_mm, velocity_mm_s):
     return t, x, v
 
 
-def parameter_matrix(parameter_sets, model: str | BushingModel = DEFAULT_MODEL) -> np.ndarray:
+def parameter_matrix(parameter_sets, model: BushingModel = DEFAULT_BUSHING) -> np.ndarray:
     """(P, m) float array of P parameter sets of ``model`` in its parameter order (its specs'),
     from a sequence of mappings or an array."""
-    bushing = resolve_model(model)
+    bushing = required_model(model)
     names = bushing.parameter_names
     if isinstance(parameter_sets, np.ndarray):
         matrix = np.atleast_2d(np.asarray(parameter_sets, dtype=float))

@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-from fmu_src.model.registry import BushingModel, DEFAULT_MODEL, resolve_model
+from fmu_src.model.registry import BushingModel, DEFAULT_BUSHING, required_model
 from identification.forward.population import parameter_matrix, simulate_coupled_at, simulate_population_at
 from identification.forward.input_path import DrivenInput, DrivenVectorInput, prepare_input, prepare_vector_input
 from identification.forward.parameter_sets import parameter_sets
@@ -90,7 +90,7 @@ def model_rest_force(bushing: BushingModel, values, x0_mm: float, rest_force_N: 
 
 
 def simulate_driven(matrix: np.ndarray, driven: DrivenInput, max_substeps: int | None = None,
-                    model: str | BushingModel = DEFAULT_MODEL) -> np.ndarray:
+                    model: BushingModel = DEFAULT_BUSHING) -> np.ndarray:
     """Forces [N], shape (P, outputs), of a (P, m) matrix of ``model``'s parameters
     (``population.parameter_matrix``) on a prepared input, at its output samples
     (``driven.sample_index``). NaN from where a candidate fails."""
@@ -99,13 +99,13 @@ def simulate_driven(matrix: np.ndarray, driven: DrivenInput, max_substeps: int |
 
 
 def simulate_driven_vector(matrix: np.ndarray, driven: DrivenVectorInput, max_substeps: int | None = None,
-                           model: str | BushingModel = DEFAULT_MODEL, coupled_axes: int = 0) -> np.ndarray:
+                           model: BushingModel = DEFAULT_BUSHING, coupled_axes: int = 0) -> np.ndarray:
     """Force vectors [N], shape (P, outputs, d), of a (P, m) matrix of ``model``'s parameters on a
     prepared multi-axis input, at its output samples: the first ``coupled_axes`` axes (2 or 3) run
     the model's coupled form on their displacement vector (``definition.CoupledKernels``),
     every other axis its one-axis model alone (0: every axis alone; so does Kelvin-Voigt, whose
     linear elements couple nothing). NaN from where a candidate fails."""
-    bushing = resolve_model(model)
+    bushing = required_model(model)
     kwargs = {} if max_substeps is None else {"max_substeps": max_substeps}
     parts = []
     if coupled_axes and bushing.coupled is not None:

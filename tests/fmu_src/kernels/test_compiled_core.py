@@ -69,7 +69,7 @@ def test_compiled_forces_equal_the_python_kernels_bitwise_for_every_model(model)
     t = sample_times(0.3, 1000.0)
     x, v = Random(2.0, 0.3, seed=5).signals(t)
     x = x + 0.01 * np.sin(2 * np.pi * 50 * t)       # off the held path: a displacement jump at every step
-    compiled = simulate_population_held(matrix, t, x, v, model=model)
+    compiled = simulate_population_held(matrix, t, x, v, model=MODELS[model])
     for row, forces in zip(matrix, compiled):
         python = simulate_python_core(dict(zip(names, row)), t, x, v, model=model)
         np.testing.assert_array_equal(forces, python)
@@ -77,10 +77,12 @@ def test_compiled_forces_equal_the_python_kernels_bitwise_for_every_model(model)
 
 CACHE_PROBE = """
 import numpy as np
+from fmu_src.model.registry import get_model
 from identification.forward import population as compiled_core
 t = np.linspace(0.0, 0.02, 21)
-compiled_core.simulate_population_held([{"k": 1.0, "c": 1.0, "preload": 0.0}], t, t, np.ones_like(t), model="kelvin_voigt")
-module = compiled_core.compiled_model("kelvin_voigt")
+compiled_core.simulate_population_held([{"k": 1.0, "c": 1.0, "preload": 0.0}], t, t, np.ones_like(t),
+                                       model=get_model("kelvin_voigt"))
+module = compiled_core.compiled_model(get_model("kelvin_voigt"))
 stats = module._simulate_population.stats
 print(module.__file__, len(stats.cache_hits), len(stats.cache_misses))
 """
@@ -110,12 +112,13 @@ def test_the_compiled_model_is_cached_on_disk_for_the_next_process(tmp_path):
 UNWRITABLE_PROBE = """
 import warnings
 import numpy as np
+from fmu_src.model.registry import get_model
 from identification.forward import population as compiled_core
 t = np.linspace(0.0, 0.02, 21)
 with warnings.catch_warnings(record=True) as caught:
     warnings.simplefilter("always")
     forces = compiled_core.simulate_population_held([{"k": 2.0, "c": 0.0, "preload": 0.0}], t, t, np.ones_like(t),
-                                                    model="kelvin_voigt")
+                                                    model=get_model("kelvin_voigt"))
 print(repr(float(forces[0, -1])), len(caught), str(caught[0].message) if caught else "")
 """
 
@@ -140,12 +143,13 @@ def test_an_unwritable_cache_folder_compiles_in_memory_and_says_so_once(tmp_path
 
 SPENCER_PROBE = """
 import numpy as np
+from fmu_src.model.registry import get_model
 from identification.forward import population as compiled_core
 t = np.linspace(0.0, 0.02, 21)
 values = {"c0": 1.0, "k0": 1.0, "c1": 1.0, "k1": 100.0, "x0": 0.0, "alpha": 1.0, "A": 1.0, "beta": 0.5,
           "gamma": 0.5, "n": 2.0}
-forces = compiled_core.simulate_population_held([values], t, t, np.ones_like(t), model="spencer")
-stats = compiled_core.compiled_model("spencer")._simulate_population.stats
+forces = compiled_core.simulate_population_held([values], t, t, np.ones_like(t), model=get_model("spencer"))
+stats = compiled_core.compiled_model(get_model("spencer"))._simulate_population.stats
 print(repr(float(forces[0, -1])), len(stats.cache_hits), len(stats.cache_misses))
 """
 
@@ -187,11 +191,13 @@ def test_a_changed_model_source_compiles_afresh_instead_of_loading_stale_machine
 
 SPENCER_FORCES = """
 import numpy as np
+from fmu_src.model.registry import get_model
 from identification.forward import population as compiled_core
 t = np.linspace(0.0, 0.05, 51)
 values = {"c0": 1.0, "k0": 1.0, "c1": 1.0, "k1": 100.0, "x0": 0.0, "alpha": 1.0, "A": 1.0, "beta": 0.5,
           "gamma": 0.5, "n": 2.0}
-forces = compiled_core.simulate_population_held([values], t, np.sin(60.0 * t), 60.0 * np.cos(60.0 * t), model="spencer")
+forces = compiled_core.simulate_population_held([values], t, np.sin(60.0 * t), 60.0 * np.cos(60.0 * t),
+                                                model=get_model("spencer"))
 print(" ".join(repr(float(f)) for f in forces[0]))
 """
 

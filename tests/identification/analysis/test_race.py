@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from fmu_src.model.registry import MODELS
 from identification.__main__ import main
 from identification.analysis import race
 from identification.analysis.race import out_of_race
@@ -169,7 +170,7 @@ def test_two_threads_asking_for_one_sensitivity_module_compile_it_once(monkeypat
     monkeypatch.setattr(parameter_jacobian, "_compiled", {})
     monkeypatch.setattr(parameter_jacobian, "_generated_module", generated)
     got = []
-    threads = [threading.Thread(target=lambda: got.append(parameter_jacobian.sensitivity_module("proposed", 14)))
+    threads = [threading.Thread(target=lambda: got.append(parameter_jacobian.sensitivity_module(MODELS["proposed"], 14)))
                for _ in range(2)]
     for thread in threads:
         thread.start()

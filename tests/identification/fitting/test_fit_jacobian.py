@@ -66,7 +66,7 @@ def test_every_lane_is_the_one_direction_tangent(name):
     lanes = 3
     generator = tangents.Generator()
     names = _tangent_names(model, generator)
-    vector = python_sensitivities(name, lanes).__globals__
+    vector = python_sensitivities(model, lanes).__globals__
     one = generator.compiled
     p = tuple(values[0])
     rng = random.Random(3)
@@ -122,14 +122,14 @@ def test_sensitivities_equal_central_differences_every_model(name):
     t, x, v = jumping_sine()
     index = np.arange(t.size)
     seeds = np.random.default_rng(1).standard_normal((1, values.shape[1], lanes)) * values[:, :, None]
-    forces, sensitivities = python_sensitivities(name, lanes)(values, seeds, t, x, v, index, v, 100,
+    forces, sensitivities = python_sensitivities(model, lanes)(values, seeds, t, x, v, index, v, 100,
                                                               *_step_sizes(t), REST_FORCE_N)
     points = CommunicationPoints(t, x, v, index, v, REST_FORCE_N)
-    plain = simulate_population_at(values, points, 100, model=name)
+    plain = simulate_population_at(values, points, 100, model=model)
     assert np.array_equal(forces, plain)
     for k in range(lanes):
-        up = simulate_population_at(values + CENTRAL_STEP * seeds[:, :, k], points, 100, model=name)
-        down = simulate_population_at(values - CENTRAL_STEP * seeds[:, :, k], points, 100, model=name)
+        up = simulate_population_at(values + CENTRAL_STEP * seeds[:, :, k], points, 100, model=model)
+        down = simulate_population_at(values - CENTRAL_STEP * seeds[:, :, k], points, 100, model=model)
         central = (up - down) / (2.0 * CENTRAL_STEP)
         assert np.linalg.norm(sensitivities[0, :, k] - central[0]) <= 1e-6 * np.linalg.norm(central[0]), (name, k)
 
@@ -246,7 +246,7 @@ def test_table_rows_fall_back_to_differences(table2_problem):
     from identification.measured.kdyn_table import load_kdyn_table
     table = load_kdyn_table(DATA / "kdyn_table5_table6_grid.csv")
     sine = RigTest(load_measurement(DATA / "synthetic_table2_noise1pct_sine_2mm_10Hz.csv"), "sine")
-    objective = Objective([sine], model="proposed", table=table, search=True)
+    objective = Objective([sine], model=get_model("proposed"), table=table, search=True)
     exact_problem = Problem(objective, table2_problem.space, "exact")
     difference_problem = Problem(objective, table2_problem.space, "difference")
     theta = table2_problem.space.to_coordinates(load_parameters(DATA / "params_table2_sine.json"))
@@ -281,8 +281,8 @@ def test_the_generated_module_is_named_after_its_source_and_the_compilers(monkey
     version, another name."""
     import identification.forward.parameter_jacobian as fit_jacobian
     from fmu_src.kernels import numba_binding as compiled_kernels
-    module = fit_jacobian.sensitivity_module("proposed", 14)
     model = get_model("proposed")
+    module = fit_jacobian.sensitivity_module(model, 14)
     machinery = compiled_kernels.integration_module()
     source = compiled_kernels.model_source(model, machinery, fit_jacobian._appendix(model, 14, machinery))
     assert module.__name__ == compiled_kernels.module_name("bushing_jacobian14_proposed", source)
@@ -318,8 +318,9 @@ def test_the_sensitivities_check_their_output_points_as_the_forces_do():
 
 
 LOCK_PROBE = """
+from fmu_src.model.registry import get_model
 from identification.forward import parameter_jacobian
-module = parameter_jacobian.sensitivity_module("single_bouc_wen", 2)
+module = parameter_jacobian.sensitivity_module(get_model("single_bouc_wen"), 2)
 stats = module._simulate_sensitivities.stats
 print(len(stats.cache_hits), len(stats.cache_misses))
 """

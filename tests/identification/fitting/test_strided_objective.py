@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from conftest import paper_force, paper_parameters
+from fmu_src.model.registry import get_model
 from identification.fitting.objectives import FIT_SAMPLES_PER_CYCLE, Objective, fit_stride
 from identification.forward.population import parameter_matrix
 from identification.measured.measurements import Measurement
@@ -30,7 +31,7 @@ def test_a_slow_sine_at_1024_hz_counts_every_eighth_sample():
 
 def test_the_misfit_keeps_its_scale_at_the_truth_and_off_it():
     params, test = slow_sine(10.0)
-    objective = Objective([test], model="proposed")
+    objective = Objective([test], model=get_model("proposed"))
     assert objective.strides == [8] and objective.size == pytest.approx(test.measurement.time_s.size, abs=8)
     full = objective.tests[0].driven.sample_index.size * 8
     assert full == pytest.approx(test.measurement.time_s.size, abs=8)
@@ -39,7 +40,7 @@ def test_the_misfit_keeps_its_scale_at_the_truth_and_off_it():
     assert objective(truth)[0] == pytest.approx(1.0, abs=0.15)
     # a set 5 % stiffer: a smooth misfit, the same whichever samples count
     stiffer = parameter_matrix([dict(params, k0=1.05 * params["k0"])])
-    every = Objective([test], model="proposed")
+    every = Objective([test], model=get_model("proposed"))
     every.tests = [every.tests[0].__class__(t.name, *_every_sample(test, t)) for t in every.tests]
     every.size = test.measurement.time_s.size
     assert objective(stiffer)[0] == pytest.approx(every(stiffer)[0], rel=0.02)

@@ -276,7 +276,8 @@ def test_the_multiaxis_rows_of_the_jacobian_are_its_forward_differences(fit_rig)
     ellipse = load_multiaxis(files["ellipse"])
     tests = [RigTest(load_measurement(sine), "sine")]
     space = SearchSpace.from_measurements([tests[0].measurement] + ellipse.components(), "single_bouc_wen")
-    objective = Objective(tests, model="single_bouc_wen", multiaxis=MultiAxisTests([ellipse], coupling="radial"))
+    objective = Objective(tests, model=get_model("single_bouc_wen"),
+                          multiaxis=MultiAxisTests([ellipse], coupling="radial"))
     assert objective.difference_size == ellipse.force_N.size
     theta = space.to_coordinates(FIT_TRUTH)
     residual, jacobian = Problem(objective, space, "exact").residuals_and_jacobian(theta)
