@@ -208,25 +208,20 @@ def race_models(requests: list[SearchRequest], engine, race: bool = True, progre
         search = searches[model]
         reason = (out_of_race(search.first_stage_misfit, search.d, search.n, list(results.values())) if race
                   else None)
+        before_last = None      # weighed again before its last stage where it ran on
+        if reason is None:
+            print(f"fitting {search.request.model.title} ...", file=sys.stderr)
+            if race:
+                before_last = search.early_stages()
+                reason = out_of_race(before_last, search.d, search.n, list(results.values()), RACE_CLOSING_LAST,
+                                     BEFORE_LAST_STAGE)
         if reason is not None:
             stopped.append(Stopped(model, search.d, search.screened_misfit, search.first_stage_misfit,
-                                   search.seconds, reason))
+                                   search.seconds, reason, before_last))
             del searches[model]
             print(f"{search.request.model.title}: out of the race ({reason})", file=sys.stderr)
             settled(results, stopped)
             continue
-        print(f"fitting {search.request.model.title} ...", file=sys.stderr)
-        if race:
-            before_last = search.early_stages()
-            reason = out_of_race(before_last, search.d, search.n, list(results.values()), RACE_CLOSING_LAST,
-                                 BEFORE_LAST_STAGE)
-            if reason is not None:
-                stopped.append(Stopped(model, search.d, search.screened_misfit, search.first_stage_misfit,
-                                       search.seconds, reason, before_last))
-                del searches[model]
-                print(f"{search.request.model.title}: out of the race ({reason})", file=sys.stderr)
-                settled(results, stopped)
-                continue
         results[model] = _reported(search.finish(ensemble=False))
         settled(results, stopped)
     return results, stopped, searches

@@ -236,11 +236,15 @@ class Search:
     def first_stage(self) -> float:
         """The first least-squares stage from the screened points (after the exact Jacobian's
         module is ready); its best misfit (chi^2/n). :meth:`finish` goes on from there."""
+        self._timed(self._first_stage)
+        return self.first_stage_misfit
+
+    def _timed(self, step) -> None:
+        """``step()`` run, its bars closed and its time added to ``seconds``."""
         began = time.perf_counter()
-        self._first_stage()
+        step()
         self.bars.close()
         self.seconds += time.perf_counter() - began
-        return self.first_stage_misfit
 
     def _first_stage(self) -> None:
         if self.first_records is not None:
@@ -261,10 +265,7 @@ class Search:
     def early_stages(self) -> float:
         """Every least-squares stage but the last (the first, where :meth:`first_stage` has not
         run it); the best misfit (chi^2/n) they reached. :meth:`finish` runs the last from there."""
-        began = time.perf_counter()
-        self._early_stages()
-        self.bars.close()
-        self.seconds += time.perf_counter() - began
+        self._timed(self._early_stages)
         return self.before_last_misfit
 
     def _early_stages(self) -> None:
