@@ -323,7 +323,9 @@ class _Comparison:
             plot_comparison(m, self.predictions[Path(m.source).name],
                             out_dir / f"compare_{measurement_name(m.source)}.png")
         if table is not None:
-            plot_table_comparison(table, {a.model: a.table for a in self.assessments}, out_dir / f"compare_{table.name}.png")
+            bushing_of = {b.name: b for b in self.bushings}
+            plot_table_comparison(table, {bushing_of[a.model]: a.table for a in self.assessments},
+                                  out_dir / f"compare_{table.name}.png")
         coupling = (weigh_couplings(self.parameters, self.bushings, options.multiaxis, options.couplings,
                                     recommendation.model) if options.couplings else None)
         if options.first_contact is not None:
@@ -450,16 +452,17 @@ class _SettledWriter:
 
 def _validation_errors(validation, bushings, parameters: dict, assessments: list[Assessment], training_names: set):
     """Each model's (NRMSE, eq. 10) on each validation file, entered into its assessment where
-    the file is held out; and the predictions, {file name: {model: force}}."""
+    the file is held out; and the predictions, {file name: {model (the BushingModel): force [N]}}."""
     errors, predictions = {}, {}
     for m in validation:
         name = Path(m.source).name
         rest = held_force(m)
-        predictions[name] = {bushing.name: simulate(parameters[bushing.name], m.time_s, m.displacement_mm,
+        predicted_by_name = {bushing.name: simulate(parameters[bushing.name], m.time_s, m.displacement_mm,
                                                     m.measured_velocity_mm_s, model=bushing, rest_force_N=rest)
                              for bushing in bushings}
+        predictions[name] = {bushing: predicted_by_name[bushing.name] for bushing in bushings}
         for assessment in assessments:
-            predicted = predictions[name][assessment.model]
+            predicted = predicted_by_name[assessment.model]
             errors[name, assessment.model] = (nrmse(predicted, m.force_N), rms_level_error(predicted, m.force_N))
             if name not in training_names:
                 assessment.validation[name] = errors[name, assessment.model]

@@ -122,8 +122,8 @@ def plot_measurement(parameters, measurement: Measurement, path: Path,
     m = measurement
     prediction = predict(parameters, m.time_s, m.displacement_mm, m.measured_velocity_mm_s, model=model)
     bushing, _ = parameter_sets(parameters, model)
-    predictions = {bushing.name: prediction.force_N}
+    predictions = {bushing: prediction.force_N}
     if kelvin_voigt is not None:
-        predictions[LINEAR_BASELINE.name] = kelvin_voigt.force(m.displacement_mm, m.velocity_mm_s)
+        predictions[LINEAR_BASELINE] = kelvin_voigt.force(m.displacement_mm, m.velocity_mm_s)
     band = (prediction.lower_N, prediction.upper_N) if prediction.members > 1 else None
     return plot_comparison(m, predictions, path, band)

@@ -7,7 +7,7 @@ from typing import Sequence
 
 import numpy as np
 
-from fmu_src.model.registry import get_model
+from fmu_src.model.registry import required_model
 from identification.interrupt import writing
 from identification.measured.measurements import Measurement
 from identification.fitting.objectives import nrmse
@@ -34,6 +34,7 @@ def _save(figure, path) -> Path:
 def plot_comparison(measurement: Measurement, predictions: dict, path: Path, band: tuple | None = None,
                     measured: bool = True) -> Path:
     """Measured and predicted force over time and against displacement (paper Figs. 15-17);
+    ``predictions``: {model (the ``BushingModel``, drawn in its style): force [N]};
     ``band``: (lower, upper) force [N] of an ensemble, shaded around the first prediction;
     ``measured``: whether to draw the measurement's force (False for a displacement-only input)."""
     plt = _pyplot()
@@ -47,7 +48,7 @@ def plot_comparison(measurement: Measurement, predictions: dict, path: Path, ban
         in_time.fill_between(m.time_s, lower / 1e3, upper / 1e3, color="C0", alpha=0.25, lw=0,
                              label="ensemble band")
     for model, predicted in predictions.items():
-        bushing = get_model(model)
+        bushing = required_model(model)
         color, style = bushing.plot_style
         label = bushing.title + (f" (NRMSE {nrmse(predicted, m.force_N):.1%})" if measured else "")
         in_time.plot(m.time_s, predicted / 1e3, color=color, ls=style, lw=1.1, label=label)
@@ -158,7 +159,7 @@ def plot_dynamic_stiffness(table, folder: Path, measured=None) -> list[Path]:
             axes.grid(alpha=0.3, which="both")
         stiffness.legend(fontsize=8, title="amplitude" if unit == "mm" else "frequency")
         shaded = ", ensemble min-max shaded" if table.minimum else ""
-        figure.suptitle(f"{get_model(table.model).title}: dynamic stiffness and loss angle{shaded}", fontsize=10)
+        figure.suptitle(f"{table.title or table.model}: dynamic stiffness and loss angle{shaded}", fontsize=10)
         figure.tight_layout()
         written.append(_save(figure, folder / name))
     figure, axes = plt.subplots(figsize=(7, 5))
@@ -182,7 +183,8 @@ def plot_dynamic_stiffness(table, folder: Path, measured=None) -> list[Path]:
 
 def plot_table_comparison(table, fits: dict, path: Path) -> Path:
     """A held-out dynamic-stiffness table (``kdyn_table.KdynTable``, crosses) and each model's
-    prediction of its rows (lines in the model's style; ``fits``: {model: ``result.TableFit``}):
+    prediction of its rows (lines in the model's style; ``fits``: {model (the ``BushingModel``):
+    ``result.TableFit``}):
     |K*| (top) and the loss angle (bottom) against frequency, one column per amplitude."""
     plt = _pyplot()
     kept = table.weight > 0
@@ -198,10 +200,10 @@ def plot_table_comparison(table, fits: dict, path: Path) -> Path:
         top.plot(frequency[rows], measured["kdyn"][rows], "kx", ms=7, mew=1.5, label="table")
         bottom.plot(frequency[rows], measured["angle"][rows], "kx", ms=7, mew=1.5)
         for model, fitted in fits.items():
-            color, style = get_model(model).plot_style
+            color, style = required_model(model).plot_style
             kdyn = measured["kdyn"][rows] * (1.0 + fitted.kdyn_errors[rows])
             angle = measured["angle"][rows] + fitted.angle_errors_deg[rows]
-            top.plot(frequency[rows], kdyn, color=color, ls=style, lw=1.3, label=model)
+            top.plot(frequency[rows], kdyn, color=color, ls=style, lw=1.3, label=model.name)
             bottom.plot(frequency[rows], angle, color=color, ls=style, lw=1.3)
         top.set_title(f"{X:g} mm")
         bottom.set_xlabel("frequency [Hz]")

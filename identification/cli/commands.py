@@ -151,7 +151,7 @@ def fit_command(args) -> int:
         # each test's force as the fit computed it (the one-axis tests' fits first, then the multi-axis ones)
         for test, fitted in zip(tests, result.tests):
             m = test.measurement
-            written.append(plot_comparison(m, {model: fitted.predicted_N},
+            written.append(plot_comparison(m, {bushing: fitted.predicted_N},
                                            args.plots / f"fit_{measurement_name(m.source)}.png"))
         for m, fitted in zip(multiaxis, result.tests[len(tests):]):
             written.append(plot_multiaxis(m, {f"{bushing.title}, {args.coupling}": fitted.predicted_N},
@@ -261,7 +261,7 @@ def predict_command(args) -> int:
     if args.plot:
         from identification.analysis.plots import plot_comparison
         band = (prediction.lower_N, prediction.upper_N) if prediction.members > 1 else None
-        written.append(plot_comparison(m, {ensemble.model.name: prediction.force_N}, args.plot, band,
+        written.append(plot_comparison(m, {ensemble.model: prediction.force_N}, args.plot, band,
                                        measured=m.has_force))
     _print_prediction(prediction, written)
     return 0

@@ -68,6 +68,7 @@ class DynamicStiffness:
     converged: np.ndarray                   # steady state reached per case
     loop_force_N: np.ndarray                # (cases, steps_per_cycle): the last cycle's force
     model: str = DEFAULT_MODEL
+    title: str = ""                         # the model's title, for plots ("" : its name stands)
     members: int = 1
     minimum: dict[str, np.ndarray] = field(default_factory=dict)
     maximum: dict[str, np.ndarray] = field(default_factory=dict)
@@ -228,7 +229,7 @@ def data_sheet(bushing: BushingModel, sets: list[dict[str, float]], amplitudes_m
     table = DynamicStiffness(case_amplitude, case_frequency, np.full(cases, float(preload_mm)),
                              **{name: best[name] for name in RESULT_COLUMNS}, cycles=best["cycles"],
                              converged=best["converged"], loop_force_N=best["loop"], model=bushing.name,
-                             members=len(tables))
+                             title=bushing.title, members=len(tables))
     if members > 1:
         table.minimum = {name: np.min([t[name] for t in tables], axis=0) for name in RESULT_COLUMNS}
         table.maximum = {name: np.max([t[name] for t in tables], axis=0) for name in RESULT_COLUMNS}
