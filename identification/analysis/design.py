@@ -16,9 +16,11 @@ design -> test -> refit can loop until this says so.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
+from fmu_src.parameter_files import read_ensemble
 from identification.forward.population import parameter_matrix
 from identification.errors import IdentificationError
 from identification.fitting.progress import bar as progress_bar
@@ -108,6 +110,8 @@ def design(ensemble, noise_N: float | None = None, candidates: list[Candidate] |
     """Rank ``candidates`` (default: :func:`candidate_tests`) by the spread of ``ensemble``
     (anything ``predict`` takes with several members). ``noise_N``: the noise level to compare
     with (default: the largest of the training tests' in the ensemble's provenance)."""
+    if isinstance(ensemble, (str, Path)):     # read once: its sets and its fit's record of the noise
+        ensemble = read_ensemble(ensemble)
     bushing, sets = parameter_sets(ensemble)
     if len(sets) < 2:
         raise IdentificationError("the design needs an ensemble of at least 2 parameter sets (fit --ensemble FILE)")

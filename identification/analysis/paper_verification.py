@@ -14,15 +14,15 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
-from fmu_src.model.registry import DEFAULT_MODEL, LINEAR_BASELINE
+from fmu_src.model.registry import LINEAR_BASELINE
 from identification.measured.measurements import Measurement
 from identification.fitting.objectives import nrmse, rms_level_error
 from identification.measured.signals import Random, Sine, Step, sample_times
 from identification.fitting.search_space import KelvinVoigtFit
 from identification.analysis.plots import plot_comparison
 from identification.forward.parameter_sets import parameter_sets
-from identification.analysis.predict import predict
-from identification.forward.simulate import simulate
+from identification.analysis.predict import predict_sets
+from identification.forward.simulate import simulate_set
 
 SINE_FREQUENCIES_HZ = (1.0, 10.0, 20.0, 30.0)
 SINE_AMPLITUDES_MM = (0.5, 1.0, 2.0, 3.0)
@@ -56,27 +56,30 @@ def _case(name: str, prediction, expected) -> CaseError:
                      None if band is None else float(np.mean(band)), None if band is None else float(np.max(band)))
 
 
-def grid_errors(parameters, truth: Mapping[str, float], model: str | None = None,
-                truth_model: str = DEFAULT_MODEL) -> list[CaseError]:
+def grid_errors(parameters, truth, model: str | None = None, truth_model: str | None = None) -> list[CaseError]:
     """Errors of ``parameters`` (a set or an ensemble, anything ``predict`` takes; its best
-    member) against the forces of ``truth`` (of ``truth_model``, noise-free) over the §5
-    grid, with the ensemble's band width."""
+    member) against the forces of ``truth`` (anything ``simulate`` takes: a mapping of
+    ``truth_model``'s values, default the proposed model's, or a ``ParameterSet``; noise-free)
+    over the §5 grid, with the ensemble's band width. Each is read and checked once."""
+    bushing, sets = parameter_sets(parameters, model)
+    truth_bushing, truth_sets = parameter_sets(truth, truth_model)
     errors = []
     for name, protocol in grid_protocols():
         t = sample_times(protocol.duration_s, RATE_HZ)
         signals = protocol.signals(t)
-        expected = simulate(truth, t, *signals, model=truth_model)
-        errors.append(_case(name, predict(parameters, t, *signals, model=model), expected))
+        expected = simulate_set(truth_bushing, truth_sets[0], t, *signals)
+        errors.append(_case(name, predict_sets(bushing, sets, t, *signals), expected))
     return errors
 
 
 def data_errors(parameters, measurements: Sequence[Measurement], kelvin_voigt: KelvinVoigtFit | None = None,
                 model: str | None = None) -> list[tuple[CaseError, CaseError | None]]:
-    """Errors of ``parameters`` (a set or an ensemble) on measured files, each beside the
-    Kelvin-Voigt fit's if one is given."""
+    """Errors of ``parameters`` (a set or an ensemble, read and checked once) on measured files,
+    each beside the Kelvin-Voigt fit's if one is given."""
+    bushing, sets = parameter_sets(parameters, model)
     rows = []
     for m in measurements:
-        prediction = predict(parameters, m.time_s, m.displacement_mm, m.measured_velocity_mm_s, model=model)
+        prediction = predict_sets(bushing, sets, m.time_s, m.displacement_mm, m.measured_velocity_mm_s)
         name = Path(m.source).name
         baseline = None
         if kelvin_voigt is not None:
@@ -120,8 +123,8 @@ def plot_measurement(parameters, measurement: Measurement, path: Path,
     """Force-time and force-displacement of measurement and model (and a Kelvin-Voigt fit),
     like the paper's Figs. 9-19; an ensemble's band shaded."""
     m = measurement
-    prediction = predict(parameters, m.time_s, m.displacement_mm, m.measured_velocity_mm_s, model=model)
-    bushing, _ = parameter_sets(parameters, model)
+    bushing, sets = parameter_sets(parameters, model)
+    prediction = predict_sets(bushing, sets, m.time_s, m.displacement_mm, m.measured_velocity_mm_s)
     predictions = {bushing: prediction.force_N}
     if kelvin_voigt is not None:
         predictions[LINEAR_BASELINE] = kelvin_voigt.force(m.displacement_mm, m.velocity_mm_s)

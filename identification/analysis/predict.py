@@ -128,6 +128,15 @@ def predict(parameters, time_s, displacement_mm, velocity_mm_s=None,
         from fmu_src.parameter_files import read_ensemble
         parameters = read_ensemble(parameters)
     bushing, sets = parameter_sets(parameters, model)
+    return predict_sets(bushing, sets, time_s, displacement_mm, velocity_mm_s, rest_force_N,
+                        training_misfit_N(parameters))
+
+
+def predict_sets(bushing: BushingModel, sets: list[dict[str, float]], time_s, displacement_mm, velocity_mm_s=None,
+                 rest_force_N: float = math.nan, misfit_N: float = math.nan) -> Prediction:
+    """:func:`predict` of sets already read and checked (``parameter_sets``): ``bushing`` the
+    model, ``sets`` its sets (best first), ``misfit_N`` the fit's training misfit [N]
+    (:func:`training_misfit_N`; NaN: not known); for a caller that resolved them once."""
     x = np.asarray(displacement_mm, dtype=float)
     forces = _mounted_population(bushing, sets, lambda matrix, values, offset: simulate_driven(
         matrix, prepare_input(time_s, x - offset, velocity_mm_s,
@@ -135,7 +144,7 @@ def predict(parameters, time_s, displacement_mm, velocity_mm_s=None,
         model=bushing), by_start=True)
     _refuse_failed(forces[0], time_s)
     return Prediction(np.asarray(time_s, dtype=float), x, forces[0], np.nanmin(forces, axis=0),
-                      np.nanmax(forces, axis=0), len(sets), training_misfit_N(parameters))
+                      np.nanmax(forces, axis=0), len(sets), misfit_N)
 
 
 @dataclass

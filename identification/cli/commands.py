@@ -217,8 +217,7 @@ def report_command(args) -> int:
     from identification.analysis.paper_verification import data_errors, format_data_errors, format_errors, grid_errors, plot_measurement
     from identification.fitting.search_space import KelvinVoigtFit
     from fmu_src.parameter_files import read_ensemble
-    params = read_ensemble(args.params)
-    model = params.model.name
+    params = read_ensemble(args.params)     # read once: its model and sets go on as they are
     if not (args.data or args.truth):
         raise UsageError("give --data files and/or --truth to report on")
     prepare_directory(args.plots, "--plots")
@@ -229,13 +228,13 @@ def report_command(args) -> int:
     if args.truth:
         print(f"Against the noise-free model of {args.truth} (paper §5 grid):")
         truth = read_parameter_set(args.truth)
-        print(format_errors(grid_errors(params, truth.parameters, model, truth.model.name)))
+        print(format_errors(grid_errors(params, truth)))
     if args.data:
         measurements = [load_measurement(path) for path in args.data]
-        print(format_data_errors(data_errors(params, measurements, kelvin_voigt, model)))
+        print(format_data_errors(data_errors(params, measurements, kelvin_voigt)))
         if args.plots:
             for m in measurements:
-                path = plot_measurement(params, m, args.plots / (measurement_name(m.source) + ".png"), kelvin_voigt, model)
+                path = plot_measurement(params, m, args.plots / (measurement_name(m.source) + ".png"), kelvin_voigt)
                 print(f"wrote {path}")
     return 0
 

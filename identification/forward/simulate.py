@@ -69,6 +69,14 @@ def simulate(parameters, time_s, displacement_mm, velocity_mm_s=None, model: str
         Arrays of different lengths, or times that do not increase.
     """
     values, bushing = _parameters_and_model(parameters, model)
+    return simulate_set(bushing, values, time_s, displacement_mm, velocity_mm_s, steps_per_sample, rest_force_N)
+
+
+def simulate_set(bushing: BushingModel, values, time_s, displacement_mm, velocity_mm_s=None,
+                 steps_per_sample: int | None = None, rest_force_N: float = math.nan) -> np.ndarray:
+    """:func:`simulate` of one set already read and checked (``parameter_sets``): ``bushing`` the
+    model, ``values`` its set (paper's N-mm-s units); for a caller that resolved them once."""
+    bushing = required_model(bushing)
     offset, preload = bushing.mounting(values)      # F = model(x - offset) + preload; 0 and 0: as it is
     x = np.asarray(displacement_mm, dtype=float) - offset
     driven = prepare_input(time_s, x, velocity_mm_s, steps=steps_per_sample,

@@ -234,6 +234,18 @@ def test_design_ranks_an_informative_test_above_an_uninformative_one(capsys, tmp
     assert set(best) >= {"kind", "amplitude_mm", "spread"}
 
 
+def test_design_of_a_file_takes_the_noise_its_fit_recorded(tmp_path):
+    """design accepts what predict does, a file's path too; from a path it reads the file once and
+    takes the noise level its provenance records (it refused before, finding no record)."""
+    from fmu_src.parameter_files import save_ensemble
+    from identification.analysis.design import Candidate, design
+    base = paper_parameters("table5")
+    members = [base, dict(base, A2=base["A2"] * 1.5)]
+    path = save_ensemble(tmp_path / "two.json", members, provenance={"tests": [{"noise_N": 7.5}, {"noise_N": 12.5}]})
+    result = design(path, candidates=[Candidate("sine", 3.0, frequency_hz=30.0)])
+    assert result.noise_N == 12.5 and result.members == 2
+
+
 def test_design_says_no_further_test_is_needed_when_the_members_agree(tmp_path, capsys):
     from fmu_src.parameter_files import save_ensemble
     base = paper_parameters("table5")
