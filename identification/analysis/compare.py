@@ -50,6 +50,7 @@ from identification.errors import FitNotConvergedWarning
 from identification.fitting.result import (FLOOR_FACTOR, FitResult, TableFit, information_criterion,
                                            sines_repeatability)
 from identification.fitting.fit import training_request
+from identification.fitting.loop_start import FitStart
 from identification.fitting.presets import FitOptions
 from identification.analysis.race import Stopped, race_models
 from identification.fitting.search import table_fit
@@ -262,12 +263,13 @@ class _Comparison:
         self.data = [t.measurement.source for t in tests] + ([table.source] if table is not None else [])
         self.settled = _SettledWriter(out_dir, options.table, self.data)
 
-    def request(self, bushing, fixed=None, tests=None):
+    def request(self, bushing, fixed=None, tests=None, start: FitStart | None = None):
         """The search request of ``bushing`` (its held parameters ``fixed``, else the options'), on
-        ``tests`` (default: every training test)."""
+        ``tests`` (default: every training test), from ``start`` (a nested model's fit) if given."""
         by_model = self.options.fixed_by_model or {}
         held = fixed if fixed is not None else by_model.get(bushing.name, self.options.fixed)
-        return training_request(self.tests if tests is None else tests, bushing, replace(self.training, fixed=held))
+        request = training_request(self.tests if tests is None else tests, bushing, replace(self.training, fixed=held))
+        return request if start is None else replace(request, start=start)
 
     def fit(self, engine) -> None:
         """Race the models, assess them and recommend one; then race the recommended model's
@@ -288,7 +290,10 @@ class _Comparison:
                   f"option tried added): "
                   f"{', '.join(b.name for b, _ in variants)} ...", file=sys.stderr)
             results, stopped = self.results, self.stopped
-            more, more_stopped, more_searches = race_models([self.request(b, dict(f)) for b, f in variants], engine,
+            # each variant nests the recommended model or is nested in it: its fit is where to start
+            fitted = dict(self.results[self.recommendation.model].parameters.parameters)
+            more, more_stopped, more_searches = race_models([self.request(b, dict(f), start=FitStart(
+                fitted, self.recommendation.model, _neutral(b))) for b, f in variants], engine,
                                                             False, options.progress,
                                                             lambda r, s: settled({**results, **r}, stopped + s))
             self.results.update(more)
@@ -448,6 +453,13 @@ class _SettledWriter:
                 result.save(self.out_dir / f"params_{model}.json", data=self.data)
                 self.assessment(result)
         _write_comparison(self.out_dir, list(self.assessments.values()), None, stopped)
+
+
+def _neutral(bushing) -> dict[str, float]:
+    """The neutral values of a derived model's option elements (``OptionElement.neutral``: those
+    that leave its base's force as it is); none for a registered model."""
+    elements = bushing.options.elements if bushing.options is not None else ()
+    return {name: value for element, _ in elements for name, value in element.neutral}
 
 
 def _validation_errors(validation, bushings, parameters: dict, assessments: list[Assessment], training_names: set):

@@ -23,7 +23,7 @@ Units: mm, N, N/mm, N/mm^3.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Sequence
 
 import numpy as np
@@ -54,6 +54,25 @@ class LoopStart:
         values = ", ".join(f"{name} = {value:.4g}" for name, value in self.parameters.items())
         return (f"spring and friction from the slow loop of {self.source}: {values} "
                 f"({self.unexplained:.1%} of its rms force left to the rest of the model)")
+
+
+@dataclass(frozen=True)
+class FitStart:
+    """A start from a fit of a nested model (``compare`` weighing the recommended model's variant:
+    an option added to it or left out): that fit's ``parameters`` (the model's units; one the
+    variant does not have is not read), the model they were fitted for (``source``), and the
+    ``neutral`` values of what the variant adds (``OptionElement.neutral``: with them the variant's
+    force is the fit's)."""
+    parameters: dict[str, float]
+    source: str
+    neutral: dict[str, float] = field(default_factory=dict)
+
+    def whole(self) -> "FitStart":
+        """The fit itself as the variant's parameters: its values, the added element's neutral."""
+        return FitStart({**self.neutral, **self.parameters}, self.source)
+
+    def describe(self) -> str:
+        return f"parameters of the {self.source} fit (one start the fit itself, the rest screened)"
 
 
 def dominant_frequency_hz(test: RigTest) -> float:
@@ -109,11 +128,15 @@ def anchored_coordinates(start, space: SearchSpace) -> dict[int, float]:
     """{coordinate index: value} of a start's parameters (a slow loop's, :class:`LoopStart`, or a
     data sheet's, ``table_start.TableStart``) in the box's coordinates, clipped into the box (a
     stiffness of 0 at the box's lowest); a coordinate whose kind reads a parameter the start does
-    not give is left to the screening."""
+    not give, or that its values cannot say (a ratio over a stiffness of 0: a Maxwell element's
+    time constant at its neutral values), is left to the screening."""
     bounds = space.bounds()
     out = {}
     for i, c in enumerate(space.coordinates):
         if c.parameter in start.parameters and all(name in start.parameters for name in c.kind.reads(c)):
-            value = c.kind.to_coordinate(c, start.parameters[c.parameter], start.parameters, space)
+            try:
+                value = c.kind.to_coordinate(c, start.parameters[c.parameter], start.parameters, space)
+            except (ZeroDivisionError, ValueError):
+                continue
             out[i] = float(np.clip(value, bounds[i, 0], bounds[i, 1]))
     return out

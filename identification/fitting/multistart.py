@@ -110,9 +110,12 @@ class StartRecord:
 @dataclass(frozen=True)
 class AnchoredStarts:
     """``count`` more screened points, the first Sobol points with the coordinates ``values``
-    ({coordinate index: value}, from the data: ``identification.fitting.loop_start``) set."""
+    ({coordinate index: value}, from the data: ``identification.fitting.loop_start``) set; the
+    first of them also with the coordinates ``first`` set (a nested model's fit whole: its values
+    and the added element's neutral ones)."""
     values: dict[int, float]
     count: int
+    first: dict[int, float] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -136,6 +139,8 @@ def screen(problem: Problem, engine, count: int, seed: int, progress=None, ancho
         extra = theta[np.arange(anchored.count) % count].copy()
         for index, value in anchored.values.items():
             extra[:, index] = value
+        for index, value in anchored.first.items():
+            extra[0, index] = value
         theta = np.vstack([theta, extra])
         count = len(theta)
     if prefix is not None:

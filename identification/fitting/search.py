@@ -26,7 +26,7 @@ from identification.fitting.ensemble import (PROBES, PROFILE_EVALUATIONS, PROFIL
 from identification.errors import CharacterisationWarning, EnsembleWarning
 from identification.fitting.result import MIN_AGREEING, FitResult, RigTestFit, TableFit, agreeing_starts
 from identification.measured.kdyn_table import KdynTable
-from identification.fitting.loop_start import LOOP_STARTS, anchored_coordinates, slow_loop_start
+from identification.fitting.loop_start import LOOP_STARTS, FitStart, anchored_coordinates, slow_loop_start
 from identification.measured.measurements import Measurement
 from identification.measured.multiaxis import vector_nrmse
 from identification.fitting.multistart import (AnchoredStarts, PrefixScreening, Problem, StartRecord, failed_starts,
@@ -168,6 +168,9 @@ class SearchRequest:
     jacobian_kind: str = "exact"
     sample_ensemble: bool = True
     fixed: tuple[tuple[str, float], ...] = ()     # parameters held at given values (SearchSpace.fixed)
+    start: FitStart | None = None
+    """A nested model's fit to start from (``compare``'s variants): screened starts anchored at its
+    values where this model has them, in place of a start read off the data."""
 
 
 def run(request: SearchRequest, engine, progress: bool, started: float) -> FitResult:
@@ -345,6 +348,8 @@ class Search:
         request = self.request
         if request.settings.genetic:
             return None
+        if request.start is not None:
+            return request.start
         loop = slow_loop_start(request.tests, self.space)
         if loop is None:
             table = request.table
@@ -362,7 +367,14 @@ class Search:
         """The preset's global phase: its points and their misfits, best first."""
         settings, problem = self.request.settings, self.problem
         loop = self._data_start()
-        points = settings.screening + (LOOP_STARTS if loop else 0)
+        values = anchored_coordinates(loop, self.space) if loop else {}
+        anchored, first = (LOOP_STARTS if loop else 0), {}
+        if isinstance(loop, FitStart):
+            first = {i: value for i, value in anchored_coordinates(loop.whole(), self.space).items() if i not in values}
+            # a fit that sets every coordinate is one point: its copies would fill the stages' starts
+            anchored = LOOP_STARTS if len(values) < len(self.space.coordinates) else 1
+            self.notes.append(f"note: {anchored} of the screened starts take the {loop.describe()}")
+        points = settings.screening + anchored
         prefix = None
         if settings.prefix_fraction is not None and not settings.genetic:
             objective = problem.objective.prefix(settings.prefix_fraction)
@@ -373,9 +385,8 @@ class Search:
             from identification.fitting.multistart import genetic_algorithm
             theta, misfits = genetic_algorithm(problem, self.engine, self.request.seed, self.bars.screening, PAPER_GA)
         else:
-            anchored = AnchoredStarts(loop and anchored_coordinates(loop, self.space), LOOP_STARTS)
             theta, misfits = screen(problem, self.engine, settings.screening, self.request.seed, self.bars.screening,
-                                    anchored, prefix and PrefixScreening(prefix, settings.prefix_kept))
+                                    AnchoredStarts(values, anchored, first), prefix and PrefixScreening(prefix, settings.prefix_kept))
         self.evaluations += settings.global_evaluations(points) + kept
         return theta, misfits
 

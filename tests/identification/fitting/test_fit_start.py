@@ -1,0 +1,53 @@
+"""A search that starts from a nested model's fit (``loop_start.FitStart``: ``compare`` weighing the
+recommended model's variants): one screened start is that fit itself, the added element at its
+neutral values, so the variant ends no worse than the fit it nests, whatever its budget; a fit
+that sets every coordinate is one start, not copies of it."""
+from dataclasses import replace
+from pathlib import Path
+
+import pytest
+
+from fmu_src.model.registry import get_model
+from identification.analysis.compare import _neutral
+from identification.fitting.engine import SerialEngine
+from identification.fitting.fit import training_request
+from identification.fitting.loop_start import FitStart
+from identification.fitting.presets import SearchSettings
+from identification.fitting.search import run
+from identification.measured.rig_tests import training_tests
+
+DATA = Path(__file__).resolve().parents[3] / "data"
+TINY = SearchSettings(screening=4, stages=((1, 3),))
+"""Four Sobol points and one start of three evaluations: alone, far from any fit."""
+
+
+@pytest.fixture(scope="module")
+def tests_and_fit():
+    tests = training_tests(sine=[DATA / "synthetic_table5_sine_2mm_10Hz.csv"],
+                           step=[DATA / "synthetic_table5_step_2mm_rise0.4s.csv"], rise_times_s=[0.4])
+    base = run(training_request(tests, "single_bouc_wen", screening=256, starts=8, ensemble=False),
+               SerialEngine(), False, 0.0)
+    return tests, base
+
+
+def test_a_variant_with_an_element_added_starts_at_the_fit_it_nests(tests_and_fit):
+    tests, base = tests_and_fit
+    variant = get_model("single_bouc_wen+maxwell")
+    start = FitStart(dict(base.parameters.parameters), "single_bouc_wen", _neutral(variant))
+    assert start.neutral == {"maxwell_k": 0.0, "maxwell_c": 1.0}
+    request = replace(training_request(tests, variant, ensemble=False), settings=TINY, start=start)
+    result = run(request, SerialEngine(), False, 0.0)
+    # the Maxwell element's stiffness at the box's lowest, its time constant screened: the fit's force
+    # within a fraction of a per cent; least squares from there only descends
+    assert result.misfit <= base.misfit * 1.001
+    assert any("screened starts take the parameters of the single_bouc_wen fit" in note for note in result.notes)
+
+
+def test_a_fit_that_sets_every_coordinate_is_one_start(tests_and_fit):
+    tests, base = tests_and_fit
+    # the element left out: every coordinate of the plain model is the nested fit's (here, its own)
+    start = FitStart(dict(base.parameters.parameters), "single_bouc_wen")
+    request = replace(training_request(tests, "single_bouc_wen", ensemble=False), settings=TINY, start=start)
+    result = run(request, SerialEngine(), False, 0.0)
+    assert any(note.startswith("note: 1 of the screened starts take") for note in result.notes)
+    assert result.misfit <= base.misfit * (1 + 1e-9)
