@@ -51,7 +51,7 @@ from identification.fitting.result import (FLOOR_FACTOR, FitResult, TableFit, in
                                            sines_repeatability)
 from identification.fitting.fit import training_request
 from identification.fitting.loop_start import FitStart
-from identification.fitting.presets import FitOptions
+from identification.fitting.presets import FitOptions, from_a_fit
 from identification.analysis.race import Stopped, race_models
 from identification.fitting.search import table_fit
 from identification.interrupt import writing
@@ -269,7 +269,7 @@ class _Comparison:
         by_model = self.options.fixed_by_model or {}
         held = fixed if fixed is not None else by_model.get(bushing.name, self.options.fixed)
         request = training_request(self.tests if tests is None else tests, bushing, replace(self.training, fixed=held))
-        return request if start is None else replace(request, start=start)
+        return request if start is None else replace(request, start=start, settings=from_a_fit(request.settings))
 
     def fit(self, engine) -> None:
         """Race the models, assess them and recommend one; then race the recommended model's

@@ -76,9 +76,29 @@ PRESETS = {
 }
 
 
-def global_phase(preset: str) -> str:
-    """What the preset's global phase is, in words."""
-    settings = PRESETS[preset]
+FROM_A_FIT_SCREENING = 1.0 / 8.0
+FROM_A_FIT_STARTS = 1.0 / 4.0
+FROM_A_FIT_FINAL_STARTS = 3
+"""A search that starts from a nested model's fit (``loop_start.FitStart``: ``compare``'s variants
+of its recommended model) screens this share of the preset's points and runs this share of each
+stage's starts, at least ``FROM_A_FIT_FINAL_STARTS`` to the end (two agreeing make a fit
+converged): its best start is known to be the fit it nests (docs/benchmarks.md, "A test
+matrix", measures what this costs and saves)."""
+
+
+def from_a_fit(settings: SearchSettings) -> SearchSettings:
+    """``settings`` for a search that starts from a nested model's fit (``FROM_A_FIT_*``); the
+    paper's GA as it is."""
+    if settings.genetic:
+        return settings
+    stages = tuple((min(starts, max(FROM_A_FIT_FINAL_STARTS, round(starts * FROM_A_FIT_STARTS))), evaluations)
+                   for starts, evaluations in settings.stages)
+    return replace(settings, screening=max(1, round(settings.screening * FROM_A_FIT_SCREENING)), stages=stages)
+
+
+def global_phase(preset: str | SearchSettings) -> str:
+    """What the preset's global phase is (or that of the settings given), in words."""
+    settings = PRESETS[preset] if isinstance(preset, str) else preset
     if settings.genetic:
         return (f"the paper's GA (pymoo, population {PAPER_GA['population']}, "
                 f"{PAPER_GA['generations']} generations)")
@@ -89,10 +109,12 @@ def global_phase(preset: str) -> str:
     return f"{settings.screening} scrambled Sobol points"
 
 
-def describe(preset: str) -> str:
-    """The preset's search in one sentence (the parameter file's ``method``)."""
-    stages = ", ".join(f"{s} x {e}" for s, e in PRESETS[preset].stages)
-    return (f"{global_phase(preset)}, then successive halving of bounded trust-region least squares "
+def describe(preset: str | SearchSettings) -> str:
+    """The preset's search (or the search the settings given run) in one sentence (the parameter
+    file's ``method``)."""
+    settings = PRESETS[preset] if isinstance(preset, str) else preset
+    stages = ", ".join(f"{s} x {e}" for s, e in settings.stages)
+    return (f"{global_phase(settings)}, then successive halving of bounded trust-region least squares "
             f"(starts x evaluations: {stages}) on chi^2/n over every sample")
 
 

@@ -244,6 +244,7 @@ class FitResult(FittedParameters):
     screened_misfit: float | None = None   # the global phase's best chi^2/n (None: no search, a linear model)
     first_stage_misfit: float | None = None  # the best chi^2/n after the first least-squares stage
     before_last_misfit: float | None = None  # the best chi^2/n after every stage but the last
+    method: str | None = None              # the search as it ran, in words (None: the preset's)
 
     @property
     def free_parameters(self) -> int:
@@ -369,7 +370,7 @@ class FitResult(FittedParameters):
     def _method(self) -> str:
         if self.space is None:
             return "linear least squares F = k*x + c*v on the tests other than steps"
-        return describe(self.preset)
+        return self.method or describe(self.preset)
 
     def summary(self) -> str:
         """A report like lmfit's fit_report: figures first, then the warnings."""

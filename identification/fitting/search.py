@@ -35,7 +35,7 @@ from identification.measured.offsets import MIN_REST_S, MIN_REST_SAMPLES, held_f
 from identification.measured.repeatability import estimate_repeatability
 from identification.measured.noise import NoiseEstimate
 from identification.fitting.objectives import MultiAxisTests, Objective, nrmse
-from identification.fitting.presets import PAPER_GA, SearchSettings
+from identification.fitting.presets import PAPER_GA, SearchSettings, describe
 from identification.fitting.progress import SearchProgress, notice_later
 from identification.fitting.refinement import refine_steps
 from identification.fitting.search_space import SearchSpace
@@ -342,6 +342,12 @@ class Search:
         self.n, self.d = objective.size, len(self.space.names)     # residuals, coordinates
         return Problem(objective, self.space, self.jacobian_kind)
 
+    def _method(self) -> str:
+        """The search as it ran (``presets.describe`` of its settings), from a nested model's fit
+        where it started from one."""
+        start = self.request.start
+        return describe(self.request.settings) + (f"; started from the {start.source} fit" if start else "")
+
     def _data_start(self):
         """A start read off the data (a slow loop, else a table), or None; a table that gives
         none says why in a note. The paper's GA takes none."""
@@ -483,7 +489,7 @@ class Search:
                            failed_starts=failed_starts(records) + failed_profiles,
                            coupling=request.multi.coupling if request.multi.measurements else None,
                            screened_misfit=self.screened_misfit, first_stage_misfit=self.first_stage_misfit,
-                           before_last_misfit=self.before_last_misfit)
+                           before_last_misfit=self.before_last_misfit, method=self._method())
         result.parameters.provenance = result.provenance()
         return result
 

@@ -51,3 +51,22 @@ def test_a_fit_that_sets_every_coordinate_is_one_start(tests_and_fit):
     result = run(request, SerialEngine(), False, 0.0)
     assert any(note.startswith("note: 1 of the screened starts take") for note in result.notes)
     assert result.misfit <= base.misfit * (1 + 1e-9)
+
+
+def test_a_search_from_a_fit_screens_an_eighth_and_runs_a_quarter_of_the_starts_never_more():
+    from identification.fitting.presets import PRESETS, from_a_fit
+    settings = from_a_fit(PRESETS["default"])      # 8192 points, (128, 10), (24, 30), (6, 300)
+    assert settings.screening == 1024 and settings.stages == ((32, 10), (6, 30), (3, 300))
+    small = SearchSettings(screening=64, stages=((2, 10), (2, 30), (2, 300)))
+    assert from_a_fit(small) == replace(small, screening=8)       # at most the starts it was given
+    assert from_a_fit(PRESETS["paper"]) == PRESETS["paper"]       # the GA's population as it is
+
+
+def test_the_parameter_file_says_the_search_as_it_ran(tests_and_fit):
+    tests, base = tests_and_fit
+    assert base.provenance()["method"].startswith("256 scrambled Sobol points")      # screening=256 given
+    start = FitStart(dict(base.parameters.parameters), "single_bouc_wen")
+    request = replace(training_request(tests, "single_bouc_wen", ensemble=False), settings=TINY, start=start)
+    method = run(request, SerialEngine(), False, 0.0).provenance()["method"]
+    assert method.startswith("4 scrambled Sobol points") and "(starts x evaluations: 1 x 3)" in method
+    assert method.endswith("; started from the single_bouc_wen fit")
