@@ -99,8 +99,10 @@ def test_the_rounded_cage_tends_to_the_hard_cage_solved_by_brentq():
 
 @pytest.mark.parametrize("params, amplitude_mm, frequency_hz", [
     (HARD, 0.05, 8.0),          # inside the free travel: the plate takes the volume
-    (HARD, 0.3, 7.0),           # on and off the cage each cycle, below the resonance
-    (DEFAULTS, 1.0, 9.0),       # the rounded cage, on it for most of the cycle, at the resonance
+    # on and off the cage each cycle, below the resonance; the rounded cage, on it for most of the
+    # cycle, at the resonance: 10-13 s each, in the slow tier (the README's command stays short)
+    pytest.param(HARD, 0.3, 7.0, marks=pytest.mark.slow),
+    pytest.param(DEFAULTS, 1.0, 9.0, marks=pytest.mark.slow),
 ])
 def test_the_data_sheet_follows_the_mount_solved_by_scipy(params, amplitude_mm, frequency_hz):
     # the model's steady first harmonic (characterise: the compiled path, 256 steps a cycle,
