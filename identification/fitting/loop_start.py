@@ -136,7 +136,7 @@ def anchored_coordinates(start, space: SearchSpace) -> dict[int, float]:
         if c.parameter in start.parameters and all(name in start.parameters for name in c.kind.reads(c)):
             try:
                 value = c.kind.to_coordinate(c, start.parameters[c.parameter], start.parameters, space)
-            except (ZeroDivisionError, ValueError):
+            except ZeroDivisionError:
                 continue
             out[i] = float(np.clip(value, bounds[i, 0], bounds[i, 1]))
     return out

@@ -116,6 +116,9 @@ class AnchoredStarts:
     values: dict[int, float]
     count: int
     first: dict[int, float] = field(default_factory=dict)
+    kept: bool = False
+    """Whether the first of them passes a prefix screening whatever its misfit there (a nested
+    model's fit: the point the search must not lose)."""
 
 
 @dataclass(frozen=True)
@@ -135,7 +138,9 @@ def screen(problem: Problem, engine, count: int, seed: int, progress=None, ancho
     bounds = problem.space.bounds()
     unit = qmc.Sobol(len(bounds), scramble=True, seed=np.random.default_rng(seed)).random(count)
     theta = bounds[:, 0] + unit * (bounds[:, 1] - bounds[:, 0])
+    protected = None
     if anchored is not None and anchored.values and anchored.count:
+        protected = count if anchored.kept else None
         extra = theta[np.arange(anchored.count) % count].copy()
         for index, value in anchored.values.items():
             extra[:, index] = value
@@ -145,7 +150,10 @@ def screen(problem: Problem, engine, count: int, seed: int, progress=None, ancho
         count = len(theta)
     if prefix is not None:
         partial = _misfits(prefix.problem, engine, theta, progress)
-        chosen = np.sort(np.argsort(partial, kind="stable")[:max(1, math.ceil(prefix.kept * count))])
+        chosen = np.argsort(partial, kind="stable")[:max(1, math.ceil(prefix.kept * count))]
+        if protected is not None and protected not in chosen:
+            chosen[-1] = protected
+        chosen = np.sort(chosen)
         theta = theta[chosen]
     return theta, _misfits(problem, engine, theta, progress)
 

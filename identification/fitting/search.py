@@ -346,7 +346,8 @@ class Search:
         """The search as it ran (``presets.describe`` of its settings), from a nested model's fit
         where it started from one."""
         start = self.request.start
-        return describe(self.request.settings) + (f"; started from the {start.source} fit" if start else "")
+        used = start is not None and not self.request.settings.genetic     # the paper's GA takes no start
+        return describe(self.request.settings) + (f"; started from the {start.source} fit" if used else "")
 
     def _data_start(self):
         """A start read off the data (a slow loop, else a table), or None; a table that gives
@@ -374,8 +375,8 @@ class Search:
         settings, problem = self.request.settings, self.problem
         loop = self._data_start()
         values = anchored_coordinates(loop, self.space) if loop else {}
-        anchored, first = (LOOP_STARTS if loop else 0), {}
-        if isinstance(loop, FitStart):
+        anchored, first = (LOOP_STARTS if values else 0), {}
+        if isinstance(loop, FitStart) and values:
             first = {i: value for i, value in anchored_coordinates(loop.whole(), self.space).items() if i not in values}
             # a fit that sets every coordinate is one point: its copies would fill the stages' starts
             anchored = LOOP_STARTS if len(values) < len(self.space.coordinates) else 1
@@ -392,7 +393,7 @@ class Search:
             theta, misfits = genetic_algorithm(problem, self.engine, self.request.seed, self.bars.screening, PAPER_GA)
         else:
             theta, misfits = screen(problem, self.engine, settings.screening, self.request.seed, self.bars.screening,
-                                    AnchoredStarts(values, anchored, first), prefix and PrefixScreening(prefix, settings.prefix_kept))
+                                    AnchoredStarts(values, anchored, first, kept=isinstance(loop, FitStart)), prefix and PrefixScreening(prefix, settings.prefix_kept))
         self.evaluations += settings.global_evaluations(points) + kept
         return theta, misfits
 

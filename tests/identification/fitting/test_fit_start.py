@@ -30,12 +30,15 @@ def tests_and_fit():
     return tests, base
 
 
-def test_a_variant_with_an_element_added_starts_at_the_fit_it_nests(tests_and_fit):
+@pytest.mark.parametrize("settings", [TINY, SearchSettings(screening=64, stages=((1, 3),), prefix_fraction=0.1,
+                                                           prefix_kept=1 / 64)])
+def test_a_variant_with_an_element_added_starts_at_the_fit_it_nests(tests_and_fit, settings):
+    # with a prefix screening too, which keeps 5 of the 320 points and must keep the fit's own
     tests, base = tests_and_fit
     variant = get_model("single_bouc_wen+maxwell")
     start = FitStart(dict(base.parameters.parameters), "single_bouc_wen", _neutral(variant))
     assert start.neutral == {"maxwell_k": 0.0, "maxwell_c": 1.0}
-    request = replace(training_request(tests, variant, ensemble=False), settings=TINY, start=start)
+    request = replace(training_request(tests, variant, ensemble=False), settings=settings, start=start)
     result = run(request, SerialEngine(), False, 0.0)
     # the Maxwell element's stiffness at the box's lowest, its time constant screened: the fit's force
     # within a fraction of a per cent; least squares from there only descends
@@ -70,3 +73,18 @@ def test_the_parameter_file_says_the_search_as_it_ran(tests_and_fit):
     method = run(request, SerialEngine(), False, 0.0).provenance()["method"]
     assert method.startswith("4 scrambled Sobol points") and "(starts x evaluations: 1 x 3)" in method
     assert method.endswith("; started from the single_bouc_wen fit")
+
+
+def test_compare_searches_each_variant_from_the_recommended_fit(tmp_path):
+    import json
+    from identification.__main__ import main
+    out = tmp_path / "compare"
+    assert main(["compare", "--sine", str(DATA / "synthetic_table5_sine_2mm_10Hz.csv"), "--step",
+                 str(DATA / "synthetic_table5_step_2mm_rise0.4s.csv"), "--rise-time", "0.4", "--models",
+                 "single_bouc_wen", "--try-options", "maxwell", "--screening", "32", "--starts", "1",
+                 "--no-ensemble", "--quiet", "--workers", "1", "--out", str(out)]) == 0
+    method = lambda name: json.loads((out / f"params_{name}.json").read_text())["fit"]["method"]
+    assert method("single_bouc_wen").startswith("32 scrambled Sobol points") and "started from" not in method(
+        "single_bouc_wen")
+    variant = method("single_bouc_wen+maxwell")       # an eighth of the 32 points, from the fit
+    assert variant.startswith("4 scrambled Sobol points") and variant.endswith("; started from the single_bouc_wen fit")
