@@ -104,8 +104,7 @@ def _search(base: BushingModel, options: Options) -> SearchBox:
         held = held + element.held
     loop = base.search.loop_start if base.search is not None and not options.replaces_static_spring else None
     if loop is not None:       # the friction alone: the options' neutral values too
-        loop = replace(loop, friction_alone=loop.friction_alone
-                       + tuple(pair for element, _ in options.elements for pair in element.neutral))
+        loop = replace(loop, friction_alone=loop.friction_alone + options.neutral)
     return SearchBox(coordinates, unit_weights=unit_weights, zeros=zeros, held=held, loop_start=loop, table_start=None)
 
 

@@ -293,7 +293,8 @@ class _Comparison:
             # each variant nests the recommended model or is nested in it: its fit is where to start
             fitted = dict(self.results[self.recommendation.model].parameters.parameters)
             more, more_stopped, more_searches = race_models([self.request(b, dict(f), start=FitStart(
-                fitted, self.recommendation.model, _neutral(b))) for b, f in variants], engine,
+                fitted, self.recommendation.model, dict(b.options.neutral if b.options else ())))
+                for b, f in variants], engine,
                                                             False, options.progress,
                                                             lambda r, s: settled({**results, **r}, stopped + s))
             self.results.update(more)
@@ -453,13 +454,6 @@ class _SettledWriter:
                 result.save(self.out_dir / f"params_{model}.json", data=self.data)
                 self.assessment(result)
         _write_comparison(self.out_dir, list(self.assessments.values()), None, stopped)
-
-
-def _neutral(bushing) -> dict[str, float]:
-    """The neutral values of a derived model's option elements (``OptionElement.neutral``: those
-    that leave its base's force as it is); none for a registered model."""
-    elements = bushing.options.elements if bushing.options is not None else ()
-    return {name: value for element, _ in elements for name, value in element.neutral}
 
 
 def _validation_errors(validation, bushings, parameters: dict, assessments: list[Assessment], training_names: set):

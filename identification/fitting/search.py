@@ -350,8 +350,9 @@ class Search:
         return describe(self.request.settings) + (f"; started from the {start.source} fit" if used else "")
 
     def _data_start(self):
-        """A start read off the data (a slow loop, else a table), or None; a table that gives
-        none says why in a note. The paper's GA takes none."""
+        """The request's start (a nested model's fit), else one read off the data (a slow loop,
+        else a table), or None; a table that gives none says why in a note. The paper's GA takes
+        none."""
         request = self.request
         if request.settings.genetic:
             return None
@@ -370,18 +371,25 @@ class Search:
             self.notes.append(f"note: {LOOP_STARTS} of the screened starts take the {loop.describe()}")
         return loop
 
+    def _anchored_starts(self, start) -> AnchoredStarts:
+        """The screened starts anchored at a start (``_data_start``'s; none: no point). A nested
+        model's fit (``FitStart``) keeps its first point whole through a prefix screening, and is
+        one point where it sets every coordinate (its copies would fill the stages' starts)."""
+        values = anchored_coordinates(start, self.space) if start else {}
+        if not values:
+            return AnchoredStarts({}, 0)
+        if not isinstance(start, FitStart):
+            return AnchoredStarts(values, LOOP_STARTS)
+        first = {i: value for i, value in anchored_coordinates(start.whole(), self.space).items() if i not in values}
+        count = LOOP_STARTS if len(values) < len(self.space.coordinates) else 1
+        self.notes.append(f"note: {count} of the screened starts take the {start.describe()}")
+        return AnchoredStarts(values, count, first, kept=True)
+
     def _global_phase(self):
         """The preset's global phase: its points and their misfits, best first."""
         settings, problem = self.request.settings, self.problem
-        loop = self._data_start()
-        values = anchored_coordinates(loop, self.space) if loop else {}
-        anchored, first = (LOOP_STARTS if values else 0), {}
-        if isinstance(loop, FitStart) and values:
-            first = {i: value for i, value in anchored_coordinates(loop.whole(), self.space).items() if i not in values}
-            # a fit that sets every coordinate is one point: its copies would fill the stages' starts
-            anchored = LOOP_STARTS if len(values) < len(self.space.coordinates) else 1
-            self.notes.append(f"note: {anchored} of the screened starts take the {loop.describe()}")
-        points = settings.screening + anchored
+        anchors = self._anchored_starts(self._data_start())
+        points = settings.screening + anchors.count
         prefix = None
         if settings.prefix_fraction is not None and not settings.genetic:
             objective = problem.objective.prefix(settings.prefix_fraction)
@@ -393,7 +401,7 @@ class Search:
             theta, misfits = genetic_algorithm(problem, self.engine, self.request.seed, self.bars.screening, PAPER_GA)
         else:
             theta, misfits = screen(problem, self.engine, settings.screening, self.request.seed, self.bars.screening,
-                                    AnchoredStarts(values, anchored, first, kept=isinstance(loop, FitStart)), prefix and PrefixScreening(prefix, settings.prefix_kept))
+                                    anchors, prefix and PrefixScreening(prefix, settings.prefix_kept))
         self.evaluations += settings.global_evaluations(points) + kept
         return theta, misfits
 

@@ -107,6 +107,12 @@ class Options:
         return Options(self.chosen + other.chosen)
 
     @property
+    def neutral(self) -> tuple[tuple[str, float], ...]:
+        """(parameter, value) of every element's neutral values (``OptionElement.neutral``: with
+        them the base's force is as it is), in the elements' order."""
+        return tuple(pair for element, _ in self.elements for pair in element.neutral)
+
+    @property
     def replaces_static_spring(self) -> bool:
         return any(element.replaces_static_spring for element, _ in self.elements)
 

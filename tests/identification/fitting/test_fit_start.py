@@ -8,7 +8,6 @@ from pathlib import Path
 import pytest
 
 from fmu_src.model.registry import get_model
-from identification.analysis.compare import _neutral
 from identification.fitting.engine import SerialEngine
 from identification.fitting.fit import training_request
 from identification.fitting.loop_start import FitStart
@@ -36,7 +35,7 @@ def test_a_variant_with_an_element_added_starts_at_the_fit_it_nests(tests_and_fi
     # with a prefix screening too, which keeps 5 of the 320 points and must keep the fit's own
     tests, base = tests_and_fit
     variant = get_model("single_bouc_wen+maxwell")
-    start = FitStart(dict(base.parameters.parameters), "single_bouc_wen", _neutral(variant))
+    start = FitStart(dict(base.parameters.parameters), "single_bouc_wen", dict(variant.options.neutral))
     assert start.neutral == {"maxwell_k": 0.0, "maxwell_c": 1.0}
     request = replace(training_request(tests, variant, ensemble=False), settings=settings, start=start)
     result = run(request, SerialEngine(), False, 0.0)
