@@ -172,20 +172,34 @@ def native_fmu_path(tmp_path_factory) -> Path:
     return built_once(tmp_path_factory, "native_table5", lambda folder: build_fmu.build_native_fmu(out_dir=folder).path)
 
 
+def host_platforms(fmi_version: int) -> tuple[str, ...] | None:
+    """The platform of this machine's library among a native FMU's (FMI ``fmi_version``): what the
+    every-model fixtures build, half the compilations of the quick platforms (the Windows library's
+    own tests build theirs: ``native_fmu_path``). None (the quick platforms) on a machine that is
+    not one of the FMU's platforms."""
+    from fmu_src.fmi.native.platforms import PLATFORMS, host_target
+    target = host_target()
+    names = tuple(p.name for p in PLATFORMS[fmi_version] if p.targets == (target,))
+    return names or None
+
+
 @pytest.fixture(scope="session")
 def native_model_fmus(tmp_path_factory) -> dict:
-    """Each model's native FMU (FMI 2.0), and the six-axis one, with their default parameters."""
+    """Each model's native FMU (FMI 2.0), and the six-axis one, with their default parameters, for
+    this machine's platform only (``host_platforms``)."""
     from fmu_src.model.registry import MODELS
     return built_once(tmp_path_factory, "native", lambda folder: {
-        name: build_fmu.build_native_fmu(out_dir=folder, model=name).path for name in (*MODELS, "six_axis")})
+        name: build_fmu.build_native_fmu(out_dir=folder, model=name, platforms=host_platforms(2)).path
+        for name in (*MODELS, "six_axis")})
 
 
 @pytest.fixture(scope="session")
 def native_model_fmi3_fmus(tmp_path_factory) -> dict:
-    """Each model's native FMU as FMI 3.0, and the six-axis one, with their default parameters."""
+    """Each model's native FMU as FMI 3.0, and the six-axis one, with their default parameters, for
+    this machine's platform only (``host_platforms``)."""
     from fmu_src.model.registry import MODELS
     return built_once(tmp_path_factory, "native_fmi3", lambda folder: {
-        name: build_fmu.build_native_fmu(out_dir=folder, model=name, fmi_version=3).path
+        name: build_fmu.build_native_fmu(out_dir=folder, model=name, fmi_version=3, platforms=host_platforms(3)).path
         for name in (*MODELS, "six_axis")})
 
 
@@ -201,14 +215,16 @@ def pythonfmu_model_fmus(tmp_path_factory) -> dict:
 def coupled_six_axis_fmus(tmp_path_factory) -> dict:
     """The illustrative six axes with a spherical group (the proposed model on x, y, z) and a conical
     one (Berg on rx, ry) (``example_parameter_files.six_axis_file``): its parameter file ("file"), its
-    pythonfmu FMU and its native FMUs ("fmi2", "fmi3")."""
+    pythonfmu FMU and its native FMUs ("fmi2", "fmi3", this machine's platform only)."""
     from example_parameter_files import six_axis_file
 
     def build(folder):
         path = six_axis_file(folder, {"translation": "spherical", "rotation": "conical"})
         return {"file": path, "pythonfmu": build_fmu.build_fmu(path, folder / "pythonfmu", model="six_axis"),
-                "fmi2": build_fmu.build_native_fmu(path, folder / "fmi2", model="six_axis").path,
-                "fmi3": build_fmu.build_native_fmu(path, folder / "fmi3", model="six_axis", fmi_version=3).path}
+                "fmi2": build_fmu.build_native_fmu(path, folder / "fmi2", model="six_axis",
+                                                   platforms=host_platforms(2)).path,
+                "fmi3": build_fmu.build_native_fmu(path, folder / "fmi3", model="six_axis", fmi_version=3,
+                                                   platforms=host_platforms(3)).path}
     return built_once(tmp_path_factory, "coupled_six_axis", build)
 
 

@@ -15,6 +15,9 @@ from fmu_src.fmi.axes import SIX_AXES
 from fmu_src.parameter_files import read_six_axis
 from test_coupled_six_axis import PORTS, STEP_S, assert_state_round_trip, plane_path, run_fmu, run_group
 
+# the whole module builds the coupled six-axis FMU's native twins (FMI 2 and 3): the slow tier
+pytestmark = pytest.mark.slow
+
 
 @pytest.fixture(scope="module")
 def coupled(coupled_six_axis_fmus):

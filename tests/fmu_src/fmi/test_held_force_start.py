@@ -155,6 +155,7 @@ def test_a_coupled_group_refuses_a_held_force():
     assert six_axis_document(axes, coupling="radial")
 
 
+@pytest.mark.slow
 def test_a_coupled_groups_fmu_refuses_a_held_force_set_at_its_start(tmp_path):
     import build_fmu
     from fmu_src.parameter_files import save_six_axis

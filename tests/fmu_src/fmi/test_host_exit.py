@@ -57,6 +57,7 @@ def run_hosts(fmus: dict, processes: int) -> list[tuple[int, str]]:
     return outcomes
 
 
+@pytest.mark.slow
 def test_a_python_host_frees_and_runs_every_models_pythonfmu_fmu_and_exits_cleanly(pythonfmu_model_fmus):
     outcomes = run_hosts(pythonfmu_model_fmus, 2)
     assert [code for code, _ in outcomes] == [0, 0], outcomes

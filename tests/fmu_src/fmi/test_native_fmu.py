@@ -178,8 +178,8 @@ def extracted_binary(fmu, platform, tmp_path):
 
 @pytest.mark.skipif(shutil.which(MINGW_OBJDUMP) is None,
                     reason="needs mingw-w64's objdump (Debian: apt-get install gcc-mingw-w64-x86-64)")
-def test_the_win64_dll_is_pe32_plus_exports_fmi2_and_imports_no_python(native_fmus, tmp_path):
-    dll = extracted_binary(native_fmus["proposed"], "win64", tmp_path)
+def test_the_win64_dll_is_pe32_plus_exports_fmi2_and_imports_no_python(native_fmu_path, tmp_path):
+    dll = extracted_binary(native_fmu_path, "win64", tmp_path)
     headers = subprocess.run([MINGW_OBJDUMP, "-p", str(dll)], capture_output=True, text=True, check=True).stdout
     assert "Magic\t\t\t020b" in headers                      # PE32+ (64 bit)
     imports = [line.split(":", 1)[1].strip() for line in headers.splitlines() if "DLL Name:" in line]
@@ -191,9 +191,9 @@ def test_the_win64_dll_is_pe32_plus_exports_fmi2_and_imports_no_python(native_fm
 @pytest.mark.slow
 @pytest.mark.skipif(shutil.which(MINGW_GCC) is None or WINE is None or shutil.which("gcc") is None,
                     reason="needs gcc, mingw-w64 and wine (Debian: apt-get install gcc-mingw-w64-x86-64 wine64)")
-def test_the_win64_dll_under_wine_gives_the_forces_of_linux64(native_fmus, tmp_path):
+def test_the_win64_dll_under_wine_gives_the_forces_of_linux64(native_fmu_path, tmp_path):
     from test_c_host import HOST_SOURCE
-    path = native_fmus["proposed"]
+    path = native_fmu_path
     description = read_model_description(str(path))
     refs = {v.name: v.valueReference for v in description.modelVariables}
     dll, so = extracted_binary(path, "win64", tmp_path), extracted_binary(path, "linux64", tmp_path)

@@ -41,6 +41,7 @@ def run_outside_the_checkout(site: Path, cwd: Path, code: str) -> subprocess.Com
                           timeout=300)
 
 
+@pytest.mark.slow
 def test_the_wheel_declares_both_console_scripts(installed_wheel):
     entry_points, = installed_wheel.glob("*.dist-info/entry_points.txt")
     text = entry_points.read_text()
@@ -48,6 +49,7 @@ def test_the_wheel_declares_both_console_scripts(installed_wheel):
     assert "bushing-build-fmu = build_fmu:main" in text
 
 
+@pytest.mark.slow
 def test_the_installed_build_finds_its_default_parameters_outside_the_checkout(installed_wheel, tmp_path):
     code = ("import sys, build_fmu\n"
             "print(build_fmu.__file__)\n"
@@ -60,6 +62,7 @@ def test_the_installed_build_finds_its_default_parameters_outside_the_checkout(i
     assert read_model_description(str(fmu)).version == __version__
 
 
+@pytest.mark.slow
 def test_the_installed_build_makes_a_native_fmu_outside_the_checkout(installed_wheel, tmp_path):
     # the C layer ships with the package (package data), the generated C is written at build time
     result = run_outside_the_checkout(installed_wheel, tmp_path,

@@ -112,11 +112,13 @@ def check_bundle(bundle, models, versions=(2, 3)):
     assert ("MISSING PLATFORMS" in readme) == any(MISSING.values())
 
 
+@pytest.mark.slow
 def test_the_bundle_holds_valid_fmus_their_default_sets_a_readme_and_checksums(bundle):
     check_bundle(bundle, QUICK_MODELS)
     assert bundle.missing == {version: why for version, why in MISSING.items() if why}
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not HAS_MINGW, reason=NO_MINGW)
 def test_the_win64_binaries_are_x86_64_windows_dlls_exporting_the_fmi_functions(bundle):
     for (model, version), path in bundle.fmus.items():
@@ -140,6 +142,7 @@ def fitted_set(model: str) -> dict[str, float]:
     return berg_set()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("version", (2, 3))
 @pytest.mark.parametrize("model", QUICK_MODELS)
 def test_a_fitted_set_from_an_ssv_as_start_values_equals_an_fmu_built_with_it(bundle, tmp_path, model, version):

@@ -101,6 +101,7 @@ def run_cache_probe(cache_dir):
     return path, int(hits), int(misses)
 
 
+@pytest.mark.slow
 def test_the_compiled_model_is_cached_on_disk_for_the_next_process(tmp_path):
     path, hits, misses = run_cache_probe(tmp_path)
     assert (hits, misses) == (0, 1)            # the first process compiles ...
@@ -123,6 +124,7 @@ print(repr(float(forces[0, -1])), len(caught), str(caught[0].message) if caught 
 """
 
 
+@pytest.mark.slow
 def test_an_unwritable_cache_folder_compiles_in_memory_and_says_so_once(tmp_path):
     # the folder under a file: the model's module and its population module are both compiled in
     # memory, the population module importing the model's from there; one warning for the two

@@ -38,6 +38,7 @@ def test_a_generated_module_whose_template_reads_an_unbound_name_is_refused_at_g
     assert not (tmp_path / f"{name}.py").exists()       # nothing written
 
 
+@pytest.mark.slow
 def test_every_models_generated_modules_bind_every_name_they_read():
     from identification.forward import parameter_jacobian as fit_jacobian
     machinery = compiled_kernels.integration_module()
@@ -50,6 +51,7 @@ def test_every_models_generated_modules_bind_every_name_they_read():
             assert [found for found in unbound if found[2] not in compiled_kernels.INJECTED] == [], name
 
 
+@pytest.mark.slow
 def test_a_generated_module_names_no_package_so_every_fmu_shares_it():
     """The source (and so the name and numba's cache) of a model's generated modules is the same
     for fmu_src and for every FMU's packed copy: it imports nothing from the package and keeps of

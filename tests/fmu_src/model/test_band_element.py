@@ -211,6 +211,7 @@ def test_the_band_brake_truth_of_data_is_the_model_with_its_values():
     np.testing.assert_allclose(model, truth, rtol=0, atol=1e-8 * np.max(np.abs(truth)))
 
 
+@pytest.mark.slow
 def test_a_six_axis_fmus_axis_takes_a_band_in_both_fmus(tmp_path):
     # z a Kelvin-Voigt axis with a band: both six-axis FMUs give the one-axis forward model's force
     import json

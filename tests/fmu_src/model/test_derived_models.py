@@ -285,6 +285,7 @@ def test_the_fits_exact_jacobian_of_a_derived_model_equals_central_differences(b
         assert np.max(np.abs(central - sensitivities[0, :, j])) <= 1e-5 * scale, derived.parameter_names[j]
 
 
+@pytest.mark.slow
 def test_a_six_axis_fmus_axis_takes_a_derived_model_in_both_fmus(tmp_path):
     # a jounce bump stop on z: a Kelvin-Voigt axis with a limit on its positive side only
     import json

@@ -38,6 +38,7 @@ def road_runs(tmp_path_factory):
     return run_road(tmp_path_factory.mktemp("engine"))
 
 
+@pytest.mark.slow
 def test_libcosim_and_fmpy_agree_on_the_engine(road_runs):
     _, libcosim, fmpy_run = road_runs
     differences = ssp_system.largest_difference(libcosim, fmpy_run)
@@ -49,6 +50,7 @@ def test_libcosim_and_fmpy_agree_on_the_engine(road_runs):
             assert np.max(np.abs(libcosim[f"bushing_{mount}.{name}"])) > 1e-3
 
 
+@pytest.mark.slow
 def test_with_native_six_axis_fmus_libcosim_and_fmpy_agree_and_give_the_pythonfmu_systems_outputs(road_runs,
                                                                                                   tmp_path):
     _, libcosim_python, _ = road_runs
@@ -57,6 +59,7 @@ def test_with_native_six_axis_fmus_libcosim_and_fmpy_agree_and_give_the_pythonfm
     assert max(ssp_system.largest_difference(libcosim, libcosim_python).values()) <= 1e-12
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("native", [False, True])
 def test_with_radially_coupled_mounts_the_masters_agree_and_the_momentum_balances(road_runs, tmp_path, native):
     # x and y of every mount one coupled group: each axis's force now depends on the other's motion
@@ -69,12 +72,14 @@ def test_with_radially_coupled_mounts_the_masters_agree_and_the_momentum_balance
     assert 0.0 < np.max(np.abs(left[0] - left[1])) < 0.1 * np.max(left[1])     # it changes the forces, a little
 
 
+@pytest.mark.slow
 def test_momentum_changes_by_the_bushing_impulses(road_runs):
     body, _, fmpy_run = road_runs
     balance = engine_mount.momentum_balance(fmpy_run, STEP, body)
     assert balance["momentum"] < 1e-6 and balance["angular momentum"] < 1e-6, balance
 
 
+@pytest.mark.slow
 def test_the_momentum_check_sees_a_lost_or_reversed_moment(road_runs):
     # The same run, with the bushings' moments dropped or reversed as a careless master would:
     # the balance must fail, so the check above can fail.

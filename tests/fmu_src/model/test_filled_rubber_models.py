@@ -184,6 +184,7 @@ ROTATIONAL = {"berg": {"k0": 3e5, "k3": 1e6, "Ff_max": 2e3, "x2": 0.004, "k1": 1
 """Illustrative torsion sets (N.mm/rad, N.mm/rad^3, N.mm, rad, N.mm.s^alpha/rad ...)."""
 
 
+@pytest.mark.slow
 def test_the_filled_rubber_models_are_axes_of_the_six_axis_fmu_in_both_kinds(tmp_path):
     from fmpy import simulate_fmu
     from fmu_src.fmi.axes import SIX_AXES

@@ -120,6 +120,7 @@ def reference_force(t, x_of_t, v_of_t, p):
     return p["k0"] * x_of_t(t) + solution.y[0]
 
 
+@pytest.mark.slow
 def test_a_model_added_as_one_module_builds_both_fmus_and_is_fitted(tmp_path):
     copy = tmp_path / "project"
     for folder in ("fmu_src", "identification"):

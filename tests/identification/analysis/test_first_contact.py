@@ -259,6 +259,7 @@ def test_a_static_curve_gives_every_model_its_backbone_held_at_the_curve():
     assert [given.fixed[f"backbone_x{i}"] for i in (1, 2, 3)] == [-3.0, 0.0, 3.0]
 
 
+@pytest.mark.slow
 def test_compare_on_a_slow_triangle_assumes_its_backbone_and_fits(tmp_path, capsys):
     out = tmp_path / "compare"
     assert main(["compare", "--sine", str(VOIDED["triangle_4.2mm_0.05Hz"]), "--sine", str(VOIDED["sine_2mm_5Hz"]),

@@ -61,6 +61,7 @@ def test_a_starved_budget_prints_the_warning_and_stores_converged_false(tmp_path
     assert all(0.008 < t["noise_fraction"] < 0.012 for t in provenance["tests"])   # 1 % noise, estimated
 
 
+@pytest.mark.slow
 @pytest.mark.optimizer
 def test_a_model_that_cannot_describe_the_data_stays_above_the_floor_and_says_so():
     # The single Bouc-Wen element cannot show the proposed model's relaxation: on every path
@@ -256,6 +257,7 @@ def test_design_says_no_further_test_is_needed_when_the_members_agree(tmp_path, 
     assert answer["recommended"] == [] and 0 < answer["largest_spread_N"] < 10.0
 
 
+@pytest.mark.slow
 def test_fit_many_fits_each_bushing_and_reports_a_broken_one(tmp_path, capsys):
     import csv
     fleet = tmp_path / "fleet"

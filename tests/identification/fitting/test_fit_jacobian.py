@@ -275,6 +275,7 @@ def test_probe_gradients_equal_central_differences(table2_problem):
         assert np.linalg.norm(gradient - central) <= 1e-6 * np.linalg.norm(central), (kind, rate, measure)
 
 
+@pytest.mark.slow
 def test_the_generated_module_is_named_after_its_source_and_the_compilers(monkeypatch):
     """One cache key: the module's source and the compiler versions. Generated again, the same
     source and so the same module (numba's cache holds its machine code); another compiler
@@ -326,6 +327,7 @@ print(len(stats.cache_hits), len(stats.cache_misses))
 """
 
 
+@pytest.mark.slow
 def test_two_processes_asking_for_a_sensitivity_module_at_once_compile_it_once(tmp_path):
     # both start together on an empty cache: one compiles, the other waits for it
     # (numba_binding.compile_lock) and loads the machine code instead of compiling it beside it

@@ -339,6 +339,7 @@ def test_report_grid_errors_of_a_scaled_bushing_are_the_scale_on_every_case():
         assert abs(row.nrmse - (s - 1.0)) < 1e-6, row
 
 
+@pytest.mark.slow
 @pytest.mark.optimizer
 def test_paper_ga_preset_runs_the_ga_then_the_least_squares_stages(monkeypatch):
     # The preset's wiring, on whichever path the optimizer takes: the GA (not the Sobol

@@ -123,6 +123,7 @@ def assert_stopped_cleanly(run: Command, signal_number, message: str = "interrup
     assert run.left_behind == [], f"left running: {run.left_behind}"
 
 
+@pytest.mark.slow
 def test_sigterm_to_fit_ends_it_with_its_pool_and_leaves_the_output_file(tmp_path, command):
     # The signal goes to the command only, as `timeout` and `docker stop` send it: the workers
     # and the resource tracker must be ended by the command. A short screening, so that the
@@ -139,6 +140,7 @@ def test_sigterm_to_fit_ends_it_with_its_pool_and_leaves_the_output_file(tmp_pat
     assert sorted(p.name for p in tmp_path.iterdir()) == ["fit.json", "stderr.txt", "stdout.txt"]
 
 
+@pytest.mark.slow
 def test_ctrl_c_to_fit_many_keeps_the_finished_bushing_and_names_it(tmp_path, command):
     # A Kelvin-Voigt bushing (linear least squares) finishes in seconds, the other would take
     # minutes. Ctrl-C reaches every process of the group: the worker that fitted the quick one
@@ -161,6 +163,7 @@ def test_ctrl_c_to_fit_many_keeps_the_finished_bushing_and_names_it(tmp_path, co
     assert sorted(p.name for p in out.iterdir()) == ["a_quick.json", "b_slow.json", "summary.csv"]
 
 
+@pytest.mark.slow
 def test_sigterm_to_design_ends_it_without_output(tmp_path, command):
     from fmu_src.parameter_files import save_ensemble
     base = paper_parameters("table2")
@@ -175,6 +178,7 @@ def test_sigterm_to_design_ends_it_without_output(tmp_path, command):
     assert run.stdout == ""
 
 
+@pytest.mark.slow
 def test_ctrl_c_to_compare_on_a_dask_cluster_cancels_its_tasks_and_leaves_the_cluster(tmp_path, command):
     pytest.importorskip("distributed", reason="the Dask engine needs distributed (the 'dask' extra)")
     import logging

@@ -144,6 +144,7 @@ def rig(tmp_path_factory):
     return folder, sines, held
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("coupled, expected", [(True, "radial"), (False, "none")])
 def test_compare_picks_radial_on_coupled_data_and_none_on_uncoupled_data(rig, capsys, coupled, expected):
     folder, sines, held = rig
@@ -159,6 +160,7 @@ def test_compare_picks_radial_on_coupled_data_and_none_on_uncoupled_data(rig, ca
     assert (out / "coupling.csv").is_file()
 
 
+@pytest.mark.slow
 def test_compare_refuses_couplings_without_the_files_they_need(rig, capsys):
     folder, sines, held = rig
     common = ["compare", "--models", "single_bouc_wen", "--sine", str(sines[0]), "--out", str(folder / "refused")]
@@ -205,6 +207,7 @@ def _fit_arguments(out, *extra):
             "--quiet", "--workers", "1", "--out", str(out)]
 
 
+@pytest.mark.slow
 def test_a_fit_to_a_sine_and_an_ellipse_coupled_reaches_the_floor_and_predicts_unseen_plane_paths(fit_rig, capsys):
     folder, sine, files = fit_rig
     out = folder / "radial.json"
@@ -229,6 +232,7 @@ def test_a_fit_to_a_sine_and_an_ellipse_coupled_reaches_the_floor_and_predicts_u
         assert uncoupled > 3 * coupled, (name, coupled, uncoupled)
 
 
+@pytest.mark.slow
 def test_the_same_data_fitted_uncoupled_misses_its_noise_by_far(fit_rig, capsys):
     folder, sine, files = fit_rig
     out = folder / "none.json"
@@ -246,6 +250,7 @@ def test_the_same_data_fitted_uncoupled_misses_its_noise_by_far(fit_rig, capsys)
     (["--multiaxis", "{ellipse}", "--coupling", "spherical"], "the spherical coupling needs 3 axes"),
     (["--multiaxis", "{missing}", "--coupling", "radial"], "does not exist"),
 ])
+@pytest.mark.slow
 def test_fit_refuses_multiaxis_options_it_cannot_use_before_any_work(fit_rig, capsys, arguments, message):
     folder, sine, files = fit_rig
     names = {"ellipse": files["ellipse"], "sine": sine, "missing": folder / "missing.csv"}
@@ -256,6 +261,7 @@ def test_fit_refuses_multiaxis_options_it_cannot_use_before_any_work(fit_rig, ca
     assert not out.exists()
 
 
+@pytest.mark.slow
 def test_compare_says_where_multiaxis_training_goes(fit_rig, capsys):
     folder, sine, files = fit_rig
     code = main(["compare", "--models", "single_bouc_wen", "--sine", str(sine), "--multiaxis", str(files["ellipse"]),
@@ -264,6 +270,7 @@ def test_compare_says_where_multiaxis_training_goes(fit_rig, capsys):
     assert "fit --multiaxis FILE --coupling radial" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_the_multiaxis_rows_of_the_jacobian_are_its_forward_differences(fit_rig):
     """The exact Jacobian's one-axis rows come from the sensitivities, the multi-axis rows (no
     sensitivities) from differences: those rows equal difference_jacobian's bit for bit."""
@@ -291,6 +298,7 @@ def test_the_multiaxis_rows_of_the_jacobian_are_its_forward_differences(fit_rig)
     assert np.max(np.abs(jacobian[sine_rows] - differences[sine_rows]) / scale) < 1e-3
 
 
+@pytest.mark.slow
 def test_predict_runs_a_multiaxis_path_with_its_coupling_and_writes_a_multiaxis_file(fit_rig, capsys):
     folder, sine, files = fit_rig
     params = folder / "truth.json"

@@ -41,6 +41,7 @@ def fitted(request):
         return fit(tests, model="berg+rig", screening=1024, starts=32, workers=1, progress=False), truth
 
 
+@pytest.mark.slow
 @pytest.mark.optimizer
 def test_the_fit_recovers_the_rigs_offsets_within_their_uncertainty(fitted):
     result, _ = fitted
@@ -54,6 +55,7 @@ def test_the_fit_recovers_the_rigs_offsets_within_their_uncertainty(fitted):
     assert "rig offsets" in result.summary() and "force zero" in result.summary()
 
 
+@pytest.mark.slow
 def test_the_parameter_file_keeps_the_offsets_out_of_the_model_unless_asked(fitted, tmp_path):
     result, truth = fitted
     result.save(tmp_path / "p.json", ensemble=tmp_path / "e.json")
