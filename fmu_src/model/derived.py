@@ -131,7 +131,7 @@ def derive(base: BushingModel, options: Options) -> BushingModel:
         switch_specs += tuple(StateSpec(s.name, len(switch_specs) + i, s.unit, s.description)
                               for i, s in enumerate(element.switches(count)))
         own = element.states(count)
-        if own and element.step is None:
+        if own and element.step is None and not element.series:
             raise ModelContractError(f"the {element.token} option has states but no step")
         states += tuple(StateSpec(s.name, len(states) + i, s.unit, s.description) for i, s in enumerate(own))
     title = f"{base.title} with " + ", ".join(element.word for element, _ in options.elements)

@@ -65,11 +65,12 @@ def _reached(base: BushingModel, module: types.ModuleType) -> tuple[list[str], d
 
 
 class _Rename(ast.NodeTransformer):
-    """Module-level names of the base, read in its functions, renamed ``base_<name>`` (a local of
-    the same name is left alone)."""
+    """Module-level names of the base, read in its functions, renamed ``base_<name>`` (or
+    ``<prefix><name>``; a local of the same name is left alone)."""
 
-    def __init__(self, names: set[str]):
+    def __init__(self, names: set[str], prefix: str = "base_"):
         self.names = names
+        self.prefix = prefix
         self.local: set[str] = set()
 
     def visit_FunctionDef(self, node: ast.FunctionDef):
@@ -77,14 +78,14 @@ class _Rename(ast.NodeTransformer):
         self.local = {a.arg for a in node.args.args} | {n.id for n in ast.walk(node)
                                                         if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Store)}
         if node.name in self.names:
-            node.name = f"base_{node.name}"
+            node.name = f"{self.prefix}{node.name}"
         node.body = [self.visit(statement) for statement in node.body]
         self.local = outer
         return node
 
     def visit_Name(self, node: ast.Name):
         if isinstance(node.ctx, ast.Load) and node.id in self.names and node.id not in self.local:
-            node.id = f"base_{node.id}"
+            node.id = f"{self.prefix}{node.id}"
         return node
 
 
@@ -128,6 +129,8 @@ def _layout(base: BushingModel, options) -> tuple[list[str], list[tuple[OptionEl
 def wrapper_source(base: BushingModel, options) -> tuple[str, set[str]]:
     """The derived model's kernels, delegating to the renamed base's (module docstring); and the
     shared names they import. The option elements' states follow the base's."""
+    if any(element.series for element, _ in options.elements):
+        return series_wrapper_source(base, options)
     parts, placed = _layout(base, options)
     zero = "".join(f" - {element.displacement_zero(slot)}" for element, _, slot in placed
                    if element.displacement_zero is not None)
@@ -202,6 +205,137 @@ def wrapper_source(base: BushingModel, options) -> tuple[str, set[str]]:
         if helpers:
             source.append(helpers)
     return "\n\n".join(source), shared
+
+
+DEVICE_KERNELS = ("prepare", "prepare_step", "initial_state", "jump", "integrate", "derivatives", "force",
+                  "resting_state", "switches", "update")
+"""The kernels of a series element's device, renamed ``device_<name>`` under the series wrappers."""
+
+SERIES_ITERATIONS = 60
+"""Device steps a series element's step may take to find the device's velocity (``options.series``)."""
+
+
+def _device_source(base: BushingModel, inner) -> tuple[str, set[str]]:
+    """The device's kernels (the base with the options before the series element) as source, named
+    ``device_<kernel>``, and the shared names they import."""
+    text, shared = wrapper_source(base, inner)
+    tree = parse(text)
+    renamer = _Rename(set(DEVICE_KERNELS), prefix="device_")
+    return "\n\n\n".join(ast.unparse(renamer.visit(node)) for node in tree.body), shared
+
+
+def _series_integrate_source(n: int, zero: str) -> str:
+    """A series element's ``integrate`` (``series_wrapper_source``): the device's ``n`` states, then
+    its displacement; ``zero`` the text taken off x before the spring (the rig's displacement zero)."""
+    d = tuple_text(f"state[{i}]" for i in range(n))
+
+    def out(name: str, last: str) -> str:
+        return tuple_text([f"{name}[{i}]" for i in range(n)] + [last])
+
+    # the device's velocity w at which the compliance's force at the step's end is the device's:
+    # r(w) = x1 - (u0 + w h) - compliance F_device(w) falls with w; secants from w = v and the
+    # velocity of a device that held its force, the older end's residual halved where two new ones
+    # fall on one side (Illinois' regula falsi), until r is within rounding of the travel or w stops
+    # changing; then one secant more through the two latest points: its slope is the step's own, so
+    # the tangents through it are the converged step's (implicit) derivative, not the path's
+    def residual(indent: str) -> str:
+        return "".join(indent + line + "\n" for line in (
+            "s, used, status = device_integrate(m[0], d, u0, w, h, max_substeps)",
+            "total = total + used",
+            "if status != OK:", "    return state, total, status",
+            "r = x1 - (u0 + w * h) - c * device_force(m[0], s, u0 + w * h, w)"))
+    return (
+        f"def integrate(m, state, x, v, h, max_substeps):\n"
+        f"    c = m[1][0]\n    d = {d}\n"
+        # (+ 0.0 * u0, exact for a finite u0, keeps the new u a value of the state's for the
+        # tangents, whose zero of a value that is a tuple at run time they cannot size)
+        f"    if c == 0.0:\n        s, used, status = device_integrate(m[0], d, x{zero}, v, h, max_substeps)\n"
+        f"        return {out('s', f'x{zero} + v * h + 0.0 * state[{n}]')}, used, status\n"
+        f"    u0 = state[{n}]\n    x1 = x{zero} + v * h\n    total = 0\n"
+        f"    w = v\n{residual('    ')}"
+        f"    tolerance = 1e-12 * (abs(x1 - u0) + abs(w * h)) + 4e-16 * (abs(x1) + abs(u0))\n"
+        f"    wa = w\n    ra = r\n"
+        f"    if r != 0.0:\n        w = w + r / h\n    else:\n        w = w + 1e-7 * (abs(w) + 1.0)\n"
+        f"{residual('    ')}"
+        f"    for k in range({SERIES_ITERATIONS}):\n"
+        f"        if r == ra:\n"
+        f"            if abs(r) <= tolerance:\n                return {out('s', 'u0 + w * h')}, total, OK\n"
+        f"            break\n"
+        f"        wb = w\n        rb = r\n        w = wb - rb * (wb - wa) / (rb - ra)\n{residual('        ')}"
+        f"        if abs(r) <= tolerance or abs(w - wb) <= 4e-16 * (abs(w) + abs(wb)):\n"
+        f"            if r != rb:\n"
+        f"                w = w - r * (w - wb) / (r - rb)\n{residual('                ')}"
+        f"            return {out('s', 'u0 + w * h')}, total, OK\n"
+        f"        if (r < 0.0) != (rb < 0.0) or (ra < 0.0) == (r < 0.0):\n            wa = wb\n            ra = rb\n"
+        f"        else:\n            ra = 0.5 * ra\n"
+        f"    return state, total, TOO_MANY_SUBSTEPS\n")
+
+
+def series_wrapper_source(base: BushingModel, options) -> tuple[str, set[str]]:
+    """The kernels of a model whose options hold a series element (``options.series``): the device
+    (the base and the options before it, ``device_*``) in series with the compliance, the options
+    after it (stateless: the rig's offsets) outside both; and the shared names they import."""
+    from .options import ELEMENTS, Options
+    series = next(element for element, _ in options.elements if element.series)
+    inner = Options(tuple(item for item in options.chosen if ELEMENTS[item[0]].order < series.order))
+    outer = [(element, count) for element, count in options.elements if element.order > series.order]
+    for element, count in outer:
+        if element.states(count) or element.switches(count) or element.series:
+            raise ModelContractError(f"the {element.token} option has states or switches: it cannot sit outside "
+                                     f"the {series.token} option's device")
+    device, shared = _device_source(base, inner)
+    held = len(base.static_spring) if inner.replaces_static_spring else 0
+    k = len(base.specs) - held + sum(len(element.specs(count)) for element, count in inner.elements)
+    n = len(base.states) + sum(len(element.states(count)) for element, count in inner.elements)
+    parts = [f"device_prepare({tuple_text(f'p[{i}]' for i in range(k))})", f"(p[{k}],)"]
+    index, slots = k + 1, []
+    for element, count in outer:
+        size = len(element.specs(count))
+        slots.append((element, Slot(f"m[{len(parts)}]")))
+        parts.append(element.prepare(tuple(f"p[{index + i}]" for i in range(size))))
+        index += size
+    zero = "".join(f" - {element.displacement_zero(slot)}" for element, slot in slots
+                   if element.displacement_zero is not None)
+    outside = "".join(f" + {element.force(slot)}" for element, slot in slots if element.force is not None)
+    resting = "".join(f" - {element.rest_force(slot)}" for element, slot in slots if element.rest_force is not None)
+    d = tuple_text(f"state[{i}]" for i in range(n))
+
+    def out(name: str, last: str) -> str:
+        return tuple_text([f"{name}[{i}]" for i in range(n)] + [last])
+    source = [f"def prepare(p):\n    return {tuple_text(parts)}\n"]
+    if "def device_prepare_step" in device:
+        source.append(f"def prepare_step(m, h):\n    return "
+                      f"{tuple_text(['device_prepare_step(m[0], h)'] + [f'm[{i}]' for i in range(1, len(parts))])}\n")
+    source += [
+        # a device without states gives nothing to start or to rate: its calls would be dead code,
+        # which the C translation refuses
+        "def initial_state(m, x0):\n" + (f"    s = device_initial_state(m[0], x0{zero})\n" if n else "")
+        + f"    return {out('s', f'x0{zero}')}\n",
+        f"def jump(m, state, jump_mm):\n"
+        f"    if m[1][0] == 0.0:\n        s, status = device_jump(m[0], {d}, jump_mm)\n"
+        f"        return {out('s', f'state[{n}] + jump_mm')}, status\n"
+        f"    return state, OK\n",
+        _series_integrate_source(n, zero),
+    ]
+    rate = (f"    c = m[1][0]\n    d = {d}\n    u = state[{n}]\n    w = v\n"
+            f"    if c == 0.0:\n        u = x{zero}\n"
+            f"    else:\n        f0 = device_force(m[0], d, u, 0.0)\n"
+            f"        w = ((x{zero} - u) / c - f0) / (device_force(m[0], d, u, 1.0) - f0)\n")
+    source += [
+        f"def derivatives(m, state, x, v):\n{rate}" + ("    r = device_derivatives(m[0], d, u, w)\n" if n else "")
+        + f"    return {out('r', 'w')}\n",
+        f"def force(m, state, x, v):\n    c = m[1][0]\n"
+        f"    if c == 0.0:\n        f = device_force(m[0], {d}, x{zero}, v)\n"
+        f"    else:\n        f = (x{zero} - state[{n}]) / c\n    return f{outside}\n",
+        f"def switches(m, state, x, v):\n{rate}    return device_switches(m[0], d, u, w)\n"]
+    if "def device_resting_state" in device:
+        source.append(f"def resting_state(m, x0, force):\n    f = force{resting}\n"
+                      f"    u = x0{zero} - m[1][0] * f\n" + ("    s = device_resting_state(m[0], u, f)\n" if n else "")
+                      + f"    return {out('s', 'u')}\n")
+    if "def device_update" in device:
+        source.append(f"def update(m, state, x, v):\n{rate}    s = device_update(m[0], d, u, w)\n"
+                      f"    return {out('s', 'u')}\n")
+    return device + "\n\n\n" + "\n\n".join(source), shared | {"OK", "TOO_MANY_SUBSTEPS"}
 
 
 def derived_source(base: BushingModel, options) -> str:

@@ -67,6 +67,18 @@ class LogScaled(CoordinateKind):
         return _log_ratio(value, getattr(scales, self.scale))
 
 
+class Compliance(CoordinateKind):
+    """log10(value * k_ref): a compliance [mm/N] over the data's reference compliance 1/k_ref
+    (0, a rigid link, maps to -inf: the box's lowest)."""
+    name = "compliance"
+
+    def to_parameter(self, c, u, values, scales):
+        return 10.0 ** u / scales.k_ref
+
+    def to_coordinate(self, c, value, params, scales):
+        return _log_ratio(value * scales.k_ref, 1.0)
+
+
 class Gain(LogScaled):
     """A Bouc-Wen gain A: log10(A/k_ref), with A >= 1 N/mm (the paper's constraint) as a bound."""
 
@@ -289,6 +301,7 @@ KIND = _Kinds(
     LogScaled("damping", "c_ref"),        # log10(value/c_ref)
     LogScaled("force", "F_ref"),          # log10(value/F_ref): a friction force limit
     LogScaled("travel", "x_ref"),         # log10(value/x_ref): a friction's travel, x_ref the largest amplitude
+    Compliance(),                         # log10(value*k_ref): a compliance in series
     Linear("offset_force", "F_ref"),      # value/F_ref: a signed force (a backbone's at its middle knot)
     Linear("rig_travel", "x_ref", "x_zero"),    # (value - x_zero)/x_ref: a rig's displacement zero
     Linear("rig_force", "F_ref", "F_zero"),     # (value - F_zero)/F_ref: a load cell's zero

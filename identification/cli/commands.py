@@ -13,6 +13,7 @@ import os
 import sys
 import tempfile
 import warnings
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -397,7 +398,7 @@ def fit_many_command(args) -> int:
 def compare_command(args) -> int:
     from fmu_src.model.options import Options
     from identification.analysis.compare import compare_models
-    from identification.analysis.first_contact import first_contact
+    from identification.analysis.first_contact import Assumption, first_contact
     if args.multiaxis:
         raise UsageError("--multiaxis: compare fits on one-axis tests and weighs the couplings on held-out multi-axis "
                          "files (--coupling none,radial --validate-multiaxis FILE); fit a model to multi-axis tests "
@@ -423,6 +424,8 @@ def compare_command(args) -> int:
         variants = [options_of([t for t in contact.tokens if t != token]) for token in contact.tokens]
         if tried is None:
             tried = list(contact.tried)
+        else:       # named: those are tried, whatever the records would have asked for
+            contact = replace(contact, trials=tuple(Assumption(token, "named with --try-options") for token in tried))
         print(contact.format(), file=sys.stderr)
     variants += [variant for variant in (_with_option(options, token, args) for token in tried or ()) if variant]
     tests = options.training(tests)

@@ -74,6 +74,11 @@ class OptionElement:
     constraints: Callable[[int], tuple[Constraint, ...]] = lambda count: ()
     counted: bool = False
     count_range: tuple[int, int] = (0, 0)
+    series: bool = False
+    """True: the element sits in series with the base and the elements before it in order (the
+    device), and the elements after it (stateless: the rig's offsets) outside both; its one state is
+    the device's displacement and ``derived_source.series_wrapper_source`` writes its kernels
+    (its own hooks other than ``specs``, ``coordinates``, ``states`` and ``prepare`` unused)."""
     replaces_static_spring: bool = False
     """True: the base's static spring (``BushingModel.static_spring``) is held at 0 and this element
     carries the static force instead (and a slow loop's least-squares start does not apply)."""

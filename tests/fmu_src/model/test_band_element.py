@@ -16,6 +16,7 @@ from scipy.optimize import brentq
 from fmu_src.model.parameter_specs import ParameterError
 from fmu_src.model.registry import get_model
 from fmu_src.parameter_files import save_parameters
+from element_checks import assert_fmu_is_the_forward_model, assert_six_axis_z_is_the_forward_model
 from example_parameter_files import defaults
 from python_core import simulate_python_core
 
@@ -136,33 +137,11 @@ def test_the_compiled_band_element_equals_its_python_kernels_bitwise():
     np.testing.assert_array_equal(compiled, simulate_python_core(params, t, x, v, model=model.name))
 
 
-def _sine_inputs(t, amplitude_m=2.5e-3, hz=3.0):
-    w = 2 * np.pi * hz
-    signals = np.zeros(t.size, dtype=[("time", float), ("x", float), ("v", float)])
-    signals["time"], signals["x"], signals["v"] = t, amplitude_m * np.sin(w * t), amplitude_m * w * np.cos(w * t)
-    return signals
-
-
 @pytest.mark.parametrize("kind", ["pythonfmu", "native2"])
 def test_both_fmus_of_a_model_with_a_band_equal_its_forward_model(kind, tmp_path):
-    import build_fmu
-    from fmpy import simulate_fmu
-    from fmpy.validation import validate_fmu
-    from identification.forward.population import simulate_population_held
-    if kind != "pythonfmu" and shutil.which("gcc") is None and shutil.which("cc") is None:
-        pytest.skip("no C compiler for the native FMU")
-    model = get_model("single_bouc_wen+band")
-    params = dict(defaults("single_bouc_wen"), **BAND)
-    file = save_parameters(tmp_path / "band.json", params, model.name)
-    fmu = (build_fmu.build_fmu(file, tmp_path, model=model.name) if kind == "pythonfmu"
-           else build_fmu.build_native_fmu(file, tmp_path, model=model.name).path)
-    assert validate_fmu(str(fmu)) == []
-    t = np.arange(0.0, 0.8, 1e-3)
-    signals = _sine_inputs(t)
-    result = simulate_fmu(str(fmu), stop_time=t[-1], step_size=1e-3, output_interval=1e-3, input=signals, output=["F"])
-    want = simulate_population_held([model.check(params)], t, signals["x"] * 1e3, signals["v"] * 1e3, model=model)[0]
+    want = assert_fmu_is_the_forward_model(kind, get_model("single_bouc_wen+band"),
+                                           dict(defaults("single_bouc_wen"), **BAND), tmp_path)
     assert np.ptp(want) > 2 * BAND["band_f"]
-    np.testing.assert_allclose(result["F"], want[:len(result)], rtol=0, atol=1e-12 * np.max(np.abs(want)))
 
 
 @pytest.mark.parametrize("version", [2, 3])
@@ -213,31 +192,9 @@ def test_the_band_brake_truth_of_data_is_the_model_with_its_values():
 
 @pytest.mark.slow
 def test_a_six_axis_fmus_axis_takes_a_band_in_both_fmus(tmp_path):
-    # z a Kelvin-Voigt axis with a band: both six-axis FMUs give the one-axis forward model's force
-    import json
-    import build_fmu
-    from fmpy import simulate_fmu
-    from conftest import DATA
-    from identification.forward.population import simulate_population_held
-    if shutil.which("gcc") is None and shutil.which("cc") is None:
-        pytest.skip("no C compiler for the native FMU")
-    axis = dict(k=300.0, c=1.0, preload=0.0, **BAND)
-    document = json.loads((DATA / "params_six_axis_illustrative.json").read_text())
-    document["axes"]["z"] = {"model": "KelvinVoigtBushing_Band", "parameters": axis}
-    params = tmp_path / "six.json"
-    params.write_text(json.dumps(document))
-    t = np.arange(0.0, 0.8, 1e-3)
-    names = ["dx", "vx", "dy", "vy", "dz", "vz", "rx", "wx", "ry", "wy", "rz", "wz"]
-    signals = np.zeros(t.size, dtype=[("time", float)] + [(name, float) for name in names])
-    w = 2 * np.pi * 3.0
-    signals["time"], signals["dz"], signals["vz"] = t, 2.5e-3 * np.sin(w * t), 2.5e-3 * w * np.cos(w * t)
-    model = get_model("kelvin_voigt+band")
-    want = simulate_population_held([model.check(axis)], t, signals["dz"] * 1e3, signals["vz"] * 1e3, model=model)[0]
-    for fmu in (build_fmu.build_fmu(params, tmp_path / "python", model="six_axis"),
-                build_fmu.build_native_fmu(params, tmp_path / "native", model="six_axis").path):
-        got = simulate_fmu(str(fmu), stop_time=t[-1], step_size=1e-3, output_interval=1e-3, input=signals,
-                           output=["Fz"])["Fz"]
-        np.testing.assert_allclose(got, want[:len(got)], rtol=0, atol=1e-12 * np.max(np.abs(want)))
+    # z a Kelvin-Voigt axis with a band
+    assert_six_axis_z_is_the_forward_model(get_model("kelvin_voigt+band"), dict(k=300.0, c=1.0, preload=0.0, **BAND),
+                                           tmp_path)
 
 
 FAST = dict(PURE, band_gap=0.0, band_k=1000.0, band_depth=0.0, band_f=1.0, band_ratio_pos=100.0,

@@ -18,6 +18,7 @@ from fmu_src.model.parameter_specs import ParameterError
 from fmu_src.model.registry import MODELS, get_model
 from fmu_src.parameter_files import read_parameter_set, save_parameters
 from identification.measured.signals import Random, sample_times
+from element_checks import assert_sensitivities_are_central_differences
 from example_parameter_files import BACKBONE, LIMITS, defaults
 from example_parameter_files import derived_parameter_file as derived_parameter_file_in
 from python_core import simulate_python_core
@@ -261,28 +262,15 @@ def test_both_fmus_of_a_derived_model_equal_its_forward_model(kind, derived_para
 @pytest.mark.parametrize("base", ["single_bouc_wen", "asymmetric_bouc_wen", "hydraulic_free_decoupler"])
 def test_the_fits_exact_jacobian_of_a_derived_model_equals_central_differences(base):
     # every parameter a direction (33 for the free plate: more than one module carries, so in chunks)
-    from identification.forward.parameter_jacobian import population_sensitivities
-    from identification.forward.population import CommunicationPoints, simulate_population_at
+    from identification.forward.population import CommunicationPoints
     derived = get_model(f"{base}+backbone4+limits+rig")
     params = {name: value for name, value in defaults(base).items() if name not in get_model(base).static_spring}
     params.update(BACKBONE, **LIMITS, rig_displacement_zero=0.1, rig_force_zero=20.0)
     t = sample_times(0.2, 1000.0)
     x, v = Random(2.0, 0.3, seed=5).signals(t)
     row = np.array([derived.values(derived.check(params))])
-    directions = row.shape[1]
-    outputs = np.arange(t.size)
-    points = CommunicationPoints(t, x, v, outputs, v)
-    forces, sensitivities = population_sensitivities(row, np.eye(directions)[None], points, model=derived)
-    np.testing.assert_array_equal(forces[0], simulate_population_at(row, points, model=derived)[0])
-    for j in range(directions):
-        h = 1e-6 * max(1.0, abs(row[0, j]))
-        up, down = row.copy(), row.copy()
-        up[0, j] += h
-        down[0, j] -= h
-        central = (simulate_population_at(up, points, model=derived)[0]
-                   - simulate_population_at(down, points, model=derived)[0]) / (2 * h)
-        scale = np.max(np.abs(central)) + 1e-9
-        assert np.max(np.abs(central - sensitivities[0, :, j])) <= 1e-5 * scale, derived.parameter_names[j]
+    assert_sensitivities_are_central_differences(derived, row, CommunicationPoints(t, x, v, np.arange(t.size), v),
+                                                 lambda j, value: 1e-6 * max(1.0, abs(value)))
 
 
 @pytest.mark.slow

@@ -22,12 +22,12 @@ from python_core import simulate_python_core
 
 
 def test_the_table_holds_the_options_in_their_order():
-    assert list(option_table.ELEMENTS) == ["backbone", "limits", "maxwell", "iwan", "band", "rig"]
+    assert list(option_table.ELEMENTS) == ["backbone", "limits", "maxwell", "iwan", "band", "series", "rig"]
     assert Options.parse(["Rig", "maxwell", "backbone5", "LIMITS"]).tokens == ("backbone5", "limits", "maxwell", "rig")
 
 
 def test_every_option_round_trips_through_a_name_and_an_identifier():
-    for token in ("backbone3", "limits", "maxwell", "iwan2", "band", "rig"):
+    for token in ("backbone3", "limits", "maxwell", "iwan2", "band", "series", "rig"):
         model = get_model(f"berg+{token}")
         assert get_model(model.identifier) is model
         assert split_name(model.identifier) == (get_model("berg").identifier, Options.parse([token]))

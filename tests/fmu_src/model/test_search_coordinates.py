@@ -23,6 +23,7 @@ COORDINATES = {
     "damping": SearchCoordinate("p", KIND.damping, -4.0, 2.0),
     "force": SearchCoordinate("p", KIND.force, -3.0, 0.5),
     "travel": SearchCoordinate("p", KIND.travel, -4.0, 0.5),
+    "compliance": SearchCoordinate("p", KIND.compliance, -3.0, 1.0),
     "gain": SearchCoordinate("p", KIND.gain, -4.0, 1.0),
     "exponent": SearchCoordinate("p", KIND.exponent, 0.1, 1.5),
     "cubic": SearchCoordinate("p", KIND.cubic, 0.0, 2.0),

@@ -239,6 +239,7 @@ def test_compare_tries_what_the_first_contact_tries_unless_told(tmp_path, capsys
     assert {"kelvin_voigt+rig", "kelvin_voigt"} <= set(rows)        # the rig assumed, weighed without it
     if extra:
         assert "kelvin_voigt+band+rig" not in rows
+        assert "tried: band" not in printed.out + printed.err      # what is named is what is said
     else:
         assert "tried: band" in printed.out + printed.err
         assert rows["kelvin_voigt+band+rig"]["recommended"] == "True"
