@@ -224,20 +224,51 @@ def _device_source(base: BushingModel, inner) -> tuple[str, set[str]]:
     return "\n\n\n".join(ast.unparse(renamer.visit(node)) for node in tree.body), shared
 
 
+def _series_start_source(n: int, zero: str) -> str:
+    """A series element's ``initial_state``: the device virgin at the displacement u where the
+    spring holds its force at rest, u + compliance F_device(u) = x0 less the zero (secants from
+    u = x0 and the u of a device that held its force there, at least one, so that the tangents
+    are the converged start's even where x0 is already the root; an elastic device's g(u) rises
+    with a slope of 1 + compliance K)."""
+    d = "s" if n else "()"
+    start = "    s = device_initial_state(m[0], u)\n" if n else ""
+    # a device without states gives nothing to start: its call would be dead code, which the C
+    # translation refuses
+
+    def residual(indent: str) -> str:
+        return (start.replace("    ", indent, 1) + f"{indent}f = device_force(m[0], {d}, u, 0.0)\n"
+                f"{indent}g = u + c * f - x0z\n")
+    last = tuple_text([f"s[{i}]" for i in range(n)] + ["u"])
+    return (f"def initial_state(m, x0):\n    c = m[1][0]\n    x0z = x0{zero}\n    u = x0z\n{start}"
+            f"    if c == 0.0:\n        return {last}\n"
+            f"    f = device_force(m[0], {d}, u, 0.0)\n    g = u + c * f - x0z\n"
+            f"    ua = u\n    ga = g\n"
+            f"    if g != 0.0:\n        u = u - g\n    else:\n        u = u + 1e-7 * (abs(u) + 1.0)\n{residual('    ')}"
+            f"    for k in range({SERIES_ITERATIONS}):\n"
+            f"        if g == ga:\n            break\n"
+            f"        ub = u\n        gb = g\n        u = ub - gb * (ub - ua) / (gb - ga)\n{residual('        ')}"
+            f"        ua = ub\n        ga = gb\n"
+            f"        if abs(g) <= 4e-16 * (abs(u) + c * abs(f) + abs(x0z)):\n            break\n"
+            f"    return {last}\n")
+
+
 def _series_integrate_source(n: int, zero: str) -> str:
     """A series element's ``integrate`` (``series_wrapper_source``): the device's ``n`` states, then
-    its displacement; ``zero`` the text taken off x before the spring (the rig's displacement zero)."""
+    its displacement; ``zero`` the text taken off x before the spring (the rig's displacement zero).
+    Each of the device's steps gets the substeps ``max_substeps`` allows a step."""
     d = tuple_text(f"state[{i}]" for i in range(n))
 
     def out(name: str, last: str) -> str:
         return tuple_text([f"{name}[{i}]" for i in range(n)] + [last])
 
     # the device's velocity w at which the compliance's force at the step's end is the device's:
-    # r(w) = x1 - (u0 + w h) - compliance F_device(w) falls with w; secants from w = v and the
-    # velocity of a device that held its force, the older end's residual halved where two new ones
-    # fall on one side (Illinois' regula falsi), until r is within rounding of the travel or w stops
-    # changing; then one secant more through the two latest points: its slope is the step's own, so
-    # the tangents through it are the converged step's (implicit) derivative, not the path's
+    # r(w) = x1 - (u0 + w h) - compliance F_device(w) falls with w, at a slope of about
+    # h + compliance (C + K h) (the device's dashpot C and stiffness K at the step's start, from its
+    # force); a Newton step from w = v on that slope, then secants, the older end's residual halved
+    # where two new ones fall on one side (Illinois' regula falsi), until r is within rounding of
+    # the travel or stops changing (rounding); then one secant more through the two latest points,
+    # kept where it is no worse: its slope is the step's own, so the tangents through it are the
+    # converged step's (implicit) derivative, not the path's
     def residual(indent: str) -> str:
         return "".join(indent + line + "\n" for line in (
             "s, used, status = device_integrate(m[0], d, u0, w, h, max_substeps)",
@@ -252,22 +283,27 @@ def _series_integrate_source(n: int, zero: str) -> str:
         f"    if c == 0.0:\n        s, used, status = device_integrate(m[0], d, x{zero}, v, h, max_substeps)\n"
         f"        return {out('s', f'x{zero} + v * h + 0.0 * state[{n}]')}, used, status\n"
         f"    u0 = state[{n}]\n    x1 = x{zero} + v * h\n    total = 0\n"
+        f"    f0 = device_force(m[0], d, u0, 0.0)\n    du = 1e-6 * (abs(u0) + 1.0)\n"
+        f"    slope = device_force(m[0], d, u0, 1.0) - f0 + h * (device_force(m[0], d, u0 + du, 0.0) - f0) / du\n"
+        f"    if slope < 0.0:\n        slope = 0.0\n    slope = h + c * slope\n"
         f"    w = v\n{residual('    ')}"
         f"    tolerance = 1e-12 * (abs(x1 - u0) + abs(w * h)) + 4e-16 * (abs(x1) + abs(u0))\n"
         f"    wa = w\n    ra = r\n"
-        f"    if r != 0.0:\n        w = w + r / h\n    else:\n        w = w + 1e-7 * (abs(w) + 1.0)\n"
+        f"    if r != 0.0:\n        w = w + r / slope\n    else:\n        w = w + 1e-7 * (abs(w) + 1.0)\n"
         f"{residual('    ')}"
         f"    for k in range({SERIES_ITERATIONS}):\n"
-        f"        if r == ra:\n"
-        f"            if abs(r) <= tolerance:\n                return {out('s', 'u0 + w * h')}, total, OK\n"
-        f"            break\n"
+        f"        if r == ra:\n            break\n"
         f"        wb = w\n        rb = r\n        w = wb - rb * (wb - wa) / (rb - ra)\n{residual('        ')}"
-        f"        if abs(r) <= tolerance or abs(w - wb) <= 4e-16 * (abs(w) + abs(wb)):\n"
+        f"        if abs(r) <= tolerance or abs(w - wb) <= 4e-16 * (abs(w) + abs(wb)) or r == rb:\n"
         f"            if r != rb:\n"
-        f"                w = w - r * (w - wb) / (r - rb)\n{residual('                ')}"
+        f"                wc = w\n                rc = r\n                sc = s\n"
+        f"                w = wc - rc * (wc - wb) / (rc - rb)\n{residual('                ')}"
+        f"                if abs(r) > abs(rc):\n                    w = wc\n                    s = sc\n"
         f"            return {out('s', 'u0 + w * h')}, total, OK\n"
         f"        if (r < 0.0) != (rb < 0.0) or (ra < 0.0) == (r < 0.0):\n            wa = wb\n            ra = rb\n"
         f"        else:\n            ra = 0.5 * ra\n"
+        f"    if r == ra:         # the iteration stands still: r is at its rounding\n"
+        f"        return {out('s', 'u0 + w * h')}, total, OK\n"
         f"    return state, total, TOO_MANY_SUBSTEPS\n")
 
 
@@ -307,10 +343,7 @@ def series_wrapper_source(base: BushingModel, options) -> tuple[str, set[str]]:
         source.append(f"def prepare_step(m, h):\n    return "
                       f"{tuple_text(['device_prepare_step(m[0], h)'] + [f'm[{i}]' for i in range(1, len(parts))])}\n")
     source += [
-        # a device without states gives nothing to start or to rate: its calls would be dead code,
-        # which the C translation refuses
-        "def initial_state(m, x0):\n" + (f"    s = device_initial_state(m[0], x0{zero})\n" if n else "")
-        + f"    return {out('s', f'x0{zero}')}\n",
+        _series_start_source(n, zero),
         f"def jump(m, state, jump_mm):\n"
         f"    if m[1][0] == 0.0:\n        s, status = device_jump(m[0], {d}, jump_mm)\n"
         f"        return {out('s', f'state[{n}] + jump_mm')}, status\n"
@@ -322,6 +355,7 @@ def series_wrapper_source(base: BushingModel, options) -> tuple[str, set[str]]:
             f"    else:\n        f0 = device_force(m[0], d, u, 0.0)\n"
             f"        w = ((x{zero} - u) / c - f0) / (device_force(m[0], d, u, 1.0) - f0)\n")
     source += [
+        # a device without states gives nothing to rate: its call would be dead code
         f"def derivatives(m, state, x, v):\n{rate}" + ("    r = device_derivatives(m[0], d, u, w)\n" if n else "")
         + f"    return {out('r', 'w')}\n",
         f"def force(m, state, x, v):\n    c = m[1][0]\n"

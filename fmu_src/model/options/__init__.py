@@ -3,13 +3,14 @@
 Each module here defines one option element (``element.OptionElement``) as ``ELEMENT``:
 ``backbone`` (a measured static curve), ``limits`` (travel limits), ``maxwell`` (a parallel
 Maxwell element), ``iwan`` (distributed slip: spring-sliders in parallel), ``band`` (a band brake's
-self-energizing friction through its play), ``rig`` (a measured
+self-energizing friction through its play), ``series`` (a compliance in series with the model and
+the elements before it), ``rig`` (a measured
 test's displacement and load-cell zeros). The table
 (``ELEMENTS``) is discovered from the modules, in each element's ``order``: a new element is its
 module, its independent reference and its tests, and touches no other element's file.
 
 ``Options`` is which elements a derived model has (and the counts of those counted), named by
-their tokens in one order: ``backbone9``, ``limits``, ``maxwell``, ``iwan4``, ``band``, ``rig``.
+their tokens in one order: ``backbone9``, ``limits``, ``maxwell``, ``iwan4``, ``band``, ``series``, ``rig``.
 """
 from __future__ import annotations
 
@@ -86,7 +87,8 @@ class Options:
 
     @property
     def tokens(self) -> tuple[str, ...]:
-        """The options' names in their one order (``backbone9``, ``limits``, ``maxwell``, ``iwan4``, ``rig``)."""
+        """The options' names in their one order (``backbone9``, ``limits``, ``maxwell``, ``iwan4``, ``band``,
+        ``series``, ``rig``)."""
         return tuple(f"{token}{count}" if ELEMENTS[token].counted else token for token, count in self.chosen)
 
     def __bool__(self) -> bool:

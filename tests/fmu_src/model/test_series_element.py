@@ -202,3 +202,49 @@ def test_a_six_axis_fmus_axis_takes_a_compliance_in_series_in_both_fmus(tmp_path
     # z the standard linear solid
     assert_six_axis_z_is_the_forward_model(get_model("kelvin_voigt+series"), ZENER, tmp_path, stop_s=0.5,
                                            amplitude_m=2.0e-3, hz=5.0)
+
+
+@pytest.mark.parametrize("name", ["asymmetric_bouc_wen+series", "spencer+series", "proposed+series"])
+@pytest.mark.parametrize("compliance", [0.03, 1.0])
+def test_a_soft_spring_steps_within_the_fits_substep_budget(name, compliance):
+    # a spring far softer than the device: the device barely moves and F tends to x / compliance;
+    # each step's first trial takes the device's own slope, so no trial runs the device off (a
+    # guess that assumed the device held its force overshot 1500-fold and failed the step)
+    from identification.fitting.objectives import FIT_MAX_SUBSTEPS
+    from identification.forward.population import simulate_population_held
+    base = name.split("+")[0]
+    model = get_model(name)
+    t, x, v = sine(1e-3, stop=0.6)
+    force = simulate_population_held([model.check(dict(defaults(base), series_compliance=compliance))], t, x, v,
+                                     max_substeps=FIT_MAX_SUBSTEPS, model=model)[0]
+    assert np.all(np.isfinite(force))
+    np.testing.assert_allclose(force, x / compliance, rtol=0, atol=0.1 * np.max(np.abs(x)) / compliance)
+
+
+def test_the_rigs_displacement_zero_comes_off_x_before_the_spring():
+    t, x, v = sine(1e-3, stop=0.3)
+    shifted = simulate("kelvin_voigt+series+rig", dict(ZENER, rig_displacement_zero=0.4, rig_force_zero=0.0),
+                       t, x, v)
+    np.testing.assert_allclose(shifted, simulate("kelvin_voigt+series", ZENER, t, x - 0.4, v), rtol=0, atol=1e-9)
+
+
+def test_a_start_away_from_zero_is_in_equilibrium_with_the_spring():
+    # a Kelvin-Voigt device with a preload on the spring at x0 = 1 mm, at rest: u + c (k u + preload)
+    # = x0, so F = (k x0 + preload) / (1 + c k) from the first sample on, whatever the compliance
+    params = dict(ZENER, preload=50.0)
+    t = np.arange(0.0, 0.05, 1e-3)
+    x, v = np.full(t.size, 1.0), np.zeros(t.size)
+    for compliance in (1e-9, 2e-3, 0.1):
+        want = (params["k"] * 1.0 + params["preload"]) / (1.0 + compliance * params["k"])
+        got = simulate("kelvin_voigt+series", dict(params, series_compliance=compliance), t, x, v)
+        np.testing.assert_allclose(got, want, rtol=1e-9)
+
+
+def test_a_start_holding_a_force_deflects_the_spring_by_it():
+    from identification.forward.population import simulate_population_held
+    model = get_model("single_bouc_wen+series")
+    params = dict(defaults("single_bouc_wen"), series_compliance=1e-3)
+    t = np.arange(0.0, 0.02, 1e-3)
+    held = simulate_population_held([model.check(params)], t, np.zeros(t.size), np.zeros(t.size), model=model,
+                                    rest_force_N=123.0)[0]
+    np.testing.assert_allclose(held, 123.0, rtol=1e-9)
