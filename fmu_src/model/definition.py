@@ -58,7 +58,8 @@ DAMPING_UNITS = ("N.s/mm", "N.mm.s/rad")
 MOUNTING_SPECS = (
     ParameterSpec("offset", "mm", "displacement where the model sits at its own zero: F = model(x - offset) + "
                   "preload, as MSC Adams' BUSHING takes it"),
-    ParameterSpec("preload", "N", "force added to the model's: F = model(x - offset) + preload", bound_powers=(0, 0)),
+    ParameterSpec("preload", "N", "force added to the model's: F = model(x - offset) + preload", bound_powers=(0, 0),
+                  temperature="none"),
 )
 """How an axis mounts its model: every model on every axis takes them (0 and 0: the model as it
 is, bit for bit). A model with a parameter of the same name (Kelvin-Voigt's preload, the same
@@ -316,6 +317,10 @@ class BushingModel:
     before left in the device), for a model whose elements can hold a force at rest; the nearest
     it can hold where it cannot hold that much. None: it holds none (a run starts relaxed).
     ``start_state`` chooses between it and ``initial_state``."""
+    conditions: tuple[tuple[str, str], ...] = ()
+    """(parameter, the ``Measurement`` field that sets it): the parameters a test's own conditions
+    set (a temperature law's ``temperature`` from a test's ``temperature_K``); the forward model
+    takes them from each test that carries them (``population.conditioned``)."""
     step: Callable = field(init=False, repr=False, compare=False)
     """step(constants, state, state_x, x, v, h, max_substeps) -> (state, substeps, status): the
     step protocol of ``integration.step`` bound to this model's ``jump`` and ``integrate``."""

@@ -141,7 +141,8 @@ def derive(base: BushingModel, options: Options) -> BushingModel:
         constraints=constraints, switch_specs=switch_specs, update=g.get("update"), search=_search(base, options),
         description=f"{base.description or base.title}; with {', '.join(options.tokens)}",
         plot_style=base.plot_style, rank=base.rank, settling_s=base.settling_s, rotational=base.rotational,
-        static_spring=(), base=base, options=options, resting_state=g.get("resting_state"))
+        static_spring=(), base=base, options=options, resting_state=g.get("resting_state"),
+        conditions=tuple(pair for element, _ in options.elements for pair in element.conditions))
     _DERIVED[name] = model
     return model
 

@@ -129,6 +129,8 @@ def _layout(base: BushingModel, options) -> tuple[list[str], list[tuple[OptionEl
 def wrapper_source(base: BushingModel, options) -> tuple[str, set[str]]:
     """The derived model's kernels, delegating to the renamed base's (module docstring); and the
     shared names they import. The option elements' states follow the base's."""
+    if any(element.law is not None for element, _ in options.elements):
+        return law_wrapper_source(base, options)
     if any(element.series for element, _ in options.elements):
         return series_wrapper_source(base, options)
     parts, placed = _layout(base, options)
@@ -370,6 +372,36 @@ def series_wrapper_source(base: BushingModel, options) -> tuple[str, set[str]]:
         source.append(f"def update(m, state, x, v):\n{rate}    s = device_update(m[0], d, u, w)\n"
                       f"    return {out('s', 'u')}\n")
     return device + "\n\n\n" + "\n\n".join(source), shared | {"OK", "TOO_MANY_SUBSTEPS"}
+
+
+def law_wrapper_source(base: BushingModel, options) -> tuple[str, set[str]]:
+    """The kernels of a model whose options hold a law on its parameters (``OptionElement.law``: a
+    temperature law): the model without the law (every kernel as it is, its ``prepare`` renamed
+    ``unconditioned_prepare``) under a ``prepare`` that multiplies each of its parameters by its
+    role's factor (``ParameterSpec.temperature_role``) first; and the shared names they import."""
+    from .options import Options
+    laws = [(element, count) for element, count in options.elements if element.law is not None]
+    if len(laws) > 1:
+        raise ModelContractError(f"{' and '.join(element.token for element, _ in laws)}: give one law on the "
+                                 "parameters")
+    law, count = laws[0]
+    inner = Options(tuple(item for item in options.chosen if item[0] != law.token))
+    text, shared = wrapper_source(base, inner)
+    renamer = _Rename({"prepare"}, prefix="unconditioned_")
+    text = "\n\n\n".join(ast.unparse(renamer.visit(node)) for node in parse(text).body)
+    held = set(base.static_spring) if options.replaces_static_spring else set()
+    specs = [spec for spec in base.specs if spec.name not in held]
+    specs += [spec for element, c in options.elements for spec in element.specs(c)]
+    own = {spec.name for spec in law.specs(count)}
+    index = {spec.name: i for i, spec in enumerate(specs)}
+    lines, factors = law.law(tuple(f"p[{index[spec.name]}]" for spec in law.specs(count)))
+    scaled = [f"p[{i}] * {factors[spec.temperature_role]}" if spec.temperature_role in factors else f"p[{i}]"
+              for i, spec in enumerate(specs) if spec.name not in own]
+    # a factor no parameter takes is left out (the C translation refuses a value never read)
+    unused = {name for role, name in factors.items() if not any(name in text for text in scaled)}
+    body = "".join(f"    {line}\n" for line in lines if line.split(" = ")[0] not in unused)
+    prepare = f"def prepare(p):\n{body}    return unconditioned_prepare({tuple_text(scaled)})\n"
+    return text + "\n\n\n" + prepare, shared
 
 
 def derived_source(base: BushingModel, options) -> str:

@@ -20,6 +20,9 @@ from .units import UnitError, si_form
 
 UNIT_SYSTEM = "N-mm-s"
 
+TEMPERATURE_ROLES = ("viscous", "elastic", "friction", "none")
+"""How a temperature law may change a parameter (``ParameterSpec.temperature``)."""
+
 
 # The rules' words (``str.format`` templates), which the FMUs' runtimes log too (``fmi.runtime_messages``).
 NOT_FINITE = "{name} = {value} [{unit}] must be a finite number"
@@ -46,12 +49,34 @@ class ParameterSpec:
     why: str = ""
     maximum: float | None = None
     bound_powers: tuple[int, int] | None = None
+    temperature: str = ""
+    """How a temperature law (``options.wlf``) changes the parameter: ``viscous`` (a rate's
+    coefficient: times the time-temperature shift a_T), ``elastic`` (a stiffness or a static
+    force: times the law's elastic factor), ``friction`` (a sliding level: times its friction
+    factor), ``none`` (unchanged); "" (default): by its unit (``temperature_role``)."""
 
     def __post_init__(self):
         try:
             si_form(self.unit)
         except UnitError as exc:
             raise UnitError(f"parameter {self.name}: {exc}") from None
+        if self.temperature not in TEMPERATURE_ROLES + ("",):
+            raise ValueError(f"parameter {self.name}: temperature role {self.temperature!r} is not one of "
+                             f"{', '.join(TEMPERATURE_ROLES)}")
+
+    @property
+    def temperature_role(self) -> str:
+        """Its ``temperature`` role, or the one its unit implies: N.s/mm a dashpot (viscous); N/mm,
+        N/mm^3 and N/mm^e a stiffness (elastic); N a sliding level (friction); anything else none
+        (a displacement, an exponent, a shape; a fractional coefficient, whose shift would be
+        a_T^alpha, and a fluid's mass)."""
+        if self.temperature:
+            return self.temperature
+        if self.unit == "N.s/mm":
+            return "viscous"
+        if self.unit == "N/mm" or self.unit.startswith("N/mm^"):
+            return "elastic"
+        return "friction" if self.unit == "N" else "none"
 
     @property
     def allowed(self) -> str:

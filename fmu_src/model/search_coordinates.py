@@ -106,6 +106,18 @@ class Exponent(CoordinateKind):
         return value
 
 
+class Value(CoordinateKind):
+    """The value itself, in its own unit (a WLF constant C1 [1] or C2 [K], a temperature
+    coefficient [1/K]): a law's constant that no reference of the data scales."""
+    name = "value"
+
+    def to_parameter(self, c, u, values, scales):
+        return u
+
+    def to_coordinate(self, c, value, params, scales):
+        return value
+
+
 class Linear(CoordinateKind):
     """value/scale, scale the data's reference named ``scale`` (F_ref, x_ref): a signed offset
     (a backbone's force at its middle knot). With ``centre``, the data's estimate of the value
@@ -305,6 +317,7 @@ KIND = _Kinds(
     Linear("offset_force", "F_ref"),      # value/F_ref: a signed force (a backbone's at its middle knot)
     Linear("rig_travel", "x_ref", "x_zero"),    # (value - x_zero)/x_ref: a rig's displacement zero
     Linear("rig_force", "F_ref", "F_zero"),     # (value - F_zero)/F_ref: a load cell's zero
+    Value(),                              # the value itself: a temperature law's constant
     Segment(), Gain(), Exponent(), Cubic(), TimeConstant(), Slower(), Shape(), ShapeSum(), PowerLaw(), Resonance(), DampingRatio(),
     QuadraticDamping())
 """Every kind of coordinate, by name: ``KIND.stiffness``, ``KIND.time_constant``, ..."""

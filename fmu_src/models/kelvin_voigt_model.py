@@ -11,7 +11,7 @@ from ..model.definition import BushingModel, LinearForce
 PARAMETER_SPECS = (
     ParameterSpec("k", "N/mm", "stiffness", **SPRING),
     ParameterSpec("c", "N.s/mm", "viscous damping", **DAMPING),
-    ParameterSpec("preload", "N", "force at x = 0"),
+    ParameterSpec("preload", "N", "force at x = 0", temperature="none"),
 )
 
 

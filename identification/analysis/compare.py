@@ -57,11 +57,10 @@ from identification.fitting.search import table_fit
 from identification.interrupt import writing
 from identification.measured.kdyn_table import KDYN_UNCERTAINTY, LOSS_ANGLE_UNCERTAINTY_DEG, KdynTable
 from identification.measured.measurements import load_measurement, measurement_name
-from identification.measured.offsets import held_force
 from identification.fitting.objectives import nrmse, rms_level_error
 from identification.analysis.plots import plot_comparison, plot_table_comparison
 from identification.measured.rig_tests import RigTest
-from identification.forward.simulate import simulate
+from identification.forward.simulate import simulate_measurement
 
 PREDICTION_TOLERANCE = 0.1
 """A model predicts as well as the best if its held-out error is at most this much larger (10 %)."""
@@ -418,8 +417,7 @@ def leave_one_out(tests: Sequence[RigTest], fitted: FitResult, request_of, engin
         rest = [t for j, t in enumerate(tests) if j != i]
         result = race_models([request_of(rest)], engine, False, progress)[0][fitted.model]
         m = test.measurement
-        predicted = simulate(result.parameters, m.time_s, m.displacement_mm, m.measured_velocity_mm_s,
-                             rest_force_N=held_force(m))
+        predicted = simulate_measurement(result.parameters, m)
         out.append(nrmse(predicted, m.force_N))
     by_name = {t.name: t for t in fitted.tests}
     return LeaveOneOut(fitted.model, [t.name for t in tests], [by_name[t.name].nrmse for t in tests], out,
@@ -462,9 +460,7 @@ def _validation_errors(validation, bushings, parameters: dict, assessments: list
     errors, predictions = {}, {}
     for m in validation:
         name = Path(m.source).name
-        rest = held_force(m)
-        predicted_by_name = {bushing.name: simulate(parameters[bushing.name], m.time_s, m.displacement_mm,
-                                                    m.measured_velocity_mm_s, model=bushing, rest_force_N=rest)
+        predicted_by_name = {bushing.name: simulate_measurement(parameters[bushing.name], m, model=bushing)
                              for bushing in bushings}
         predictions[name] = {bushing: predicted_by_name[bushing.name] for bushing in bushings}
         for assessment in assessments:

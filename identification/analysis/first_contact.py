@@ -1,7 +1,7 @@
 """A new device's first contact: what ``compare`` assumes about the training tests before it fits
 any model, why, and how to turn it off.
 
-A user who has never fitted this device names no option. Three things in the records say that
+A user who has never fitted this device names no option. Five things in the records say that
 the models need one, and each is recognised here from the data alone:
 
 - **the rig's offsets** (``rig``): a stroke that is not centred on 0 (a sine's centre beyond
@@ -19,7 +19,10 @@ the models need one, and each is recognised here from the data alone:
   rubber's rate dependence, which a static backbone leaves to the rest of the model;
 - **travel limits** (``limits``): without a quasi-static test, where the mean of the largest
   sine's loading and unloading branches stiffens towards its ends (the end segments'
-  slope beyond ``END_STIFFENING`` times the middle's): a stop each side.
+  slope beyond ``END_STIFFENING`` times the middle's): a stop each side;
+- **a temperature law** (``wlf``): training tests whose temperatures (a ``temperature_C`` or
+  ``temperature_K`` column) span more than ``search.TEMPERATURE_SPREAD_K``: one model across them,
+  each test run at its own temperature.
 
 One more is tried rather than assumed: where a sine's loops dissipate more than
 ``DISSIPATIVE_LOOP`` of the rectangle their force and stroke span (the energy a cycle takes,
@@ -285,6 +288,20 @@ def first_contact(tests: Sequence[RigTest], static_test: RigTest | None = None, 
             stops = _stops(largest)
             if stops:
                 assumptions.append(Assumption("limits", stops + ": a travel limit each side"))
+    temperatures = _temperatures(tests)
+    if temperatures:
+        assumptions.append(Assumption("wlf", temperatures + ": a temperature law runs each at its own"))
     dissipative = _dissipative(tests, table)
     trials = (Assumption("band", dissipative),) if dissipative else ()
     return FirstContact(tuple(assumptions), static_test, trials)
+
+
+def _temperatures(tests: Sequence[RigTest]) -> str:
+    """Words on the tests' temperatures where they span more than TEMPERATURE_SPREAD_K (a
+    temperature matrix), else ""."""
+    from identification.fitting.search import TEMPERATURE_SPREAD_K
+    means = sorted({round(t.measurement.mean_temperature_K - 273.15, 1) for t in tests
+                    if getattr(t.measurement, "temperature_K", None) is not None})
+    if len(means) < 2 or means[-1] - means[0] <= TEMPERATURE_SPREAD_K:
+        return ""
+    return f"the training tests are at {', '.join(f'{c:g}' for c in means)} degC"

@@ -25,7 +25,8 @@ from identification.forward.population import parameter_matrix
 from identification.errors import IdentificationError
 from identification.forward.input_path import prepare_input
 from identification.forward.parameter_sets import parameter_sets
-from identification.forward.simulate import model_rest_force, simulate_driven
+from identification.forward.simulate import model_rest_force, simulate_driven, temperature_conditions
+from identification.forward.population import conditioned_set
 
 
 @dataclass
@@ -96,7 +97,8 @@ class Prediction:
 
 
 def predict(parameters, time_s, displacement_mm, velocity_mm_s=None,
-            model: str | BushingModel | None = None, rest_force_N: float = math.nan) -> Prediction:
+            model: str | BushingModel | None = None, rest_force_N: float = math.nan,
+            temperature_K: float = math.nan) -> Prediction:
     """Predict a test: the best set's force and the ensemble's band at every sample.
 
     Parameters
@@ -112,6 +114,9 @@ def predict(parameters, time_s, displacement_mm, velocity_mm_s=None,
     rest_force_N : float, optional
         The force [N] the test holds at rest before it moves (``measured.offsets.held_force``):
         a model that can hold a force at rest starts holding it; NaN (default): relaxed.
+    temperature_K : float, optional
+        The rubber's temperature [K] (a model with a temperature law runs at it); NaN (default):
+        at each set's own ``temperature``.
 
     Returns
     -------
@@ -128,6 +133,7 @@ def predict(parameters, time_s, displacement_mm, velocity_mm_s=None,
         from fmu_src.parameter_files import read_ensemble
         parameters = read_ensemble(parameters)
     bushing, sets = parameter_sets(parameters, model)
+    sets = [conditioned_set(bushing, values, temperature_conditions(temperature_K)) for values in sets]
     return predict_sets(bushing, sets, time_s, displacement_mm, velocity_mm_s, rest_force_N,
                         training_misfit_N(parameters))
 

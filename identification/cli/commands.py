@@ -255,7 +255,7 @@ def predict_command(args) -> int:
     m = load_measurement(args.data, force_optional=True)
     from identification.measured.offsets import held_force
     prediction = predict(ensemble, m.time_s, m.displacement_mm, m.measured_velocity_mm_s,
-                         rest_force_N=held_force(m) if m.has_force else math.nan)
+                         rest_force_N=held_force(m) if m.has_force else math.nan, temperature_K=m.mean_temperature_K)
     prediction.write_csv(args.out)
     written = [args.out]
     if args.plot:

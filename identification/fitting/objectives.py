@@ -355,8 +355,8 @@ def _prepared_tests(tests, noise, steps, rests, strides) -> list[PreparedTest]:
     prepared = []
     for test, level, m_steps, rest, stride in zip(tests, noise, steps, rests, strides):
         m = test.measurement
-        driven = prepare_input(m.time_s, m.displacement_mm, m.measured_velocity_mm_s, decimate_holds=True,
-                               steps=m_steps, rest_force_N=rest, stride=stride)
+        driven = replace(prepare_input(m.time_s, m.displacement_mm, m.measured_velocity_mm_s, decimate_holds=True,
+                                       steps=m_steps, rest_force_N=rest, stride=stride), conditions=m.conditions)
         sigma = max(level.sigma_N, MIN_NOISE_FRACTION * level.rms_force_N)
         prepared.append(PreparedTest(test.name, driven, m.force_N[driven.sample_index],
                                      sigma / math.sqrt(stride) if stride > 1 else sigma))

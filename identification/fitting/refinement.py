@@ -24,7 +24,7 @@ forward model's is not worth finer steps. m stops at MAX_REFINED_STEPS.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -74,9 +74,10 @@ def refine_steps(objective: Objective, row: np.ndarray, delta_chi2: float) -> Re
         error = math.nan
         while 2 * m <= MAX_REFINED_STEPS:
             measurement = test.measurement
-            finer = prepare_input(measurement.time_s, measurement.displacement_mm, measurement.measured_velocity_mm_s,
-                                  decimate_holds=True, steps=2 * m, rest_force_N=prepared.driven.rest_force_N,
-                                  stride=prepared.driven.stride)
+            finer = replace(prepare_input(measurement.time_s, measurement.displacement_mm,
+                                          measurement.measured_velocity_mm_s, decimate_holds=True, steps=2 * m,
+                                          rest_force_N=prepared.driven.rest_force_N, stride=prepared.driven.stride),
+                            conditions=prepared.driven.conditions)
             fine = simulate_driven(candidate, finer, FIT_MAX_SUBSTEPS, objective.bushing)[0]
             work += 2 * m
             runs, ran = bool(np.all(np.isfinite(fine))), bool(np.all(np.isfinite(coarse)))

@@ -31,7 +31,7 @@ from identification.measured.measurements import Measurement
 from identification.measured.multiaxis import vector_nrmse
 from identification.fitting.multistart import (AnchoredStarts, PrefixScreening, Problem, StartRecord, failed_starts,
                                                first_records, jacobian, run_stages, screen, simulations_per_jacobian)
-from identification.measured.offsets import MIN_REST_S, MIN_REST_SAMPLES, held_force, short_rest
+from identification.measured.offsets import MIN_REST_S, MIN_REST_SAMPLES, short_rest
 from identification.measured.repeatability import estimate_repeatability
 from identification.measured.noise import NoiseEstimate
 from identification.fitting.objectives import MultiAxisTests, Objective, nrmse
@@ -39,7 +39,7 @@ from identification.fitting.presets import PAPER_GA, SearchSettings, describe
 from identification.fitting.progress import SearchProgress, notice_later
 from identification.fitting.refinement import refine_steps
 from identification.fitting.search_space import SearchSpace
-from identification.forward.simulate import simulate_multiaxis, simulate
+from identification.forward.simulate import simulate_measurement, simulate_multiaxis
 from identification.fitting.table_start import sines_as_table, table_start
 
 
@@ -578,8 +578,10 @@ TEMPERATURE_SPREAD_K = 5.0
 
 def temperature_notes(tests, bushing: BushingModel) -> list[str]:
     """The fit's notes on the tests that carry the rubber's temperature (``Measurement.temperature_K``):
-    no model has a temperature law yet, so each fits them as one device at one condition, and says
-    so (more loudly where the tests' temperatures differ by more than TEMPERATURE_SPREAD_K)."""
+    a model with a temperature law (``BushingModel.conditions``) runs each at its mean temperature,
+    and says so (and where a test's temperature varies by more than TEMPERATURE_SPREAD_K within it,
+    that the law takes its mean); a model without one fits them as one device at one condition, and
+    says so (more loudly where the tests' temperatures differ by more than TEMPERATURE_SPREAD_K)."""
     carried = [(test.name, test.measurement.temperature_K) for test in tests
                if isinstance(test.measurement, Measurement) and test.measurement.temperature_K is not None]
     if not carried:
@@ -587,11 +589,18 @@ def temperature_notes(tests, bushing: BushingModel) -> list[str]:
     means = [float(np.mean(t)) for _, t in carried]
     each = "; ".join(f"{name} {mean - 273.15:.4g} degC" for (name, _), mean in zip(carried, means))
     spread = max(means) - min(means)
+    if any(field == "temperature_K" for _, field in bushing.conditions):
+        notes = [f"note: the {bushing.name} model runs each training test at its temperature ({each})"]
+        varying = [name for name, t in carried if float(np.max(t) - np.min(t)) > TEMPERATURE_SPREAD_K]
+        if varying:
+            notes.append(f"note: the temperature varies by more than {TEMPERATURE_SPREAD_K:g} K within "
+                         f"{', '.join(varying)}: the temperature law takes each test's mean")
+        return notes
     if spread > TEMPERATURE_SPREAD_K:
         return [f"note: the training tests are at different temperatures ({each}; {spread:.3g} K apart): the "
                 f"{bushing.name} model has no temperature law, so it fits them as one device at one condition, "
-                "and its figures mix what the temperature changes with what the model misses; fit each "
-                "temperature's tests on their own"]
+                "and its figures mix what the temperature changes with what the model misses; add the option "
+                "wlf (a temperature law) or fit each temperature's tests on their own"]
     return [f"note: the training tests carry their temperature ({each}): the {bushing.name} model has no "
             "temperature law; its parameters hold at about that temperature"]
 
@@ -602,8 +611,7 @@ def test_fits(tests, noise, parameters: ParameterSet, steps=None) -> list[RigTes
     fits = []
     for test, level, m_steps in zip(tests, noise, steps or [None] * len(tests)):
         m = test.measurement
-        predicted = simulate(parameters, m.time_s, m.displacement_mm, m.measured_velocity_mm_s,
-                             steps_per_sample=m_steps, rest_force_N=held_force(m))
+        predicted = simulate_measurement(parameters, m, steps_per_sample=m_steps)
         repeats = estimate_repeatability(m.time_s, m.displacement_mm, m.force_N) if test.kind == "sine" else None
         fits.append(RigTestFit(test.name, test.kind, level, nrmse(predicted, m.force_N), repeats, predicted))
     return fits

@@ -87,6 +87,10 @@ class DrivenInput:
     stride: int = 1
     """The forces of every ``stride``-th sample are asked for (1: every sample's, holds aside);
     ``steps_per_sample`` is then per stride's interval."""
+    conditions: tuple[tuple[str, float], ...] = ()
+    """The test's conditions, (``Measurement`` field, value): ``temperature_K`` [K] sets a model's
+    temperature (``BushingModel.conditions``, ``population.conditioned``); a prepared input takes
+    them with ``dataclasses.replace``."""
 
 
 def steps_per_sample(time_s: np.ndarray, displacement_mm: np.ndarray, velocity_mm_s: np.ndarray,

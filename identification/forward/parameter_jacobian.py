@@ -45,7 +45,8 @@ from fmu_src.model.registry import BushingModel, DEFAULT_BUSHING, required_model
 from fmu_src.kernels.jit import numba
 from fmu_src.syntax_trees import parse
 from identification.forward.population import (CommunicationPoints, _input_arrays, _population_loop, _step_sizes,
-                                               output_points, parameter_matrix, rest_force)
+                                               condition_columns, conditioned, output_points, parameter_matrix,
+                                               rest_force)
 
 _MAX_SUBSTEPS = integration.DEFAULT_MAX_SUBSTEPS
 
@@ -235,6 +236,11 @@ def population_sensitivities(parameter_sets, seeds, points: CommunicationPoints,
     if seeds.ndim != 3 or seeds.shape[:2] != matrix.shape:
         raise ValueError(f"seeds must have shape (P, m, K) = ({matrix.shape[0]}, {matrix.shape[1]}, K), "
                          f"got {seeds.shape}")
+    columns = condition_columns(bushing, points)
+    if columns:      # a parameter the run's conditions set moves nothing: its direction is 0
+        matrix = conditioned(matrix, bushing, points)
+        seeds = seeds.copy()
+        seeds[:, [column for column, _ in columns], :] = 0.0
     lanes = seeds.shape[2]
     size = lane_chunk(lanes)
     module = sensitivity_module(bushing, size)

@@ -248,6 +248,9 @@ class CommunicationPoints:
     output_velocity_mm_s: np.ndarray
     rest_force_N: float = math.nan
     """The force [N] the run starts holding at rest (NaN: relaxed), for a model with a resting state."""
+    conditions: tuple[tuple[str, float], ...] = ()
+    """The run's conditions, (``Measurement`` field, value), such as ``temperature_K`` [K]
+    (:func:`conditioned`)."""
 
 
 def rest_force(points) -> float:
@@ -256,14 +259,47 @@ def rest_force(points) -> float:
     return float(getattr(points, "rest_force_N", math.nan))
 
 
+def condition_columns(model: BushingModel, points) -> list[tuple[int, float]]:
+    """(column, value) of each parameter of ``model`` that the conditions of ``points`` set
+    (``BushingModel.conditions``: a temperature law's ``temperature`` from ``temperature_K``)."""
+    given = dict(getattr(points, "conditions", ()))
+    names = model.parameter_names
+    return [(names.index(parameter), float(given[field])) for parameter, field in model.conditions if field in given]
+
+
+def conditioned(matrix: np.ndarray, model: BushingModel, points) -> np.ndarray:
+    """The (P, m) parameter matrix with the columns the run's conditions set (:func:`condition_columns`)
+    replaced by them: a test at its own temperature; the matrix itself where none is set."""
+    columns = condition_columns(model, points)
+    if not columns:
+        return matrix
+    matrix = matrix.copy()
+    for column, value in columns:
+        matrix[:, column] = value
+    return matrix
+
+
+def conditioned_set(model: BushingModel, values, conditions) -> dict[str, float]:
+    """The parameter set ``values`` with the parameters the ``conditions`` ((``Measurement`` field,
+    value) pairs: a test's temperature) set (``BushingModel.conditions``); as it is where none."""
+    given = dict(conditions)
+    out = dict(values)
+    for parameter, field in model.conditions:
+        if field in given:
+            out[parameter] = float(given[field])
+    return out
+
+
 def simulate_population_at(parameter_sets, points: CommunicationPoints, max_substeps: int = _MAX_SUBSTEPS,
                            model: BushingModel = DEFAULT_BUSHING) -> np.ndarray:
     """Forces [N], shape (P, outputs), at the output points of ``points``
     (``CommunicationPoints``); the input between communication points as in
-    :func:`simulate_population_held`, the start at rest holding ``points.rest_force_N`` where given."""
+    :func:`simulate_population_held`, the start at rest holding ``points.rest_force_N`` where given,
+    the parameters its conditions set at them (:func:`conditioned`)."""
     t, x, v = _input_arrays(points.time_s, points.displacement_mm, points.velocity_mm_s)
     out_index, out_velocity = output_points(t, points.output_index, points.output_velocity_mm_s)
-    return _forces(compiled_model(model), parameter_matrix(parameter_sets, model), t, x, v, out_index, out_velocity,
+    matrix = conditioned(parameter_matrix(parameter_sets, model), required_model(model), points)
+    return _forces(compiled_model(model), matrix, t, x, v, out_index, out_velocity,
                    max_substeps, *_step_sizes(t), rest_force(points))
 
 

@@ -72,6 +72,25 @@ def simulate(parameters, time_s, displacement_mm, velocity_mm_s=None, model: str
     return simulate_set(bushing, values, time_s, displacement_mm, velocity_mm_s, steps_per_sample, rest_force_N)
 
 
+def temperature_conditions(temperature_K: float) -> tuple[tuple[str, float], ...]:
+    """A run's conditions (``DrivenInput.conditions``) of a temperature [K]; none for NaN."""
+    return () if temperature_K != temperature_K else (("temperature_K", float(temperature_K)),)
+
+
+def simulate_measurement(parameters, measurement, model: str | BushingModel | None = None,
+                         steps_per_sample: int | None = None) -> np.ndarray:
+    """:func:`simulate` on a measured test as the fit takes it: its measured velocity, started at
+    rest holding the force it holds before it moves (``offsets.held_force``) and at its own
+    conditions (``Measurement.conditions``: a model with a temperature law at the test's mean
+    temperature). Force [N] at every sample."""
+    from identification.measured.offsets import held_force
+    from identification.forward.population import conditioned_set
+    values, bushing = _parameters_and_model(parameters, model)
+    m = measurement
+    return simulate_set(bushing, conditioned_set(bushing, values, m.conditions), m.time_s, m.displacement_mm,
+                        m.measured_velocity_mm_s, steps_per_sample, held_force(m) if m.has_force else math.nan)
+
+
 def simulate_set(bushing: BushingModel, values, time_s, displacement_mm, velocity_mm_s=None,
                  steps_per_sample: int | None = None, rest_force_N: float = math.nan) -> np.ndarray:
     """:func:`simulate` of one set already read and checked (``parameter_sets``): ``bushing`` the

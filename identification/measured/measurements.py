@@ -68,6 +68,19 @@ class Measurement:
         return self.time_s.size
 
     @property
+    def conditions(self) -> tuple[tuple[str, float], ...]:
+        """(field, value) of the test's conditions a model may take (``BushingModel.conditions``):
+        ``temperature_K``, the mean of its temperature column [K], where it has one."""
+        if self.temperature_K is None:
+            return ()
+        return (("temperature_K", self.mean_temperature_K),)
+
+    @property
+    def mean_temperature_K(self) -> float:
+        """The mean of its temperature column [K]; NaN where it has none."""
+        return math.nan if self.temperature_K is None else float(np.mean(self.temperature_K))
+
+    @property
     def measured_velocity_mm_s(self) -> np.ndarray | None:
         """The velocity column if the file has one, else None (the forward model then derives
         the velocity from its interpolant of the displacement)."""

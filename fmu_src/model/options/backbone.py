@@ -21,7 +21,8 @@ def backbone_specs(knots: int) -> tuple[ParameterSpec, ...]:
     return (tuple(ParameterSpec(f"backbone_x{i + 1}", "mm", f"the backbone's knot {i + 1}: its displacement "
                                 "(increasing from knot to knot)", bound_powers=None) for i in range(knots))
             + tuple(ParameterSpec(f"backbone_F{i + 1}", "N", f"the backbone's knot {i + 1}: its static force "
-                                  "(not decreasing from knot to knot)", bound_powers=(0, 0)) for i in range(knots)))
+                                  "(not decreasing from knot to knot)", bound_powers=(0, 0),
+                                  temperature="elastic") for i in range(knots)))
 
 
 def backbone_constraints(knots: int) -> tuple[Constraint, ...]:

@@ -106,6 +106,16 @@ class OptionElement:
     switches: Callable[[int], tuple[ElementState, ...]] = lambda count: ()
     """Its switches (event indicators) for its count, as ``switch_values`` gives them."""
     switch_values: Callable[[Slot], tuple[str, ...]] = _no_text
+    law: Callable[[tuple[str, ...]], tuple[tuple[str, ...], dict[str, str]]] | None = None
+    """A law on the model's other parameters (a temperature law): from its own parameters' texts,
+    the source lines of its factors and the name of each role's factor (``ParameterSpec.
+    temperature_role``: ``viscous``, ``elastic``, ``friction``); every other parameter of the
+    model is multiplied by its role's factor before the model is prepared
+    (``derived_source.law_wrapper_source``), a role without a factor left as it is. None: none."""
+    conditions: tuple[tuple[str, str], ...] = ()
+    """(parameter, the ``Measurement`` field that sets it): parameters a test's own conditions set
+    (``temperature`` from its ``temperature_K``), held by the fit, the set's value where a test
+    says nothing."""
     held: tuple[tuple[str, float], ...] = ()
     """What a fit holds of it unless told otherwise (``fit(fixed=...)``)."""
     neutral: tuple[tuple[str, float], ...] = ()

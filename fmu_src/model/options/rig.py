@@ -16,7 +16,7 @@ def rig_specs(count: int = 0) -> tuple[ParameterSpec, ...]:
     return (ParameterSpec("rig_displacement_zero", "mm", "the rig's displacement zero: the model sees x - it",
                           bound_powers=None),
             ParameterSpec("rig_force_zero", "N", "the load cell's zero: added to the model's force",
-                          bound_powers=(0, 0)))
+                          bound_powers=(0, 0), temperature="none"))
 
 
 def rig_coordinates(count: int) -> tuple[SearchCoordinate, ...]:

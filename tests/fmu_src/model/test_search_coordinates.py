@@ -26,6 +26,7 @@ COORDINATES = {
     "compliance": SearchCoordinate("p", KIND.compliance, -3.0, 1.0),
     "gain": SearchCoordinate("p", KIND.gain, -4.0, 1.0),
     "exponent": SearchCoordinate("p", KIND.exponent, 0.1, 1.5),
+    "value": SearchCoordinate("p", KIND.value, 60.0, 600.0),
     "cubic": SearchCoordinate("p", KIND.cubic, 0.0, 2.0),
     "time_constant": SearchCoordinate("p", KIND.time_constant, -math.inf, 4.0, over=("k1",)),
     "slower": SearchCoordinate("p", KIND.slower, 0.0, 6.0, over=("k2",), partner="c1"),
