@@ -288,7 +288,7 @@ def first_contact(tests: Sequence[RigTest], static_test: RigTest | None = None, 
             stops = _stops(largest)
             if stops:
                 assumptions.append(Assumption("limits", stops + ": a travel limit each side"))
-    temperatures = _temperatures(tests)
+    temperatures = _temperatures(tests, table)
     if temperatures:
         assumptions.append(Assumption("wlf", temperatures + ": a temperature law runs each at its own"))
     dissipative = _dissipative(tests, table)
@@ -296,12 +296,15 @@ def first_contact(tests: Sequence[RigTest], static_test: RigTest | None = None, 
     return FirstContact(tuple(assumptions), static_test, trials)
 
 
-def _temperatures(tests: Sequence[RigTest]) -> str:
-    """Words on the tests' temperatures where they span more than TEMPERATURE_SPREAD_K (a
-    temperature matrix), else ""."""
+def _temperatures(tests: Sequence[RigTest], table=None) -> str:
+    """Words on the training tests' and data sheet's temperatures where they span more than
+    TEMPERATURE_SPREAD_K (a temperature matrix), else ""."""
     from identification.fitting.search import TEMPERATURE_SPREAD_K
-    means = sorted({round(t.measurement.mean_temperature_K - 273.15, 1) for t in tests
-                    if getattr(t.measurement, "temperature_K", None) is not None})
+    kelvin = [t.measurement.mean_temperature_K for t in tests
+              if getattr(t.measurement, "temperature_K", None) is not None]
+    if table is not None and table.temperature_K is not None:
+        kelvin += [float(t) for t in table.temperature_K]
+    means = sorted({round(k - 273.15, 1) for k in kelvin})
     if len(means) < 2 or means[-1] - means[0] <= TEMPERATURE_SPREAD_K:
         return ""
     return f"the training tests are at {', '.join(f'{c:g}' for c in means)} degC"

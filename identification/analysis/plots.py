@@ -181,6 +181,35 @@ def plot_dynamic_stiffness(table, folder: Path, measured=None) -> list[Path]:
     return written
 
 
+def plot_temperature_sheet(tables, folder: Path) -> Path:
+    """A data sheet over temperature (``dynamic_stiffness.characterise_at_temperatures``' (T [K],
+    table) pairs): |K*| and the loss angle against the temperature [degC], one curve per
+    amplitude and frequency, each with an ensemble's min-max shaded. Returns the PNG."""
+    plt = _pyplot()
+    celsius = np.array([temperature - 273.15 for temperature, _ in tables])
+    first = tables[0][1]
+    figure, (stiffness, angle) = plt.subplots(1, 2, figsize=(12, 4.4))
+    for case in range(len(first)):
+        label = f"{first.amplitude_mm[case]:g} mm, {first.frequency_hz[case]:g} Hz"
+        for axes, column in ((stiffness, "kdyn_N_per_mm"), (angle, "loss_angle_deg")):
+            values = [table.column(column)[case] for _, table in tables]
+            axes.plot(celsius, values, "o-", color=f"C{case % 10}", ms=3.5, lw=1.2, label=label)
+            if first.minimum:
+                axes.fill_between(celsius, [table.minimum[column][case] for _, table in tables],
+                                  [table.maximum[column][case] for _, table in tables], color=f"C{case % 10}",
+                                  alpha=0.2, lw=0)
+    stiffness.set(xlabel="temperature [degC]", ylabel="dynamic stiffness |K*| [N/mm]", yscale="log")
+    angle.set(xlabel="temperature [degC]", ylabel="loss angle [deg]")
+    for axes in (stiffness, angle):
+        axes.grid(alpha=0.3, which="both")
+    stiffness.legend(fontsize=7, ncol=2)
+    shaded = ", ensemble min-max shaded" if first.minimum else ""
+    figure.suptitle(f"{first.title or first.model}: dynamic stiffness and loss angle over temperature{shaded}",
+                    fontsize=10)
+    figure.tight_layout()
+    return _save(figure, Path(folder) / "kdyn_vs_temperature.png")
+
+
 def plot_table_comparison(table, fits: dict, path: Path) -> Path:
     """A held-out dynamic-stiffness table (``kdyn_table.KdynTable``, crosses) and each model's
     prediction of its rows (lines in the model's style; ``fits``: {model (the ``BushingModel``):

@@ -258,6 +258,10 @@ def _add_characterise(subcommands) -> None:
                                      help="frequencies [Hz], comma-separated (default %(default)s)")
     characterise_parser.add_argument("--preload-mm", type=float, default=0.0, metavar="P",
                                      help="static displacement the sines are about [mm] (default 0)")
+    characterise_parser.add_argument("--temperatures-c", type=number_list, metavar="LIST",
+                                     help="rubber temperatures [degC], comma-separated, for a model with a "
+                                          "temperature law (wlf, arrhenius): the table at each, with a "
+                                          "temperature_K column, and the sheet over temperature as a plot")
     characterise_parser.add_argument("--out", type=Path, required=True, help="table to write (CSV)")
     characterise_parser.add_argument("--plots", type=Path, help="directory for the data-sheet plots (PNG)")
     characterise_parser.add_argument("--json", action="store_true", help="print a summary as JSON")
@@ -331,7 +335,8 @@ def _require_extras(args) -> None:
 
 
 def _add_training_arguments(parser) -> None:
-    group = parser.add_argument_group("training tests (CSV time_s,displacement_mm,force_N[,velocity_mm_s])")
+    group = parser.add_argument_group("training tests (CSV time_s,displacement_mm,force_N[,velocity_mm_s]"
+                                      "[,temperature_C or temperature_K])")
     group.add_argument("--sine", action="append", type=Path, default=[], metavar="FILE",
                        help="sine test; repeatable")
     group.add_argument("--step", action="append", type=Path, default=[], metavar="FILE",
@@ -358,8 +363,10 @@ def _add_model_option_arguments(parser) -> None:
                        help="options every model gets, comma-separated: backbone<K> (a static curve of K knots), "
                             "limits (a travel limit each side), maxwell (a Maxwell element in parallel), iwan<N> (N "
                             "spring-sliders in parallel: distributed slip), band (a band brake's self-energizing "
-                            "friction through a play with a progressive contact), rig (the "
-                            "rig's displacement and load-cell zeros, fitted and kept out of the FMU); none: no "
+                            "friction through a play with a progressive contact), series (a compliance in series), "
+                            "rig (the rig's displacement and load-cell zeros, fitted and kept out of the FMU), wlf "
+                            "or arrhenius (a temperature law: each test runs at its file's temperature_C or "
+                            "temperature_K column); none: no "
                             "option (compare, given no --options, assumes the ones its training tests show and says "
                             "which and why; named options, or none, turn that off)")
     group.add_argument("--backbone-knots", type=number_list, metavar="LIST",

@@ -309,6 +309,8 @@ def characterise_command(args) -> int:
     check_output(args.out, "--out", suffixes=(".csv",))
     prepare_directory(args.plots, "--plots")
     ensemble = read_ensemble(args.params, args.model)
+    if args.temperatures_c:
+        return _characterise_at_temperatures(args, ensemble)
     table = characterise(ensemble, args.amplitudes_mm, args.frequencies_hz, preload_mm=args.preload_mm)
     written = [table.to_csv(args.out)]
     if args.plots:
@@ -325,6 +327,31 @@ def characterise_command(args) -> int:
     summary = table.summary()
     print(f"loop area against pi*K''*X^2: largest difference {100 * summary['largest_energy_difference_relative']:.2g} % "
           "(only the first harmonic does work under a sine: the difference is quadrature error)")
+    print("wrote " + ", ".join(map(str, written)))
+    return 0
+
+
+def _characterise_at_temperatures(args, ensemble) -> int:
+    """``characterise --temperatures-c``: the table at each temperature, one CSV with a
+    temperature_K column, the sheets and the sheet over temperature as plots."""
+    import json
+    from identification.forward.dynamic_stiffness import characterise_at_temperatures, write_temperature_sheet
+    kelvin = [celsius + 273.15 for celsius in args.temperatures_c]
+    tables = characterise_at_temperatures(ensemble, kelvin, args.amplitudes_mm, args.frequencies_hz, args.preload_mm)
+    written = [write_temperature_sheet(args.out, tables, [f"{ensemble.model.name} model at "
+                                                          f"{', '.join(f'{c:g}' for c in args.temperatures_c)} degC"])]
+    if args.plots:
+        from identification.analysis.plots import plot_temperature_sheet
+        args.plots.mkdir(exist_ok=True)
+        written.append(plot_temperature_sheet(tables, args.plots))
+    if args.json:
+        print(json.dumps({"temperatures_K": kelvin, "tables": [table.summary() for _, table in tables],
+                          "written": [str(path) for path in written]}, indent=1))
+        return 0
+    for temperature, table in tables:
+        print(f"{ensemble.model.name} model, {table.members} parameter set(s), preload {args.preload_mm:g} mm, "
+              f"{temperature - 273.15:g} degC:")
+        print(table.format())
     print("wrote " + ", ".join(map(str, written)))
     return 0
 

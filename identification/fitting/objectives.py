@@ -133,11 +133,10 @@ class PreparedTable:
     def stiffness(self, matrix: np.ndarray, model: str | BushingModel) -> tuple[np.ndarray, np.ndarray]:
         """|K*| [N/mm] and the loss angle [deg] of P candidates on every row, each (P, rows):
         ``cycles`` cycles of ``steps_per_cycle`` steps from rest (``identification.measured.kdyn_table``)."""
-        from identification.forward.dynamic_stiffness import SteadyStateLoop, run_sines, stiffness_from_sums
+        from identification.forward.dynamic_stiffness import SteadyStateLoop, run_table_rows, stiffness_from_sums
         rows = self.rows
-        result, _ = run_sines(matrix, model, rows.amplitude_mm, rows.frequency_hz, rows.preload_mm,
-                              SteadyStateLoop(self.steps_per_cycle, self.cycles, 0.0, FIT_MAX_SUBSTEPS))
-        result = result.reshape(matrix.shape[0], len(rows), 4)
+        result = run_table_rows(matrix, required_model(model), rows,
+                                SteadyStateLoop(self.steps_per_cycle, self.cycles, 0.0, FIT_MAX_SUBSTEPS))
         _, _, kdyn, angle = stiffness_from_sums(result, rows.amplitude_mm)
         failed = result[..., 3] == 2
         return np.where(failed, np.nan, kdyn), np.where(failed, np.nan, angle)

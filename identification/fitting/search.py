@@ -623,7 +623,7 @@ def table_fit(table: KdynTable | None, parameters: ParameterSet) -> TableFit | N
     a fitted table, or one held out (``compare``)."""
     if table is None:
         return None
-    from identification.forward.dynamic_stiffness import (MAX_CYCLES, STEPS_PER_CYCLE, SteadyStateLoop, run_sines,
+    from identification.forward.dynamic_stiffness import (MAX_CYCLES, STEPS_PER_CYCLE, SteadyStateLoop, run_table_rows,
                                                           stiffness_from_sums)
     from identification.fitting.objectives import PreparedTable
     model = parameters.model
@@ -632,8 +632,7 @@ def table_fit(table: KdynTable | None, parameters: ParameterSet) -> TableFit | N
     matrix = parameter_matrix([parameters.parameters], model)
 
     def steady(steps):
-        result, _ = run_sines(matrix, model, rows.amplitude_mm, rows.frequency_hz, rows.preload_mm,
-                              SteadyStateLoop(steps))
+        result = run_table_rows(matrix, model, rows, SteadyStateLoop(steps))[0]
         if np.any(result[:, 3] == 1):
             warnings.warn(f"{table.name}: some cases of the fitted set reach no steady state within {MAX_CYCLES} "
                           "cycles", CharacterisationWarning, stacklevel=4)

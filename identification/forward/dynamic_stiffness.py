@@ -194,6 +194,45 @@ def characterise(parameters, amplitudes_mm: Sequence[float] = DEFAULT_AMPLITUDES
     return data_sheet(bushing, sets, amplitudes_mm, frequencies_hz, preload_mm, loop, stacklevel=3)
 
 
+def characterise_at_temperatures(parameters, temperatures_K: Sequence[float],
+                                 amplitudes_mm: Sequence[float] = DEFAULT_AMPLITUDES_MM,
+                                 frequencies_hz: Sequence[float] = DEFAULT_FREQUENCIES_HZ,
+                                 preload_mm: float = 0.0) -> list[tuple[float, DynamicStiffness]]:
+    """:func:`characterise` at each of ``temperatures_K`` [K] of a model with a temperature law
+    (``BushingModel.conditions``: every set's ``temperature`` set to each in turn), as
+    (temperature, table) pairs: the data sheet over temperature. IdentificationError for a model
+    without a law, or a temperature its law refuses (named, with its unit and range)."""
+    from fmu_src.model.parameter_specs import ParameterError
+    from identification.forward.parameter_sets import parameter_sets
+    from identification.forward.population import conditioned_set
+    bushing, sets = parameter_sets(parameters, None)
+    if not any(field == "temperature_K" for _, field in bushing.conditions):
+        raise IdentificationError(f"the {bushing.name} model has no temperature law: its data sheet is the same at "
+                                  "every temperature (fit it with the option wlf or arrhenius)")
+    out = []
+    for temperature in temperatures_K:
+        at = [conditioned_set(bushing, values, (("temperature_K", float(temperature)),)) for values in sets]
+        try:
+            at = [bushing.check(values) for values in at]
+        except ParameterError as exc:
+            raise IdentificationError(f"{float(temperature) - 273.15:g} degC: {exc}") from None
+        out.append((float(temperature), data_sheet(bushing, at, amplitudes_mm, frequencies_hz, preload_mm,
+                                                   SteadyStateLoop(), stacklevel=3)))
+    return out
+
+
+def write_temperature_sheet(path: str | Path, tables: Sequence[tuple[float, DynamicStiffness]],
+                            comments: Sequence[str] = ()) -> Path:
+    """The tables of :func:`characterise_at_temperatures` as one data sheet with a ``temperature_K``
+    column [K] (``kdyn_table.load_kdyn_table`` reads it back: a table to fit across temperatures)."""
+    columns: dict[str, list[np.ndarray]] = {}
+    for temperature, table in tables:
+        for name in COLUMNS:
+            columns.setdefault(name, []).append(table.column(name))
+        columns.setdefault("temperature_K", []).append(np.full(len(table), temperature))
+    return write_kdyn_table(path, {name: np.concatenate(parts) for name, parts in columns.items()}, comments)
+
+
 def data_sheet(bushing: BushingModel, sets: list[dict[str, float]], amplitudes_mm: Sequence[float],
                frequencies_hz: Sequence[float], preload_mm: float, loop: SteadyStateLoop,
                stacklevel: int = 2) -> DynamicStiffness:
@@ -285,6 +324,22 @@ def run_sines(matrix: np.ndarray, model: str | BushingModel, amplitude_mm: np.nd
         steps_per_cycle, min(MIN_CYCLES, int(cycles.min())), np.tile(cycles, members), tolerance, loop.max_substeps,
         result, last)
     return result, last
+
+
+def run_table_rows(matrix: np.ndarray, model: BushingModel, rows, loop: SteadyStateLoop) -> np.ndarray:
+    """:func:`run_sines` on the rows of a ``kdyn_table.KdynTable`` (their amplitudes, frequencies,
+    preloads; ``loop.max_cycles`` one cap or one per row), each row at its own temperature where
+    the table has one (``KdynTable.temperature_groups``: the matrix's condition columns set,
+    ``population.conditioned``). Returns ``result`` (P, rows, 4)."""
+    from identification.forward.population import conditioned
+    cycles = np.broadcast_to(np.asarray(loop.max_cycles, dtype=np.int64), (len(rows),))
+    result = np.empty((matrix.shape[0], len(rows), 4))
+    for conditions, index in rows.temperature_groups():
+        part, _ = run_sines(conditioned(matrix, model, conditions), model, rows.amplitude_mm[index],
+                            rows.frequency_hz[index], rows.preload_mm[index],
+                            SteadyStateLoop(loop.steps_per_cycle, cycles[index], loop.tolerance, loop.max_substeps))
+        result[:, index] = part.reshape(matrix.shape[0], index.size, 4)
+    return result
 
 
 def stiffness_from_sums(result: np.ndarray, amplitude_mm: np.ndarray) -> tuple[np.ndarray, ...]:

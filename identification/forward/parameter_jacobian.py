@@ -236,9 +236,9 @@ def population_sensitivities(parameter_sets, seeds, points: CommunicationPoints,
     if seeds.ndim != 3 or seeds.shape[:2] != matrix.shape:
         raise ValueError(f"seeds must have shape (P, m, K) = ({matrix.shape[0]}, {matrix.shape[1]}, K), "
                          f"got {seeds.shape}")
-    columns = condition_columns(bushing, points)
+    columns = condition_columns(bushing, getattr(points, "conditions", ()))
     if columns:      # a parameter the run's conditions set moves nothing: its direction is 0
-        matrix = conditioned(matrix, bushing, points)
+        matrix = conditioned(matrix, bushing, getattr(points, "conditions", ()))
         seeds = seeds.copy()
         seeds[:, [column for column, _ in columns], :] = 0.0
     lanes = seeds.shape[2]

@@ -259,18 +259,19 @@ def rest_force(points) -> float:
     return float(getattr(points, "rest_force_N", math.nan))
 
 
-def condition_columns(model: BushingModel, points) -> list[tuple[int, float]]:
-    """(column, value) of each parameter of ``model`` that the conditions of ``points`` set
-    (``BushingModel.conditions``: a temperature law's ``temperature`` from ``temperature_K``)."""
-    given = dict(getattr(points, "conditions", ()))
+def condition_columns(model: BushingModel, conditions) -> list[tuple[int, float]]:
+    """(column, value) of each parameter of ``model`` that the ``conditions`` ((``Measurement``
+    field, value) pairs: a run's ``DrivenInput.conditions``) set (``BushingModel.conditions``: a
+    temperature law's ``temperature`` from ``temperature_K``)."""
+    given = dict(conditions)
     names = model.parameter_names
     return [(names.index(parameter), float(given[field])) for parameter, field in model.conditions if field in given]
 
 
-def conditioned(matrix: np.ndarray, model: BushingModel, points) -> np.ndarray:
-    """The (P, m) parameter matrix with the columns the run's conditions set (:func:`condition_columns`)
+def conditioned(matrix: np.ndarray, model: BushingModel, conditions) -> np.ndarray:
+    """The (P, m) parameter matrix with the columns the ``conditions`` set (:func:`condition_columns`)
     replaced by them: a test at its own temperature; the matrix itself where none is set."""
-    columns = condition_columns(model, points)
+    columns = condition_columns(model, conditions)
     if not columns:
         return matrix
     matrix = matrix.copy()
@@ -298,7 +299,8 @@ def simulate_population_at(parameter_sets, points: CommunicationPoints, max_subs
     the parameters its conditions set at them (:func:`conditioned`)."""
     t, x, v = _input_arrays(points.time_s, points.displacement_mm, points.velocity_mm_s)
     out_index, out_velocity = output_points(t, points.output_index, points.output_velocity_mm_s)
-    matrix = conditioned(parameter_matrix(parameter_sets, model), required_model(model), points)
+    matrix = conditioned(parameter_matrix(parameter_sets, model), required_model(model),
+                         getattr(points, "conditions", ()))
     return _forces(compiled_model(model), matrix, t, x, v, out_index, out_velocity,
                    max_substeps, *_step_sizes(t), rest_force(points))
 

@@ -43,6 +43,7 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from identification.errors import CharacterisationWarning, IdentificationError
+from identification.measured.measurements import temperature_column_K, temperature_column_of
 
 KDYN_UNCERTAINTY = 0.01
 LOSS_ANGLE_UNCERTAINTY_DEG = 0.2
@@ -112,11 +113,17 @@ class KdynTable:
     loss_angle_deg: np.ndarray
     weight: np.ndarray
     source: str = "table"
+    temperature_K: np.ndarray | None = None
+    """The rubber's temperature [K] of each row (a ``temperature_C`` or ``temperature_K`` column);
+    None: the table says none (a model with a temperature law takes its set's)."""
 
     def __post_init__(self):
         columns = [getattr(self, name) for name in COLUMNS]
+        if self.temperature_K is not None:
+            columns.append(self.temperature_K)
         if len({np.shape(c) for c in columns}) != 1 or np.ndim(self.amplitude_mm) != 1:
             raise IdentificationError(f"{self.source}: the table's columns must be 1-D arrays of equal length")
+        columns = columns[:len(COLUMNS)]
         for row in range(len(self.amplitude_mm)):
             values = {name: float(column[row]) for name, column in zip(COLUMNS, columns)}
             for name, value in values.items():
@@ -143,7 +150,8 @@ class KdynTable:
 
     def subset(self, rows: np.ndarray) -> "KdynTable":
         """The rows selected by the boolean mask ``rows`` (contiguous arrays)."""
-        return KdynTable(*(np.ascontiguousarray(getattr(self, name)[rows]) for name in COLUMNS), self.source)
+        return KdynTable(*(np.ascontiguousarray(getattr(self, name)[rows]) for name in COLUMNS), self.source,
+                         None if self.temperature_K is None else np.ascontiguousarray(self.temperature_K[rows]))
 
     def kept(self) -> "KdynTable":
         """The rows of weight > 0."""
@@ -151,7 +159,16 @@ class KdynTable:
 
     def with_values(self, kdyn_N_per_mm, loss_angle_deg, source: str | None = None) -> "KdynTable":
         return KdynTable(self.amplitude_mm, self.frequency_hz, self.preload_mm, np.asarray(kdyn_N_per_mm, float),
-                         np.asarray(loss_angle_deg, float), self.weight, source or self.source)
+                         np.asarray(loss_angle_deg, float), self.weight, source or self.source, self.temperature_K)
+
+    def temperature_groups(self) -> list[tuple[tuple[tuple[str, float], ...], np.ndarray]]:
+        """(the rows' conditions, their indices) of each temperature the table holds, in the order
+        they first appear (``DrivenInput.conditions``); one group of every row and no conditions
+        where it has no temperature column."""
+        if self.temperature_K is None:
+            return [((), np.arange(len(self)))]
+        temperatures = list(dict.fromkeys(float(t) for t in self.temperature_K))
+        return [((("temperature_K", t),), np.flatnonzero(self.temperature_K == t)) for t in temperatures]
 
 
 def load_kdyn_table(path: str | Path) -> KdynTable:
@@ -183,6 +200,8 @@ def load_kdyn_table(path: str | Path) -> KdynTable:
     if len(lines) < 2:
         raise IdentificationError(f"{path}: a header but no rows")
     columns = {name: [] for name in (*REQUIRED, *OPTIONAL)}
+    temperature_column = temperature_column_of(path, header, lines[0][1])
+    temperatures, temperature_lines = [], []
     seen: dict[tuple, int] = {}
     for number, line in lines[1:]:
         cells = [cell.strip() for cell in next(csv.reader([line]))]
@@ -203,13 +222,27 @@ def load_kdyn_table(path: str | Path) -> KdynTable:
                 raise IdentificationError(f"{path}, line {number}, column {name}: {text} is not a finite number")
         _check_row(path, f"line {number}", values)
         case = (values["amplitude_mm"], values["frequency_hz"], values["preload_mm"])
+        if temperature_column is not None:
+            name = header[temperature_column[0]]
+            try:
+                temperatures.append(float(row[name]))
+            except ValueError:
+                raise IdentificationError(f"{path}, line {number}, column {name}: {row[name]!r} is not a "
+                                          "number") from None
+            temperature_lines.append(number)
+            case += (temperatures[-1],)
         if case in seen:
+            at = f" at {case[3]:g} {temperature_column[1]}" if len(case) > 3 else ""
             raise IdentificationError(f"{path}, line {number}: the case {case[0]:g} mm, {case[1]:g} Hz, preload "
-                                      f"{case[2]:g} mm is given twice (also line {seen[case]})")
+                                      f"{case[2]:g} mm{at} is given twice (also line {seen[case]})")
         seen[case] = number
         for name in columns:
             columns[name].append(values[name])
-    table = KdynTable(*(np.array(columns[name]) for name in COLUMNS), source=str(path))
+    temperature_K = None
+    if temperature_column is not None:
+        temperature_K = temperature_column_K(path, header[temperature_column[0]], temperature_column,
+                                       np.array(temperatures), temperature_lines)
+    table = KdynTable(*(np.array(columns[name]) for name in COLUMNS), source=str(path), temperature_K=temperature_K)
     for what, values, unit, plausible in (("amplitude", table.amplitude_mm, "mm", PLAUSIBLE_AMPLITUDE_MM),
                                           ("frequency", table.frequency_hz, "Hz", PLAUSIBLE_FREQUENCY_HZ)):
         if np.any(values > plausible):

@@ -130,7 +130,7 @@ def measurement_name(source: str | Path) -> str:
     return name
 
 
-def _temperature_column(path: Path, names: list[str], header: str) -> tuple[int, str] | None:
+def temperature_column_of(path: Path, names: list[str], header: str) -> tuple[int, str] | None:
     """(index, unit) of the header's temperature column, or None; MeasurementError for two or
     an unknown unit."""
     found = [i for i, name in enumerate(names) if name.split("_")[0] == "temperature"]
@@ -145,7 +145,8 @@ def _temperature_column(path: Path, names: list[str], header: str) -> tuple[int,
     return found[0], unit
 
 
-def _temperature_K(path: Path, name: str, column: tuple[int, str], values: np.ndarray, lines: list[int]) -> np.ndarray:
+def temperature_column_K(path: Path, name: str, column: tuple[int, str], values: np.ndarray,
+                         lines: list[int]) -> np.ndarray:
     """The column's temperatures [K] (``lines`` the file's line of each sample); refused at or below
     absolute zero, warned outside PLAUSIBLE_TEMPERATURE_K."""
     unit = column[1]
@@ -212,7 +213,7 @@ def load_measurement(path: str | Path, force_optional: bool = False) -> Measurem
             f"{path}: header {header!r} (line {header_line}) lacks column(s) {', '.join(missing)}; "
             "expected time_s,displacement_mm,force_N[,velocity_mm_s]")
 
-    temperature_column = _temperature_column(path, names, header)
+    temperature_column = temperature_column_of(path, names, header)
 
     rows = body[1:]
     if len(rows) < MIN_SAMPLES:
@@ -251,7 +252,7 @@ def load_measurement(path: str | Path, force_optional: bool = False) -> Measurem
         warnings.warn(f"{path}: {message}", MeasurementWarning, stacklevel=2)
     temperature = None
     if temperature_column is not None:
-        temperature = _temperature_K(path, names[temperature_column[0]], temperature_column,
+        temperature = temperature_column_K(path, names[temperature_column[0]], temperature_column,
                                      data[:, temperature_column[0]], [number for number, _ in rows])
     return Measurement(time_s, displacement, force, velocity, derived, str(path), comments, has_force, temperature)
 

@@ -5,12 +5,14 @@ Each module here defines one option element (``element.OptionElement``) as ``ELE
 Maxwell element), ``iwan`` (distributed slip: spring-sliders in parallel), ``band`` (a band brake's
 self-energizing friction through its play), ``series`` (a compliance in series with the model and
 the elements before it), ``rig`` (a measured
-test's displacement and load-cell zeros). The table
+test's displacement and load-cell zeros), ``wlf`` and ``arrhenius`` (temperature laws: the
+rubber's temperature shifts the model's dashpots and scales its stiffnesses and sliding levels). The table
 (``ELEMENTS``) is discovered from the modules, in each element's ``order``: a new element is its
 module, its independent reference and its tests, and touches no other element's file.
 
 ``Options`` is which elements a derived model has (and the counts of those counted), named by
-their tokens in one order: ``backbone9``, ``limits``, ``maxwell``, ``iwan4``, ``band``, ``series``, ``rig``.
+their tokens in one order: ``backbone9``, ``limits``, ``maxwell``, ``iwan4``, ``band``, ``series``, ``rig``,
+``wlf``, ``arrhenius``.
 """
 from __future__ import annotations
 
@@ -26,7 +28,7 @@ from .element import OptionElement
 def _discover() -> dict[str, OptionElement]:
     found = []
     for info in pkgutil.iter_modules(__path__):
-        if info.name == "element":
+        if info.name in ("element", "temperature_law"):
             continue
         module = importlib.import_module(f"{__name__}.{info.name}")
         element = getattr(module, "ELEMENT", None)
@@ -78,6 +80,10 @@ class Options:
             if token in seen and seen[token] != count:
                 raise ParameterError(f"{token}{seen[token]} and {token}{count}: give one {token}")
             seen[token] = count
+        laws = [token for token in seen if ELEMENTS[token].law is not None]
+        if len(laws) > 1:
+            raise ParameterError(f"{' and '.join(laws)}: a model takes one law on its parameters (each is a "
+                                 "temperature law); give one")
         object.__setattr__(self, "chosen", tuple(sorted(seen.items(), key=lambda item: ELEMENTS[item[0]].order)))
 
     @property

@@ -1,11 +1,12 @@
-"""The temperature law (``wlf``, fmu_src/model/options/wlf.py), against what it is by its
-definition: at the reference temperature the model without the law bit for bit; at any other the
+"""The temperature laws (``wlf`` and ``arrhenius``, fmu_src/model/options/wlf.py, arrhenius.py),
+against what they are by their definitions: at the reference temperature the model without the law bit for bit; at any other the
 independent textbook bushing of tests/references/thermal_rubber.py (WLF-shifted dashpots and
 Maxwell element, exponentially scaled stiffnesses and slider level) to rounding, the temperature
 set by a test's conditions or by the set; an FMU whose temperature changes between steps; the
 fit's exact Jacobian; the roles its units give; refusals."""
 from __future__ import annotations
 
+import math
 import shutil
 import sys
 from pathlib import Path
@@ -54,6 +55,31 @@ def test_at_the_reference_temperature_the_model_is_the_model_without_the_law_bit
     lawful = simulate_population_at([law.check({**values, **LAW})], points, model=law)[0]
     assert np.all(np.isfinite(plain))
     np.testing.assert_array_equal(lawful, plain)
+
+
+@pytest.mark.parametrize("temperature_K", [253.15, 353.15])
+def test_the_arrhenius_law_is_the_model_at_the_textbook_shift(temperature_K):
+    """a_T = exp(E_a/R (1/T - 1/T_ref)) on every dashpot, the same coefficients on the rest, against
+    the model without the law at the parameters shifted here; at the reference, bit for bit."""
+    plain, law = get_model("kelvin_voigt+maxwell+iwan1"), get_model("kelvin_voigt+maxwell+iwan1+arrhenius")
+    base = {k: v for k, v in thermal_rubber.project_parameters().items()
+            if k not in ("temperature", "temperature_ref", "wlf_c1", "wlf_c2", "elastic_per_K", "friction_per_K")}
+    arrhenius = dict(temperature_ref=296.15, arrhenius_K=12000.0, elastic_per_K=-0.004, friction_per_K=-0.006)
+    points = sine_points()[3]
+    at_reference = simulate_population_at([law.check({**base, **arrhenius, "temperature": 296.15})], points, model=law)
+    np.testing.assert_array_equal(at_reference, simulate_population_at([plain.check(base)], points, model=plain))
+    d = temperature_K - 296.15
+    a_T, e, g = math.exp(12000.0 * (1 / temperature_K - 1 / 296.15)), math.exp(-0.004 * d), math.exp(-0.006 * d)
+    shifted = dict(base, k=base["k"] * e, c=base["c"] * a_T, maxwell_k=base["maxwell_k"] * e,
+                   maxwell_c=base["maxwell_c"] * a_T, iwan_k=base["iwan_k"] * e, iwan_f=base["iwan_f"] * g)
+    want = simulate_population_at([plain.check(shifted)], points, model=plain)[0]
+    got = simulate_population_at([law.check({**base, **arrhenius, "temperature": temperature_K})], points, model=law)[0]
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-12 * np.max(np.abs(want)))
+
+
+def test_a_model_takes_one_temperature_law():
+    with pytest.raises(ParameterError, match="wlf and arrhenius: a model takes one law on its parameters"):
+        get_model("kelvin_voigt+wlf+arrhenius")
 
 
 @pytest.mark.parametrize("temperature_K", [253.15, 296.15, 333.15, 353.15])

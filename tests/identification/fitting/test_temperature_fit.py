@@ -87,3 +87,74 @@ def test_a_fit_across_three_temperatures_recovers_the_law_and_predicts_the_tempe
         m = load_measurement(path)
         predicted = simulate_measurement(p, m, model=THERMAL)
         assert nrmse(predicted, m.force_N) < 0.02, path.name
+
+
+def _first_harmonic(amplitude_mm, frequency_hz, temperature_K, cycles, steps=64):
+    """|K*| [N/mm] and the loss angle [deg] of the textbook bushing's last of ``cycles`` cycles from
+    rest, the first harmonic by the rectangle rule over its ``steps`` points."""
+    n = steps * cycles
+    t = np.arange(n + 1) / (steps * frequency_hz)
+    x = amplitude_mm * np.sin(2 * np.pi * frequency_hz * t)
+    v = amplitude_mm * 2 * np.pi * frequency_hz * np.cos(2 * np.pi * frequency_hz * t)
+    force = thermal_rubber.force(thermal_rubber.TRUTH, temperature_K, t, x, v)
+    phase = 2 * np.pi * frequency_hz * t[n - steps:n]
+    b, a = 2 * np.mean(force[n - steps:n] * np.sin(phase)), 2 * np.mean(force[n - steps:n] * np.cos(phase))
+    return abs(complex(b, a)) / amplitude_mm, np.degrees(np.arctan2(a, b))
+
+
+def test_a_data_sheet_runs_each_row_at_its_own_temperature():
+    from identification.fitting.objectives import PreparedTable
+    from identification.measured.kdyn_table import KdynTable
+    model = get_model(THERMAL)
+    amplitude, frequency = np.array([0.5, 0.5, 0.5, 1.0]), np.array([2.0, 10.0, 10.0, 5.0])
+    temperature = np.array([253.15, 253.15, 333.15, 296.15])
+    table = KdynTable(amplitude, frequency, np.zeros(4), np.ones(4), np.full(4, 10.0), np.ones(4), "sheet", temperature)
+    prepared = PreparedTable.of(table, model)
+    truth = np.array([model.values(model.check(thermal_rubber.project_parameters(temperature_K=200.0)))])
+    kdyn, angle = prepared.stiffness(truth, model)
+    for i in range(4):
+        want = _first_harmonic(amplitude[i], frequency[i], temperature[i], int(prepared.cycles[i]))
+        assert kdyn[0, i] == pytest.approx(want[0], rel=1e-9) and angle[0, i] == pytest.approx(want[1], abs=1e-9)
+    assert kdyn[0, 1] > 2 * kdyn[0, 2]             # -20 degC against 60 degC, the same sine
+
+
+def test_a_data_sheets_temperature_column_is_read_and_checked(tmp_path):
+    from identification.errors import IdentificationError
+    from identification.measured.kdyn_table import load_kdyn_table
+    path = tmp_path / "sheet.csv"
+    path.write_text("amplitude_mm,frequency_hz,kdyn_N_per_mm,loss_angle_deg,temperature_C\n"
+                    "0.5,10,900,25,-20\n0.5,10,400,19,60\n1,5,370,33,23\n")
+    table = load_kdyn_table(path)
+    np.testing.assert_allclose(table.temperature_K, [253.15, 333.15, 296.15])
+    assert [index.tolist() for _, index in table.subset(np.array([True, True, False])).temperature_groups()] == [[0], [1]]
+    path.write_text("amplitude_mm,frequency_hz,kdyn_N_per_mm,loss_angle_deg,temperature_C\n0.5,10,900,25,-20\n"
+                    "0.5,10,910,25,-20\n")
+    with pytest.raises(IdentificationError, match=r"line 3: the case 0.5 mm, 10 Hz, preload 0 mm at -20 C is given "
+                                                  r"twice \(also line 2\)"):
+        load_kdyn_table(path)
+    path.write_text("amplitude_mm,frequency_hz,kdyn_N_per_mm,loss_angle_deg,temperature\n0.5,10,900,25,-20\n")
+    with pytest.raises(IdentificationError, match="temperature_K, temperature_C"):
+        load_kdyn_table(path)
+    path.write_text("amplitude_mm,frequency_hz,kdyn_N_per_mm,loss_angle_deg,temperature_C\n0.5,10,900,25,-300\n")
+    with pytest.raises(IdentificationError, match="absolute zero"):
+        load_kdyn_table(path)
+
+
+def test_a_data_sheet_over_temperature_is_written_read_back_and_refused_without_a_law(tmp_path):
+    from fmu_src.parameter_files import save_parameters
+    from identification.errors import IdentificationError
+    from identification.forward.dynamic_stiffness import characterise_at_temperatures, write_temperature_sheet
+    from identification.measured.kdyn_table import load_kdyn_table
+    file = save_parameters(tmp_path / "truth.json", thermal_rubber.project_parameters(), THERMAL)
+    tables = characterise_at_temperatures(file, [253.15, 353.15], [0.5], [2.0, 10.0])
+    cold, warm = (table for _, table in tables)
+    assert np.all(cold.kdyn_N_per_mm > warm.kdyn_N_per_mm) and np.all(cold.loss_angle_deg > warm.loss_angle_deg)
+    sheet = load_kdyn_table(write_temperature_sheet(tmp_path / "sheet.csv", tables))
+    np.testing.assert_array_equal(sheet.temperature_K, [253.15, 253.15, 353.15, 353.15])
+    np.testing.assert_allclose(sheet.kdyn_N_per_mm, np.concatenate([cold.kdyn_N_per_mm, warm.kdyn_N_per_mm]),
+                               rtol=1e-9)
+    with pytest.raises(IdentificationError, match="-150 degC: .*temperature = 123.15 \\[K\\] must be in"):
+        characterise_at_temperatures(file, [123.15], [0.5], [2.0])
+    plain = save_parameters(tmp_path / "plain.json", dict(k=100.0, c=1.0, preload=0.0), "kelvin_voigt")
+    with pytest.raises(IdentificationError, match="the kelvin_voigt model has no temperature law"):
+        characterise_at_temperatures(plain, [253.15], [0.5], [2.0])
