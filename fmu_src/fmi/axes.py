@@ -82,11 +82,11 @@ class Axis:
         return SMALL_ANGLE_RAD if self.rotational else PLAUSIBLE_TRAVEL_M
 
     def state_port(self, unit: str) -> tuple[str, float]:
-        """(FMU unit, kernel -> port factor) of a state declared in "N", "m", "m/s" or "1"
-        (definition), or of a coupled group's event indicator in "N.m/s" (z.u: N times mm/s,
-        or N.mm times rad/s) or "m2/s" (d.v: mm^2/s, or rad^2/s)."""
-        if unit == "1":
-            return ("1", 1.0)
+        """(FMU unit, kernel -> port factor) of a state declared in "N", "m", "m/s", "1" or "K"
+        (definition; a temperature is one on every axis), or of a coupled group's event indicator
+        in "N.m/s" (z.u: N times mm/s, or N.mm times rad/s) or "m2/s" (d.v: mm^2/s, or rad^2/s)."""
+        if unit in ("1", "K"):
+            return (unit, 1.0)
         if unit == "N.m/s":
             return ("N.m/s", 1e-3)
         if unit == "m2/s":

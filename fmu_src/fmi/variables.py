@@ -137,10 +137,18 @@ def all_variables(axis_models, groups=()) -> list[FmuVariable]:
                                     "simulation time [s]", 0, "time", 0)]
 
 
+NOMINAL_TEMPERATURE_K = 300.0
+"""A temperature state's nominal value [K]: a solver's scale for its error (a rubber near room
+temperature)."""
+
+
 def nominal(variable: FmuVariable) -> float:
-    """A state's nominal value (1.0 for the other variables and for dimensionless states)."""
+    """A state's nominal value (1.0 for the other variables and for dimensionless states; a
+    temperature's NOMINAL_TEMPERATURE_K)."""
     if variable.kind != "state" or variable.unit == "1":
         return 1.0
+    if variable.unit == "K":
+        return NOMINAL_TEMPERATURE_K
     return {**NOMINAL_DISPLACEMENT, **NOMINAL_VELOCITY, **NOMINAL_FORCE}[variable.unit]
 
 

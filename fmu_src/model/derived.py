@@ -102,6 +102,13 @@ def _search(base: BushingModel, options: Options) -> SearchBox:
     for element, count in options.elements:
         coordinates += element.coordinates(count)
         held = held + element.held
+    roles = {spec.temperature_role for spec in base.specs if spec.name not in held_out}
+    roles |= {spec.temperature_role for element, count in options.elements if not element.law_roles
+              for spec in element.specs(count)}
+    idle = {name for element, _ in options.elements for name, role in element.law_roles if role not in roles}
+    if idle:       # a law's constant that moves nothing is held at its neutral value
+        coordinates = tuple(c for c in coordinates if c.parameter not in idle)
+        held = held + tuple(pair for pair in options.neutral if pair[0] in idle)
     loop = base.search.loop_start if base.search is not None and not options.replaces_static_spring else None
     if loop is not None:       # the friction alone: the options' neutral values too
         loop = replace(loop, friction_alone=loop.friction_alone + options.neutral)
@@ -131,7 +138,7 @@ def derive(base: BushingModel, options: Options) -> BushingModel:
         switch_specs += tuple(StateSpec(s.name, len(switch_specs) + i, s.unit, s.description)
                               for i, s in enumerate(element.switches(count)))
         own = element.states(count)
-        if own and element.step is None and not element.series:
+        if own and element.step is None and not element.series and not element.heating:
             raise ModelContractError(f"the {element.token} option has states but no step")
         states += tuple(StateSpec(s.name, len(states) + i, s.unit, s.description) for i, s in enumerate(own))
     title = f"{base.title} with " + ", ".join(element.word for element, _ in options.elements)

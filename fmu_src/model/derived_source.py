@@ -385,23 +385,94 @@ def law_wrapper_source(base: BushingModel, options) -> tuple[str, set[str]]:
         raise ModelContractError(f"{' and '.join(element.token for element, _ in laws)}: give one law on the "
                                  "parameters")
     law, count = laws[0]
-    inner = Options(tuple(item for item in options.chosen if item[0] != law.token))
+    heating = [(element, c) for element, c in options.elements if element.heating]
+    inner = Options(tuple(item for item in options.chosen
+                          if item[0] != law.token and not any(item[0] == e.token for e, _ in heating)))
     text, shared = wrapper_source(base, inner)
-    renamer = _Rename({"prepare"}, prefix="unconditioned_")
-    text = "\n\n\n".join(ast.unparse(renamer.visit(node)) for node in parse(text).body)
     held = set(base.static_spring) if options.replaces_static_spring else set()
     specs = [spec for spec in base.specs if spec.name not in held]
     specs += [spec for element, c in options.elements for spec in element.specs(c)]
-    own = {spec.name for spec in law.specs(count)}
+    own = {spec.name for element, c in [laws[0], *heating] for spec in element.specs(c)}
     index = {spec.name: i for i, spec in enumerate(specs)}
-    lines, factors = law.law(tuple(f"p[{index[spec.name]}]" for spec in law.specs(count)))
-    scaled = [f"p[{i}] * {factors[spec.temperature_role]}" if spec.temperature_role in factors else f"p[{i}]"
-              for i, spec in enumerate(specs) if spec.name not in own]
-    # a factor no parameter takes is left out (the C translation refuses a value never read)
-    unused = {name for role, name in factors.items() if not any(name in text for text in scaled)}
-    body = "".join(f"    {line}\n" for line in lines if line.split(" = ")[0] not in unused)
-    prepare = f"def prepare(p):\n{body}    return unconditioned_prepare({tuple_text(scaled)})\n"
+
+    def law_body(temperature: str, parameter) -> tuple[str, str]:
+        """(the law's lines at ``temperature``, the inner model's scaled parameters' tuple), the
+        parameters' texts ``parameter(i)``."""
+        texts = [temperature] + [parameter(index[spec.name]) for spec in law.specs(count)[1:]]
+        lines, factors = law.law(tuple(texts))
+        scaled = [f"{parameter(i)} * {factors[spec.temperature_role]}" if spec.temperature_role in factors
+                  else parameter(i) for i, spec in enumerate(specs) if spec.name not in own]
+        # a factor no parameter takes is left out (the C translation refuses a value never read)
+        unused = {name for name in factors.values() if not any(name in text for text in scaled)}
+        body = "".join(f"    {line}\n" for line in lines if line.split(" = ")[0] not in unused)
+        return body, tuple_text(scaled)
+    temperature = f"p[{index[law.specs(count)[0].name]}]"
+    if heating:
+        return heated_source(base, inner, text, shared, law_body, index, heating[0])
+    renamer = _Rename({"prepare"}, prefix="unconditioned_")
+    text = "\n\n\n".join(ast.unparse(renamer.visit(node)) for node in parse(text).body)
+    body, scaled = law_body(temperature, lambda i: f"p[{i}]")
+    prepare = f"def prepare(p):\n{body}    return unconditioned_prepare({scaled})\n"
     return text + "\n\n\n" + prepare, shared
+
+
+HEATED_KERNELS = DEVICE_KERNELS
+"""The kernels of a heated model's inner model, renamed ``unheated_<name>`` under the thermal wrapper."""
+
+
+def heated_source(base: BushingModel, inner, text: str, shared: set[str], law_body, index: dict,
+                  heating) -> tuple[str, set[str]]:
+    """The kernels of a model with a temperature law and a thermal state (``options.heating``):
+    the inner model (without the law and the heating, its kernels renamed ``unheated_*``) at the
+    rubber's temperature, the state's last entry; ``heated_constants(m, T)`` its constants there
+    (the law at T); the thermal state stepped by the trapezoid of F v and the cooling law."""
+    element, count = heating
+    renamer = _Rename(set(HEATED_KERNELS), prefix="unheated_")
+    inner_text = "\n\n\n".join(ast.unparse(renamer.visit(node)) for node in parse(text).body)
+    n = len(base.states) + sum(len(e.states(c)) for e, c in inner.elements)
+    size = len(index)
+    capacity, resistance = (index[spec.name] for spec in element.specs(count))
+    ambient = next(name for name, i in index.items() if name == "temperature")
+    own = tuple_text(f"state[{i}]" for i in range(n))
+
+    def out(name: str, last: str) -> str:
+        return tuple_text([f"{name}[{i}]" for i in range(n)] + [last])
+    body, scaled = law_body(f"p[{index[ambient]}]", lambda i: f"p[{i}]")
+    at_T, scaled_T = law_body("temperature_K", lambda i: f"m[1][{i}]")
+    stepping = "unheated_prepare_step(c, h)" if "def unheated_prepare_step" in inner_text else "c"
+    source = [
+        f"def prepare(p):\n{body}    return (unheated_prepare({scaled}), {tuple_text(f'p[{i}]' for i in range(size))}, "
+        f"(p[{capacity}], p[{resistance}], p[{index[ambient]}]))\n",
+        f"def heated_constants(m, temperature_K):\n{at_T}    return unheated_prepare({scaled_T})\n",
+        f"def initial_state(m, x0):\n" + (f"    s = unheated_initial_state(m[0], x0)\n" if n else "")
+        + f"    return {out('s', 'm[2][2]')}\n",
+        f"def jump(m, state, jump_mm):\n    c = heated_constants(m, state[{n}])\n"
+        f"    s, status = unheated_jump(c, {own}, jump_mm)\n    return {out('s', f'state[{n}]')}, status\n",
+        f"def integrate(m, state, x, v, h, max_substeps):\n"
+        f"    temperature_K = state[{n}]\n    c = heated_constants(m, temperature_K)\n"
+        f"    f0 = unheated_force(c, {own}, x, v)\n"
+        f"    s, used, status = unheated_integrate({stepping}, {own}, x, v, h, max_substeps)\n"
+        f"    f1 = unheated_force(c, s, x + v * h, v)\n"
+        f"    # the trapezoid of F v [N.mm/s = mW] over the step, in W\n"
+        f"    power = 0.0005 * (f0 + f1) * v\n"
+        f"    decay = math.exp(-h / (m[2][0] * m[2][1]))\n"
+        f"    heated = m[2][2] + (temperature_K - m[2][2]) * decay + power * m[2][1] * (1.0 - decay)\n"
+        f"    if status == OK and not math.isfinite(heated):\n        status = NOT_FINITE\n"
+        f"    return {out('s', 'heated')}, used, status\n",
+        f"def force(m, state, x, v):\n    return unheated_force(heated_constants(m, state[{n}]), {own}, x, v)\n",
+        f"def derivatives(m, state, x, v):\n    c = heated_constants(m, state[{n}])\n"
+        + (f"    d = unheated_derivatives(c, {own}, x, v)\n" if n else "")
+        + f"    power = 0.001 * unheated_force(c, {own}, x, v) * v\n"
+        f"    return {out('d', f'(power - (state[{n}] - m[2][2]) / m[2][1]) / m[2][0]')}\n",
+        f"def switches(m, state, x, v):\n    return unheated_switches(heated_constants(m, state[{n}]), {own}, x, v)\n"]
+    if "def unheated_resting_state" in inner_text:
+        source.append(f"def resting_state(m, x0, force):\n" + (f"    s = unheated_resting_state(m[0], x0, force)\n"
+                                                                if n else "")
+                      + f"    return {out('s', 'm[2][2]')}\n")
+    if "def unheated_update" in inner_text:
+        source.append(f"def update(m, state, x, v):\n    s = unheated_update(heated_constants(m, state[{n}]), {own}, x, v)\n"
+                      f"    return {out('s', f'state[{n}]')}\n")
+    return inner_text + "\n\n\n" + "\n\n".join(source), shared | {"OK", "NOT_FINITE"}
 
 
 def derived_source(base: BushingModel, options) -> str:

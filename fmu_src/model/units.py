@@ -1,5 +1,5 @@
 """Units, read from their names: every unit a parameter, port or state is declared in is a product
-of powers of N, mm, m, s, rad, kg, Hz and K (``N.s^2/mm``, ``m/s/s``, ``m2/s``), so its SI form (the
+of powers of N, mm, m, s, rad, kg, Hz, K, J and W (``N.s^2/mm``, ``m/s/s``, ``m2/s``), so its SI form (the
 base units and factor FMI and SSP declare) and its form on a rotational axis are computed from
 the name, not tabulated per model: a model that declares a new unit needs no entry anywhere else.
 
@@ -13,7 +13,8 @@ from fractions import Fraction
 
 SYMBOLS = {"N": ({"kg": 1, "m": 1, "s": -2}, Fraction(1)), "mm": ({"m": 1}, Fraction(1, 1000)),
            "m": ({"m": 1}, Fraction(1)), "s": ({"s": 1}, Fraction(1)), "rad": ({"rad": 1}, Fraction(1)),
-           "kg": ({"kg": 1}, Fraction(1)), "Hz": ({"s": -1}, Fraction(1)), "K": ({"K": 1}, Fraction(1))}
+           "kg": ({"kg": 1}, Fraction(1)), "Hz": ({"s": -1}, Fraction(1)), "K": ({"K": 1}, Fraction(1)),
+           "J": ({"kg": 1, "m": 2, "s": -2}, Fraction(1)), "W": ({"kg": 1, "m": 2, "s": -3}, Fraction(1))}
 """Each symbol a unit may use: its SI base exponents and factor (value_SI = factor * value)."""
 BASE_ORDER = ("kg", "m", "s", "A", "K", "mol", "cd", "rad")
 """FMI's order of a BaseUnit's exponents."""

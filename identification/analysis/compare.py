@@ -60,7 +60,7 @@ from identification.measured.measurements import load_measurement, measurement_n
 from identification.fitting.objectives import nrmse, rms_level_error
 from identification.analysis.plots import plot_comparison, plot_table_comparison
 from identification.measured.rig_tests import RigTest
-from identification.forward.simulate import simulate_measurement
+from identification.forward.simulate import simulate_record
 
 PREDICTION_TOLERANCE = 0.1
 """A model predicts as well as the best if its held-out error is at most this much larger (10 %)."""
@@ -417,7 +417,7 @@ def leave_one_out(tests: Sequence[RigTest], fitted: FitResult, request_of, engin
         rest = [t for j, t in enumerate(tests) if j != i]
         result = race_models([request_of(rest)], engine, False, progress)[0][fitted.model]
         m = test.measurement
-        predicted = simulate_measurement(result.parameters, m)
+        predicted = simulate_record(result.parameters, m)
         out.append(nrmse(predicted, m.force_N))
     by_name = {t.name: t for t in fitted.tests}
     return LeaveOneOut(fitted.model, [t.name for t in tests], [by_name[t.name].nrmse for t in tests], out,
@@ -460,7 +460,7 @@ def _validation_errors(validation, bushings, parameters: dict, assessments: list
     errors, predictions = {}, {}
     for m in validation:
         name = Path(m.source).name
-        predicted_by_name = {bushing.name: simulate_measurement(parameters[bushing.name], m, model=bushing)
+        predicted_by_name = {bushing.name: simulate_record(parameters[bushing.name], m, model=bushing)
                              for bushing in bushings}
         predictions[name] = {bushing: predicted_by_name[bushing.name] for bushing in bushings}
         for assessment in assessments:

@@ -8,6 +8,8 @@ plus a random input (peak 2 mm), all sampled at 1 kHz.
 """
 from __future__ import annotations
 
+import math
+
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Mapping, Sequence
@@ -72,6 +74,16 @@ def grid_errors(parameters, truth, model: str | None = None, truth_model: str | 
     return errors
 
 
+def predict_record(bushing, sets, m: Measurement):
+    """``predict_sets`` on a measured file as the fit takes it: from rest holding the force it
+    holds before it moves, at its own temperature (a model with a temperature law)."""
+    from identification.forward.population import conditioned_set
+    from identification.measured.offsets import held_force
+    sets = [bushing.check(conditioned_set(bushing, values, m.conditions)) for values in sets]
+    return predict_sets(bushing, sets, m.time_s, m.displacement_mm, m.measured_velocity_mm_s,
+                        held_force(m) if m.has_force else math.nan)
+
+
 def data_errors(parameters, measurements: Sequence[Measurement], kelvin_voigt: KelvinVoigtFit | None = None,
                 model: str | None = None) -> list[tuple[CaseError, CaseError | None]]:
     """Errors of ``parameters`` (a set or an ensemble, read and checked once) on measured files,
@@ -79,7 +91,7 @@ def data_errors(parameters, measurements: Sequence[Measurement], kelvin_voigt: K
     bushing, sets = parameter_sets(parameters, model)
     rows = []
     for m in measurements:
-        prediction = predict_sets(bushing, sets, m.time_s, m.displacement_mm, m.measured_velocity_mm_s)
+        prediction = predict_record(bushing, sets, m)
         name = Path(m.source).name
         baseline = None
         if kelvin_voigt is not None:
@@ -124,7 +136,7 @@ def plot_measurement(parameters, measurement: Measurement, path: Path,
     like the paper's Figs. 9-19; an ensemble's band shaded."""
     m = measurement
     bushing, sets = parameter_sets(parameters, model)
-    prediction = predict_sets(bushing, sets, m.time_s, m.displacement_mm, m.measured_velocity_mm_s)
+    prediction = predict_record(bushing, sets, m)
     predictions = {bushing: prediction.force_N}
     if kelvin_voigt is not None:
         predictions[LINEAR_BASELINE] = kelvin_voigt.force(m.displacement_mm, m.velocity_mm_s)

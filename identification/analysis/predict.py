@@ -133,7 +133,8 @@ def predict(parameters, time_s, displacement_mm, velocity_mm_s=None,
         from fmu_src.parameter_files import read_ensemble
         parameters = read_ensemble(parameters)
     bushing, sets = parameter_sets(parameters, model)
-    sets = [conditioned_set(bushing, values, temperature_conditions(temperature_K)) for values in sets]
+    at = temperature_conditions(temperature_K)
+    sets = [bushing.check(conditioned_set(bushing, values, at)) for values in sets]    # a temperature refused here
     return predict_sets(bushing, sets, time_s, displacement_mm, velocity_mm_s, rest_force_N,
                         training_misfit_N(parameters))
 

@@ -26,7 +26,7 @@ import warnings
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from fmu_src.model.registry import DEFAULT_MODEL, MODEL_CHOICES
+from fmu_src.model.registry import DEFAULT_MODEL, get_model
 from fmu_src.model.parameter_specs import ParameterError
 from fmu_src.parameter_files import parameter_document
 from identification.fitting.engine import make_engine
@@ -99,8 +99,10 @@ def fit_many(folder: str | Path, out_dir: str | Path, options: FitOptions | None
         try:
             manifest = load_manifest(path / MANIFEST)
             model = manifest.model or DEFAULT_MODEL
-            if model not in MODEL_CHOICES:
-                raise MeasurementError(f"{path / MANIFEST}: model {model!r} is not one of {', '.join(MODEL_CHOICES)}")
+            try:
+                model = get_model(model).name        # a registered model, with options where named
+            except ValueError as exc:         # the registry's words: the models, or the options
+                raise MeasurementError(f"{path / MANIFEST}: {exc}") from None
             labels = [_label(t.measurement.source, path) for t in manifest.tests]
             jobs.append(_Job(path.name, manifest.tests, labels, model, each))
         except (MeasurementError, ParameterError, OSError, UnicodeDecodeError) as exc:

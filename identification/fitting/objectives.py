@@ -35,6 +35,7 @@ from typing import Sequence
 
 import numpy as np
 
+from fmu_src.model.parameter_specs import ParameterError
 from fmu_src.model.registry import BushingModel, DEFAULT_BUSHING, required_model
 from identification.forward.input_path import DrivenInput, DrivenVectorInput, prepare_input, prepare_vector_input
 from identification.measured.kdyn_table import (FIT_CYCLES, FIT_STEPS_PER_CYCLE, KDYN_UNCERTAINTY, LOSS_ANGLE_UNCERTAINTY_DEG,
@@ -189,6 +190,7 @@ class Objective:
         steps = list(steps) if steps is not None else [None] * len(tests)
         if len(steps) != len(tests):
             raise ValueError(f"{len(steps)} step counts for {len(tests)} tests")
+        _check_conditions(tests, required_model(model))
         self.rest_forces = [held_force(t.measurement) for t in tests]
         self.strides = [fit_stride(t) for t in tests]
         self.noise = noise
@@ -227,7 +229,9 @@ class Objective:
             # a prefix of a step may end inside its ramp: as a plain time series, whose kind checks nothing
             cut.append(RigTest(replace(m, time_s=m.time_s[:k], displacement_mm=m.displacement_mm[:k],
                                        force_N=m.force_N[:k], velocity_mm_s=m.velocity_mm_s[:k],
-                                       temperature_K=None if m.temperature_K is None else m.temperature_K[:k])))
+                                       # the whole test's mean: the condition it runs at
+                                       temperature_K=None if m.temperature_K is None
+                                       else np.full(k, m.mean_temperature_K))))
         prefix = Objective(cut, self.noise, self.steps_per_sample, self.bushing)
         # the whole tests' forces at rest and strides (a prefix's own would judge them on less:
         # a cycle of a slow sine is longer than its prefix), its tests prepared again with them
@@ -345,6 +349,17 @@ def fit_stride(test: RigTest) -> int:
         return 1
     per_cycle = 1.0 / (frequency * float(np.median(np.diff(m.time_s))))
     return max(1, int(per_cycle // FIT_SAMPLES_PER_CYCLE))
+
+
+def _check_conditions(tests, bushing: BushingModel) -> None:
+    """ParameterError naming the test, for a test whose condition (its temperature) the model's
+    parameter refuses (outside a temperature law's range)."""
+    specs = {spec.name: spec for spec in bushing.specs}
+    for test in tests:
+        given = dict(getattr(test.measurement, "conditions", ()))
+        for parameter, field in bushing.conditions:
+            if field in given and (error := specs[parameter].range_error(given[field])) is not None:
+                raise ParameterError(f"{test.name}: its {field} sets the {bushing.name} model's {error}")
 
 
 def _prepared_tests(tests, noise, steps, rests, strides) -> list[PreparedTest]:

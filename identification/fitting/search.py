@@ -39,7 +39,7 @@ from identification.fitting.presets import PAPER_GA, SearchSettings, describe
 from identification.fitting.progress import SearchProgress, notice_later
 from identification.fitting.refinement import refine_steps
 from identification.fitting.search_space import SearchSpace
-from identification.forward.simulate import simulate_measurement, simulate_multiaxis
+from identification.forward.simulate import simulate_record, simulate_multiaxis
 from identification.fitting.table_start import sines_as_table, table_start
 
 
@@ -611,7 +611,7 @@ def test_fits(tests, noise, parameters: ParameterSet, steps=None) -> list[RigTes
     fits = []
     for test, level, m_steps in zip(tests, noise, steps or [None] * len(tests)):
         m = test.measurement
-        predicted = simulate_measurement(parameters, m, steps_per_sample=m_steps)
+        predicted = simulate_record(parameters, m, steps_per_sample=m_steps)
         repeats = estimate_repeatability(m.time_s, m.displacement_mm, m.force_N) if test.kind == "sine" else None
         fits.append(RigTestFit(test.name, test.kind, level, nrmse(predicted, m.force_N), repeats, predicted))
     return fits

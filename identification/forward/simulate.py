@@ -77,7 +77,7 @@ def temperature_conditions(temperature_K: float) -> tuple[tuple[str, float], ...
     return () if temperature_K != temperature_K else (("temperature_K", float(temperature_K)),)
 
 
-def simulate_measurement(parameters, measurement, model: str | BushingModel | None = None,
+def simulate_record(parameters, measurement, model: str | BushingModel | None = None,
                          steps_per_sample: int | None = None) -> np.ndarray:
     """:func:`simulate` on a measured test as the fit takes it: its measured velocity, started at
     rest holding the force it holds before it moves (``offsets.held_force``) and at its own
@@ -87,8 +87,9 @@ def simulate_measurement(parameters, measurement, model: str | BushingModel | No
     from identification.forward.population import conditioned_set
     values, bushing = _parameters_and_model(parameters, model)
     m = measurement
-    return simulate_set(bushing, conditioned_set(bushing, values, m.conditions), m.time_s, m.displacement_mm,
-                        m.measured_velocity_mm_s, steps_per_sample, held_force(m) if m.has_force else math.nan)
+    values = bushing.check(conditioned_set(bushing, values, m.conditions))     # a test's temperature refused here
+    return simulate_set(bushing, values, m.time_s, m.displacement_mm, m.measured_velocity_mm_s, steps_per_sample,
+                        held_force(m) if m.has_force else math.nan)
 
 
 def simulate_set(bushing: BushingModel, values, time_s, displacement_mm, velocity_mm_s=None,

@@ -71,3 +71,38 @@ def project_parameters(p: dict = TRUTH, temperature_K: float | None = None) -> d
                 temperature=p["temperature_ref"] if temperature_K is None else temperature_K,
                 temperature_ref=p["temperature_ref"], wlf_c1=p["wlf_c1"], wlf_c2=p["wlf_c2"],
                 elastic_per_K=p["elastic_per_K"], friction_per_K=p["friction_per_K"])
+
+
+def heated_force(p: dict, capacity_J_K: float, resistance_K_W: float, ambient_K: float, t: np.ndarray,
+                 x: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(F [N], the rubber's temperature [K]) at the points of the path x [mm] (straight between
+    them; v [mm/s] the velocity the dashpot reads at each point) of the bushing heated by its own
+    dissipation and cooled to ``ambient_K``: C dT/dt = D - (T - T_amb)/R, D the heat its elements
+    make (the dashpot's c s^2, the Maxwell dashpot's f_M^2/c_M at the piece's middle, the slider's
+    level times its slip), each piece at the temperature it starts at (the law of
+    :func:`at_temperature`), the cooling over the piece exact for its mean heat."""
+    out, temperature = np.empty(t.size), np.empty(t.size)
+    f_m = f_j = 0.0
+    T = ambient_K
+    q = at_temperature(p, T)
+    out[0], temperature[0] = q["k"] * x[0] + q["c"] * v[0], T
+    tau = capacity_J_K * resistance_K_W
+    for i in range(1, t.size):
+        q = at_temperature(p, T)
+        rate = q["maxwell_k"] / q["maxwell_c"]
+        h, dx = t[i] - t[i - 1], x[i] - x[i - 1]
+        slope = dx / h
+        decay = math.exp(-rate * h)
+        f_m_end = f_m * decay + q["maxwell_c"] * slope * (1.0 - decay)
+        f_mid = f_m * math.exp(-rate * h / 2) + q["maxwell_c"] * slope * (1.0 - math.exp(-rate * h / 2))
+        trial = f_j + q["jenkins_k"] * dx
+        f_j_end = min(max(trial, -q["jenkins_f"]), q["jenkins_f"])
+        slip = abs(trial - f_j_end) / q["jenkins_k"]          # [mm]
+        heat_mJ = q["c"] * slope ** 2 * h + f_mid ** 2 / q["maxwell_c"] * h + q["jenkins_f"] * slip
+        power = 1e-3 * heat_mJ / h
+        cooling = math.exp(-h / tau)
+        T = ambient_K + (T - ambient_K) * cooling + power * resistance_K_W * (1.0 - cooling)
+        f_m, f_j = f_m_end, f_j_end
+        q = at_temperature(p, T)
+        out[i], temperature[i] = q["k"] * x[i] + q["c"] * v[i] + f_m + f_j, T
+    return out, temperature

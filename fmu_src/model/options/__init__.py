@@ -84,6 +84,11 @@ class Options:
         if len(laws) > 1:
             raise ParameterError(f"{' and '.join(laws)}: a model takes one law on its parameters (each is a "
                                  "temperature law); give one")
+        heating = [token for token in seen if ELEMENTS[token].heating]
+        if heating and not laws:
+            lawful = [element.token for element in ELEMENTS.values() if element.law is not None]
+            raise ParameterError(f"{heating[0]}: a thermal state heats the rubber of a model with a temperature law; "
+                                 f"add one of {', '.join(lawful)}")
         object.__setattr__(self, "chosen", tuple(sorted(seen.items(), key=lambda item: ELEMENTS[item[0]].order)))
 
     @property

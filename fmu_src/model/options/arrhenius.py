@@ -15,8 +15,8 @@ from ..definition import SearchCoordinate
 from ..parameter_specs import ParameterSpec
 from ..search_coordinates import KIND
 from .element import OptionElement
-from .temperature_law import (CONDITIONS, HELD, NEUTRAL, coefficient_coordinates, coefficient_specs, factor_lines,
-                              temperature_specs)
+from .temperature_law import (CONDITIONS, HELD, NEUTRAL, ROLES, coefficient_coordinates, coefficient_specs,
+                              factor_lines, temperature_specs)
 
 ARRHENIUS = "arrhenius"
 
@@ -43,4 +43,5 @@ def arrhenius_law(p: tuple[str, ...]) -> tuple[tuple[str, ...], dict[str, str]]:
 ELEMENT = OptionElement(
     token=ARRHENIUS, word="an Arrhenius temperature law", order=96, usage=ARRHENIUS, specs=arrhenius_specs,
     coordinates=arrhenius_coordinates, law=arrhenius_law, conditions=CONDITIONS, prepare=lambda p: "()", held=HELD,
+    law_roles=(("arrhenius_K", "viscous"),) + ROLES,
     neutral=NEUTRAL + (("arrhenius_K", 0.0),))

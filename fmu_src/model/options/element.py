@@ -112,6 +112,16 @@ class OptionElement:
     temperature_role``: ``viscous``, ``elastic``, ``friction``); every other parameter of the
     model is multiplied by its role's factor before the model is prepared
     (``derived_source.law_wrapper_source``), a role without a factor left as it is. None: none."""
+    law_roles: tuple[tuple[str, str], ...] = ()
+    """(constant, role) of a law's constants: one whose role no other parameter of the model takes
+    (``friction_per_K`` in a model without a sliding level) moves nothing, so the fit holds it at
+    its neutral value instead of searching it."""
+    heating: bool = False
+    """True: a thermal state, the rubber's temperature, heated by the power the model takes from
+    the motion and cooled towards the law's temperature (then the surroundings'); its two
+    constants are its parameters and ``derived_source.heated_source`` writes the kernels (its own
+    hooks other than ``specs``, ``coordinates``, ``constraints`` and ``prepare`` unused). Needs a
+    law (``law``) in the same model."""
     conditions: tuple[tuple[str, str], ...] = ()
     """(parameter, the ``Measurement`` field that sets it): parameters a test's own conditions set
     (``temperature`` from its ``temperature_K``), held by the fit, the set's value where a test

@@ -55,6 +55,9 @@ def factor_lines(prefix: str, temperature: str, reference: str, shift: str, elas
     return lines, {"viscous": f"{prefix}_shift", "elastic": f"{prefix}_elastic", "friction": f"{prefix}_friction"}
 
 
+ROLES = (("elastic_per_K", "elastic"), ("friction_per_K", "friction"))
+"""The coefficients' roles (``OptionElement.law_roles``)."""
+
 # the law off: every factor 1 at the reference
 NEUTRAL = (("temperature", REFERENCE_K), ("temperature_ref", REFERENCE_K), ("elastic_per_K", 0.0),
            ("friction_per_K", 0.0))

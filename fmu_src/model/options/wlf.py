@@ -22,8 +22,8 @@ from ..definition import SearchCoordinate
 from ..parameter_specs import Constraint, ParameterSpec
 from ..search_coordinates import KIND
 from .element import OptionElement
-from .temperature_law import (CONDITIONS, HELD, NEUTRAL, coefficient_coordinates, coefficient_specs, factor_lines,
-                              temperature_specs)
+from .temperature_law import (CONDITIONS, HELD, NEUTRAL, ROLES, coefficient_coordinates, coefficient_specs,
+                              factor_lines, temperature_specs)
 
 WLF = "wlf"
 LN10 = 2.302585092994046
@@ -59,5 +59,6 @@ def wlf_law(p: tuple[str, ...]) -> tuple[tuple[str, ...], dict[str, str]]:
 ELEMENT = OptionElement(
     token=WLF, word="a WLF temperature law", order=95, usage=WLF, specs=wlf_specs, coordinates=wlf_coordinates,
     constraints=wlf_constraints, law=wlf_law, conditions=CONDITIONS, prepare=lambda p: "()", held=HELD,
+    law_roles=(("wlf_c1", "viscous"), ("wlf_c2", "viscous")) + ROLES,
     # the law off: every factor 1 at the reference (C2 any value the box holds)
     neutral=NEUTRAL + (("wlf_c1", 0.0), ("wlf_c2", 100.0)))

@@ -22,7 +22,7 @@ from python_core import simulate_python_core
 
 
 def test_the_table_holds_the_options_in_their_order():
-    assert list(option_table.ELEMENTS) == ["backbone", "limits", "maxwell", "iwan", "band", "series", "rig", "wlf", "arrhenius"]
+    assert list(option_table.ELEMENTS) == ["backbone", "limits", "maxwell", "iwan", "band", "series", "rig", "wlf", "arrhenius", "heating"]
     assert Options.parse(["Rig", "maxwell", "backbone5", "LIMITS"]).tokens == ("backbone5", "limits", "maxwell", "rig")
 
 
@@ -35,7 +35,7 @@ def test_every_option_round_trips_through_a_name_and_an_identifier():
 
 def test_bad_options_are_refused_with_what_is_allowed():
     with pytest.raises(ParameterError, match=r"unknown model option 'stops'; the options are backbone<K> .*, "
-                                             r"limits, maxwell, iwan<N> .*, band, series, rig, wlf and arrhenius"):
+                                             r"limits, maxwell, iwan<N> .*, band, series, rig, wlf, arrhenius and heating"):
         Options.parse(["stops"])
     with pytest.raises(ParameterError, match="backbone40: the count must be 2 to 32"):
         Options.parse(["backbone40"])

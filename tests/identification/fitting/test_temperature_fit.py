@@ -48,14 +48,14 @@ def test_the_objective_runs_each_test_at_its_own_temperature():
 
 
 def test_predict_and_simulate_take_a_tests_temperature(tmp_path):
-    """simulate_measurement runs a test at its own temperature; simulate at the set's; predict at
+    """simulate_record runs a test at its own temperature; simulate at the set's; predict at
     the one it is given."""
     from fmu_src.parameter_files import save_parameters
     from identification.analysis.predict import predict
-    from identification.forward.simulate import simulate, simulate_measurement
+    from identification.forward.simulate import simulate, simulate_record
     file = save_parameters(tmp_path / "truth.json", thermal_rubber.project_parameters(), THERMAL)
     m = load_measurement(HELD_OUT[0])
-    at_zero = simulate_measurement(file, m)
+    at_zero = simulate_record(file, m)
     assert nrmse(at_zero, m.force_N) < 0.01
     at_set = simulate(file, m.time_s, m.displacement_mm)                   # the set's own 23 degC
     assert nrmse(at_set, m.force_N) > 0.05
@@ -83,9 +83,9 @@ def test_a_fit_across_three_temperatures_recovers_the_law_and_predicts_the_tempe
         low, high = min(members), max(members)
         assert low <= truth[name] <= high or abs(p[name] - truth[name]) < 0.03 * abs(truth[name]), (name, low, high)
     for path in HELD_OUT:
-        from identification.forward.simulate import simulate_measurement
+        from identification.forward.simulate import simulate_record
         m = load_measurement(path)
-        predicted = simulate_measurement(p, m, model=THERMAL)
+        predicted = simulate_record(p, m, model=THERMAL)
         assert nrmse(predicted, m.force_N) < 0.02, path.name
 
 
@@ -158,3 +158,48 @@ def test_a_data_sheet_over_temperature_is_written_read_back_and_refused_without_
     plain = save_parameters(tmp_path / "plain.json", dict(k=100.0, c=1.0, preload=0.0), "kelvin_voigt")
     with pytest.raises(IdentificationError, match="the kelvin_voigt model has no temperature law"):
         characterise_at_temperatures(plain, [253.15], [0.5], [2.0])
+
+
+def test_report_runs_each_file_at_its_temperature(tmp_path):
+    from fmu_src.parameter_files import save_parameters
+    from identification.analysis.paper_verification import data_errors
+    file = save_parameters(tmp_path / "truth.json", thermal_rubber.project_parameters(), THERMAL)
+    rows = data_errors(file, [load_measurement(path) for path in HELD_OUT[:2]])
+    assert all(case.nrmse < 0.013 for case, _ in rows), [case.nrmse for case, _ in rows]
+
+
+def test_a_test_whose_temperature_the_law_refuses_is_an_error_naming_it():
+    from dataclasses import replace
+    from fmu_src.model.parameter_specs import ParameterError
+    from identification.forward.simulate import simulate_record
+    [test] = sine_tests(TRAINING[:1])
+    hot = RigTest(replace(test.measurement, temperature_K=np.full(len(test.measurement), 600.0)), kind="sine")
+    with pytest.raises(ParameterError, match=r"synthetic_thermal_sine_1mm_2Hz_m20C.csv: its temperature_K sets the "
+                                             r"kelvin_voigt\+maxwell\+iwan1\+wlf model's temperature = 600.0 \[K\]"):
+        Objective([hot], model=get_model(THERMAL))
+    with pytest.raises(ParameterError, match=r"temperature = 600.0 \[K\] must be in"):
+        simulate_record(thermal_rubber.project_parameters(), hot.measurement, model=THERMAL)
+
+
+def test_a_law_constant_that_moves_nothing_is_held():
+    """friction_per_K in a model without a sliding level, C1 and C2 in one without a dashpot."""
+    search = get_model("proposed+wlf").search
+    assert "friction_per_K" not in {c.parameter for c in search.coordinates}
+    assert ("friction_per_K", 0.0) in search.held and "wlf_c1" in {c.parameter for c in search.coordinates}
+    fractional = {c.parameter for c in get_model("fractional+wlf").search.coordinates}
+    assert not {"wlf_c1", "wlf_c2"} & fractional and "friction_per_K" in fractional
+    assert {"wlf_c1", "wlf_c2", "elastic_per_K", "friction_per_K"} <= {c.parameter for c in
+                                                                      get_model(THERMAL).search.coordinates}
+
+
+def test_fit_many_takes_a_model_with_options_and_names_a_bad_one(tmp_path):
+    import json
+    import shutil
+    from identification.fitting.fleet import fit_many
+    for name, model in (("bad", "proposed+stops"),):
+        folder = tmp_path / "fleet" / name
+        folder.mkdir(parents=True)
+        shutil.copy(TRAINING[0], folder)
+        (folder / "tests.json").write_text(json.dumps({"sine": [TRAINING[0].name], "model": model}))
+    [row] = fit_many(tmp_path / "fleet", tmp_path / "out", ensemble=False, workers=1)
+    assert "unknown model option 'stops'" in row.error and "wlf, arrhenius and heating" in row.error
