@@ -233,10 +233,16 @@ def _ssv_values(raw: Mapping[str, tuple[str | None, str | None]], model: Bushing
 
 def _model_of_ssv(set_name: str | None, names: set[str]) -> BushingModel | None:
     """The model a ParameterSet is for: by its name (our files use the FMI identifier), else
-    the model whose parameter names it holds exactly; None if neither tells."""
+    the model whose parameter names it holds exactly; None if neither tells. A model with options
+    (``BoucWenBushing_Maxwell_Wlf``) goes by its identifier."""
     for model in MODELS.values():
         if set_name == model.identifier:
             return model
+    if set_name and "_" in set_name:
+        try:
+            return get_model(set_name)
+        except ParameterError:       # not an identifier: the names decide
+            pass
     for model in MODELS.values():     # its own parameters, and the mounting's where given
         if set(model.parameter_names) <= names <= set(model.fmu_units):
             return model
