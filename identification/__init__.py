@@ -37,6 +37,8 @@ they may import):
   ensemble, where tasks run, progress, fleets;
 - ``analysis``: predictions and their bands, the next test, sensitivities, ``compare``, the
   paper's verification tables, plots;
+- ``property_files``: other tools' bushing property files read into parameter sets (Chrono's
+  vehicle JSON);
 - ``cli``: the command line.
 
 Beside them, what every subpackage may use: ``errors`` (every error and warning type),

@@ -188,7 +188,7 @@ def test_the_cosimulation_examples_name_the_extra_they_lack(script, tmp_path):
     assert not (tmp_path / "out").exists()
 
 
-SUBPACKAGES = {"identification": ("measured", "forward", "fitting", "analysis", "cli"),
+SUBPACKAGES = {"identification": ("measured", "forward", "fitting", "analysis", "property_files", "cli"),
                "fmu_src": ("model", "models", "kernels", "fmi")}
 """Each package's subpackages, in the order they may import each other: each only those before it."""
 

@@ -92,7 +92,7 @@ def build_parser(program: str = "python -m identification") -> argparse.Argument
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     subcommands = parser.add_subparsers(dest="command", required=True)
     for add in (_add_fit, _add_sensitivity, _add_report, _add_compare, _add_predict, _add_design, _add_fit_many,
-                _add_assemble, _add_characterise):
+                _add_assemble, _add_characterise, _add_import):
         add(subcommands)
     return parser
 
@@ -243,6 +243,20 @@ def _add_assemble(subcommands) -> None:
                          help="an axis without a file takes its set from this six-axis file")
 
 
+def _add_import(subcommands) -> None:
+    """The ``import`` command's arguments."""
+    import_parser = subcommands.add_parser(
+        "import", help="read another tool's bushing property file into a parameter file (Chrono's vehicle JSON)")
+    import_parser.add_argument("file", type=Path, help="the property file: a Chrono vehicle JSON file with "
+                                                       "\"Bushing Data\"")
+    import_parser.add_argument("--bushing", metavar="NAME", help="the bushing, by its part's name, where the file "
+                                                                 "holds several (\"Lower Control Arm\")")
+    import_parser.add_argument("--dof", metavar="AXIS", choices=("x", "y", "z", "rx", "ry", "rz"),
+                               help="the joint's free degree of freedom, which takes the file's DOF values "
+                                    "(default: they are left out, with a warning)")
+    import_parser.add_argument("--out", type=Path, required=True, help="six-axis parameter file to write (.json, .ssv)")
+
+
 def _add_characterise(subcommands) -> None:
     """The ``characterise`` command's arguments."""
     characterise_parser = subcommands.add_parser(
@@ -315,7 +329,7 @@ COMMANDS = {"fit": commands.fit_command, "sensitivity": commands.sensitivity_com
             "report": commands.report_command, "compare": commands.compare_command,
             "predict": commands.predict_command, "design": commands.design_command,
             "fit-many": commands.fit_many_command, "assemble": commands.assemble_command,
-            "characterise": commands.characterise_command}
+            "characterise": commands.characterise_command, "import": commands.import_command}
 NEEDS_FIT_EXTRA = ("fit", "compare", "fit-many")
 """Commands that fit: they need numba and the optimizers (the ``fit`` extra). The others only
 simulate, which the base install does too, as plain Python (``fmu_src.kernels.jit``), slower."""

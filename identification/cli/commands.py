@@ -365,6 +365,22 @@ def design_command(args) -> int:
     return 0
 
 
+def import_command(args) -> int:
+    from fmu_src.parameter_files import save_six_axis
+    from identification.property_files.chrono_json import read_chrono_bushing
+    check_output(args.out, "--out", suffixes=(".json", ".ssv"))
+    if args.file.suffix.lower() != ".json":
+        raise UsageError(f"{args.file}: a property file this version reads is Chrono's vehicle JSON (.json); "
+                         "Altair's .gbs and Adams' .bus are not read yet")
+    imported = read_chrono_bushing(args.file, args.bushing, args.dof)
+    path = save_six_axis(args.out, imported.axes, imported.provenance)
+    k_lin, k_rot = imported.axes["x"][1]["k"], imported.axes["rx"][1]["k"]
+    print(f"{imported.provenance['bushing']}: six Kelvin-Voigt axes, {k_lin:g} N/mm and {k_rot:g} N.mm/rad"
+          + (f", the free axis {args.dof} the file's DOF values" if args.dof else ""))
+    print(f"wrote {path}")
+    return 0
+
+
 def assemble_command(args) -> int:
     from identification.fitting.six_axis_assembly import assemble
     check_output(args.out, "--out", suffixes=(".json", ".ssv"))

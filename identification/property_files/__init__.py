@@ -1,0 +1,11 @@
+"""Other tools' bushing property files, read into the project's parameter files.
+
+- ``chrono_json``: Project Chrono's vehicle JSON bushings as a six-axis Kelvin-Voigt set.
+
+Each reader names what it does not take in a warning (``PropertyFileWarning``) and refuses what
+it cannot read with the file, the place and the value.
+
+May import: ``identification.measured``, ``identification.forward``, ``identification.fitting``,
+``identification.analysis``, the top-level modules and ``fmu_src``.
+"""
+from __future__ import annotations
