@@ -368,15 +368,20 @@ def design_command(args) -> int:
 def import_command(args) -> int:
     from fmu_src.parameter_files import save_six_axis
     from identification.property_files.chrono_json import read_chrono_bushing
+    from identification.property_files.gbs import read_gbs
     check_output(args.out, "--out", suffixes=(".json", ".ssv"))
-    if args.file.suffix.lower() != ".json":
-        raise UsageError(f"{args.file}: a property file this version reads is Chrono's vehicle JSON (.json); "
-                         "Altair's .gbs and Adams' .bus are not read yet")
-    imported = read_chrono_bushing(args.file, args.bushing, args.dof)
+    suffix = args.file.suffix.lower()
+    if suffix not in (".json", ".gbs"):
+        raise UsageError(f"{args.file}: the property files this version reads are Chrono's vehicle JSON (.json) and "
+                         "Altair's bushing files (.gbs); Adams' .bus is not read yet")
+    if suffix == ".gbs" and (args.bushing or args.dof):
+        raise UsageError(f"{args.file}: --bushing and --dof are for Chrono's files; a .gbs holds one bushing with "
+                         "all six directions")
+    imported = read_gbs(args.file) if suffix == ".gbs" else read_chrono_bushing(args.file, args.bushing, args.dof)
     path = save_six_axis(args.out, imported.axes, imported.provenance)
-    k_lin, k_rot = imported.axes["x"][1]["k"], imported.axes["rx"][1]["k"]
-    print(f"{imported.provenance['bushing']}: six Kelvin-Voigt axes, {k_lin:g} N/mm and {k_rot:g} N.mm/rad"
-          + (f", the free axis {args.dof} the file's DOF values" if args.dof else ""))
+    name = imported.provenance.get("bushing", args.file.name)
+    print(f"{name}: " + ", ".join(f"{axis} {model}" for axis, (model, _) in imported.axes.items())
+          + (f"; the free axis {args.dof} the file's DOF values" if args.dof else ""))
     print(f"wrote {path}")
     return 0
 

@@ -1,6 +1,9 @@
 """Other tools' bushing property files, read into the project's parameter files.
 
-- ``chrono_json``: Project Chrono's vehicle JSON bushings as a six-axis Kelvin-Voigt set.
+- ``chrono_json``: Project Chrono's vehicle JSON bushings as a six-axis Kelvin-Voigt set;
+- ``teimorbit``: the TeimOrbit text format (blocks, values, tables) Altair's and Adams' files use;
+- ``gbs``: Altair's bushing property files (``.gbs``): splines as backbones, constant stiffness
+  and damping.
 
 Each reader names what it does not take in a warning (``PropertyFileWarning``) and refuses what
 it cannot read with the file, the place and the value.
