@@ -92,7 +92,7 @@ def build_parser(program: str = "python -m identification") -> argparse.Argument
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     subcommands = parser.add_subparsers(dest="command", required=True)
     for add in (_add_fit, _add_sensitivity, _add_report, _add_compare, _add_predict, _add_design, _add_fit_many,
-                _add_assemble, _add_characterise, _add_import):
+                _add_assemble, _add_characterise, _add_import, _add_export):
         add(subcommands)
     return parser
 
@@ -258,6 +258,32 @@ def _add_import(subcommands) -> None:
     import_parser.add_argument("--out", type=Path, required=True, help="six-axis parameter file to write (.json, .ssv)")
 
 
+def _add_export(subcommands) -> None:
+    """The ``export`` command's arguments."""
+    from identification.property_files.export import OperatingPoint
+    default = OperatingPoint()
+    export_parser = subcommands.add_parser(
+        "export", help="write a parameter file as another tool's bushing property file (Altair's .gbs): each "
+                       "direction's static curve and an equivalent linear damping")
+    export_parser.add_argument("params", type=Path, help="a six-axis parameter file, or a one-axis one with --direction")
+    export_parser.add_argument("--format", choices=("gbs",), default="gbs", help="the property file's format (gbs)")
+    export_parser.add_argument("--direction", metavar="DIR", help="the direction of a one-axis file: FX, FY, FZ, TX, "
+                                                                  "TY or TZ")
+    export_parser.add_argument("--range-mm", type=float, default=default.range_mm, metavar="R",
+                               help=f"the translations' deflection range, -R to R [mm] (default {default.range_mm:g})")
+    export_parser.add_argument("--range-rad", type=float, default=default.range_rad, metavar="R",
+                               help=f"the rotations' range, -R to R [rad] (default {default.range_rad:g})")
+    export_parser.add_argument("--points", type=int, default=default.points, metavar="N",
+                               help=f"the spline's points, 2 to 32 (default {default.points})")
+    export_parser.add_argument("--amplitude-mm", type=float, default=default.amplitude_mm, metavar="X",
+                               help=f"the damping's sine amplitude on translations [mm] (default {default.amplitude_mm:g})")
+    export_parser.add_argument("--amplitude-rad", type=float, default=default.amplitude_rad, metavar="X",
+                               help=f"the damping's sine amplitude on rotations [rad] (default {default.amplitude_rad:g})")
+    export_parser.add_argument("--frequency-hz", type=float, default=default.frequency_hz, metavar="F",
+                               help=f"the damping's sine frequency [Hz] (default {default.frequency_hz:g})")
+    export_parser.add_argument("--out", type=Path, required=True, help="the property file to write (.gbs)")
+
+
 def _add_characterise(subcommands) -> None:
     """The ``characterise`` command's arguments."""
     characterise_parser = subcommands.add_parser(
@@ -330,7 +356,8 @@ COMMANDS = {"fit": commands.fit_command, "sensitivity": commands.sensitivity_com
             "report": commands.report_command, "compare": commands.compare_command,
             "predict": commands.predict_command, "design": commands.design_command,
             "fit-many": commands.fit_many_command, "assemble": commands.assemble_command,
-            "characterise": commands.characterise_command, "import": commands.import_command}
+            "characterise": commands.characterise_command, "import": commands.import_command,
+            "export": commands.export_command}
 NEEDS_FIT_EXTRA = ("fit", "compare", "fit-many")
 """Commands that fit: they need numba and the optimizers (the ``fit`` extra). The others only
 simulate, which the base install does too, as plain Python (``fmu_src.kernels.jit``), slower."""

@@ -386,6 +386,15 @@ def import_command(args) -> int:
     return 0
 
 
+def export_command(args) -> int:
+    from identification.property_files.export import OperatingPoint, export_gbs
+    check_output(args.out, "--out", suffixes=(".gbs",))
+    point = OperatingPoint(args.range_mm, args.range_rad, args.points, args.amplitude_mm, args.amplitude_rad,
+                           args.frequency_hz)
+    print(f"wrote {export_gbs(args.params, args.out, point, args.direction)}")
+    return 0
+
+
 def assemble_command(args) -> int:
     from identification.fitting.six_axis_assembly import assemble
     check_output(args.out, "--out", suffixes=(".json", ".ssv"))

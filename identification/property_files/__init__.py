@@ -3,7 +3,9 @@
 - ``chrono_json``: Project Chrono's vehicle JSON bushings as a six-axis Kelvin-Voigt set;
 - ``teimorbit``: the TeimOrbit text format (blocks, values, tables) Altair's and Adams' files use;
 - ``gbs``: Altair's bushing property files (``.gbs``): splines as backbones, constant stiffness
-  and damping.
+  and damping;
+- ``export``: a parameter file written as a ``.gbs``: each direction's static curve and an
+  equivalent linear damping at an operating point.
 
 Each reader names what it does not take in a warning (``PropertyFileWarning``) and refuses what
 it cannot read with the file, the place and the value.
