@@ -269,18 +269,16 @@ def _add_export(subcommands) -> None:
     export_parser.add_argument("--format", choices=("gbs",), default="gbs", help="the property file's format (gbs)")
     export_parser.add_argument("--direction", metavar="DIR", help="the direction of a one-axis file: FX, FY, FZ, TX, "
                                                                   "TY or TZ")
-    export_parser.add_argument("--range-mm", type=float, default=default.range_mm, metavar="R",
-                               help=f"the translations' deflection range, -R to R [mm] (default {default.range_mm:g})")
-    export_parser.add_argument("--range-rad", type=float, default=default.range_rad, metavar="R",
-                               help=f"the rotations' range, -R to R [rad] (default {default.range_rad:g})")
-    export_parser.add_argument("--points", type=int, default=default.points, metavar="N",
-                               help=f"the spline's points, 2 to 32 (default {default.points})")
-    export_parser.add_argument("--amplitude-mm", type=float, default=default.amplitude_mm, metavar="X",
-                               help=f"the damping's sine amplitude on translations [mm] (default {default.amplitude_mm:g})")
-    export_parser.add_argument("--amplitude-rad", type=float, default=default.amplitude_rad, metavar="X",
-                               help=f"the damping's sine amplitude on rotations [rad] (default {default.amplitude_rad:g})")
-    export_parser.add_argument("--frequency-hz", type=float, default=default.frequency_hz, metavar="F",
-                               help=f"the damping's sine frequency [Hz] (default {default.frequency_hz:g})")
+    for field, kind, metavar, words in (
+            ("range_mm", float, "R", "the translations' deflection range, -R to R [mm]"),
+            ("range_rad", float, "R", "the rotations' range, -R to R [rad]"),
+            ("points", int, "N", "the spline's points, 2 to 32"),
+            ("amplitude_mm", float, "X", "the damping's sine amplitude on translations [mm]"),
+            ("amplitude_rad", float, "X", "the damping's sine amplitude on rotations [rad]"),
+            ("frequency_hz", float, "F", "the damping's sine frequency [Hz]")):
+        value = getattr(default, field)
+        export_parser.add_argument("--" + field.replace("_", "-"), type=kind, default=value, metavar=metavar,
+                                   help=f"{words} (default {value:g})")
     export_parser.add_argument("--out", type=Path, required=True, help="the property file to write (.gbs)")
 
 
