@@ -439,12 +439,16 @@ def heated_source(base: BushingModel, inner, text: str, shared: set[str], law_bo
         return tuple_text([f"{name}[{i}]" for i in range(n)] + [last])
     body, scaled = law_body(f"p[{index[ambient]}]", lambda i: f"p[{i}]")
     at_T, scaled_T = law_body("temperature_K", lambda i: f"m[1][{i}]")
-    stepping = "unheated_prepare_step(c, h)" if "def unheated_prepare_step" in inner_text else "c"
+    if "def unheated_prepare_step" in inner_text:
+        raise ModelContractError(f"the {base.name} model's step has constants of its own per step size "
+                                 "(prepare_step): self-heating, which prepares the model again at every step's "
+                                 "temperature, is not generated for it yet")
+    stepping = "c"
     source = [
         f"def prepare(p):\n{body}    return (unheated_prepare({scaled}), {tuple_text(f'p[{i}]' for i in range(size))}, "
         f"(p[{capacity}], p[{resistance}], p[{index[ambient]}]))\n",
         f"def heated_constants(m, temperature_K):\n{at_T}    return unheated_prepare({scaled_T})\n",
-        f"def initial_state(m, x0):\n" + (f"    s = unheated_initial_state(m[0], x0)\n" if n else "")
+        "def initial_state(m, x0):\n" + ("    s = unheated_initial_state(m[0], x0)\n" if n else "")
         + f"    return {out('s', 'm[2][2]')}\n",
         f"def jump(m, state, jump_mm):\n    c = heated_constants(m, state[{n}])\n"
         f"    s, status = unheated_jump(c, {own}, jump_mm)\n    return {out('s', f'state[{n}]')}, status\n",
@@ -466,8 +470,8 @@ def heated_source(base: BushingModel, inner, text: str, shared: set[str], law_bo
         f"    return {out('d', f'(power - (state[{n}] - m[2][2]) / m[2][1]) / m[2][0]')}\n",
         f"def switches(m, state, x, v):\n    return unheated_switches(heated_constants(m, state[{n}]), {own}, x, v)\n"]
     if "def unheated_resting_state" in inner_text:
-        source.append(f"def resting_state(m, x0, force):\n" + (f"    s = unheated_resting_state(m[0], x0, force)\n"
-                                                                if n else "")
+        source.append("def resting_state(m, x0, force):\n" + ("    s = unheated_resting_state(m[0], x0, force)\n"
+                                                              if n else "")
                       + f"    return {out('s', 'm[2][2]')}\n")
     if "def unheated_update" in inner_text:
         source.append(f"def update(m, state, x, v):\n    s = unheated_update(heated_constants(m, state[{n}]), {own}, x, v)\n"

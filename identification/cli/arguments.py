@@ -252,10 +252,12 @@ def _add_import(subcommands) -> None:
                                                        "\"Bushing Data\" (.json) or an Altair bushing file (.gbs)")
     import_parser.add_argument("--bushing", metavar="NAME", help="the bushing, by its part's name, where the file "
                                                                  "holds several (\"Lower Control Arm\")")
-    import_parser.add_argument("--dof", metavar="AXIS", choices=("x", "y", "z", "rx", "ry", "rz"),
-                               help="the joint's free degree of freedom, which takes the file's DOF values "
-                                    "(default: they are left out, with a warning)")
-    import_parser.add_argument("--out", type=Path, required=True, help="six-axis parameter file to write (.json, .ssv)")
+    import_parser.add_argument("--joint", choices=("revolute", "universal", "spherical"),
+                               help="a Chrono bushing's joint, whose free rotations take the file's DOF values "
+                                    "(revolute: rz; universal: rx, ry; spherical: all three; default: they are "
+                                    "left out, with a warning)")
+    import_parser.add_argument("--out", type=Path, required=True, help="six-axis parameter file to write (.json: an "
+                                                                         ".ssv does not say an axis's options)")
 
 
 def _add_export(subcommands) -> None:

@@ -50,10 +50,11 @@ class OperatingPoint:
 
 def _axis_sets(path: Path, direction: str | None) -> dict[str, ParameterSet]:
     """{axis: its set} of a six-axis file, or of a one-axis file put on ``direction`` (FX ... TZ)."""
-    try:
+    if _is_six_axis(path):
+        if direction is not None:
+            raise IdentificationError(f"{path} is a six-axis file: every direction is written (leave out "
+                                      f"--direction {direction})")
         return dict(read_six_axis(path).axes)
-    except Exception:      # not a six-axis file: a one-axis one, read below with its own errors
-        pass
     one = read_parameter_set(path)
     if direction is None:
         raise IdentificationError(f"{path} is a one-axis parameter file: say which direction it is (--direction "
@@ -62,6 +63,19 @@ def _axis_sets(path: Path, direction: str | None) -> dict[str, ParameterSet]:
         raise IdentificationError(f"direction {direction!r}: one of {', '.join(DIRECTIONS)}")
     axis = next(a for a in SIX_AXES if a.name == DIRECTIONS[direction])
     return {axis.name: ParameterSet(model_on_axis(one.model, axis), one.parameters, one.provenance)}
+
+
+def _is_six_axis(path: Path) -> bool:
+    """Whether the parameter file at ``path`` is a six-axis set (its model or set name says so)."""
+    import json
+    import xml.etree.ElementTree as ET
+    from fmu_src.fmi.axes import SIX_AXIS_IDENTIFIER
+    try:
+        if path.suffix.lower() == ".ssv":
+            return ET.parse(path).getroot().get("name") == SIX_AXIS_IDENTIFIER
+        return json.loads(path.read_text(encoding="utf-8")).get("model") == SIX_AXIS_IDENTIFIER
+    except (OSError, ValueError, ET.ParseError, AttributeError):
+        return False          # the one-axis reader says what is wrong with it
 
 
 def _curve_and_damping(one: ParameterSet, rotational: bool, point: OperatingPoint) -> tuple[np.ndarray, np.ndarray, float]:
@@ -77,7 +91,14 @@ def _curve_and_damping(one: ParameterSet, rotational: bool, point: OperatingPoin
         raise IdentificationError(f"the {model.name} model's static force is not finite over +-{reach:g}")
     amplitude = point.amplitude_rad if rotational else point.amplitude_mm
     sheet = data_sheet(model, [values], [amplitude], [point.frequency_hz], 0.0, SteadyStateLoop())
-    damping = float(sheet.loss_N_per_mm[0]) / (2.0 * math.pi * point.frequency_hz)
+    omega = 2.0 * math.pi * point.frequency_hz
+    damping = float(sheet.loss_N_per_mm[0]) / omega
+    if damping < 0.0:
+        # a loss stiffness at rounding's size (an axis without damping) is none; a real one is refused
+        if -damping > 1e-9 * abs(float(sheet.storage_N_per_mm[0])) / omega:
+            raise IdentificationError(f"the {model.name} model's equivalent damping at {amplitude:g}, "
+                                      f"{point.frequency_hz:g} Hz is {damping:g} < 0: it puts energy in")
+        damping = 0.0
     return x, force, damping
 
 

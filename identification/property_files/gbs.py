@@ -24,9 +24,9 @@ the project's units (mm, rad, N, N.mm, s):
 - a direction with no formulation active: a free axis (k = 0, c = 0), warned.
 
 Refused, with the file, the line and what is allowed: a unit the reader does not know, a spline
-whose deflection does not increase, a direction the activity table leaves out, an active
-formulation without its block, a block the layout does not know (warned instead where its name is
-plausible but unread).
+whose deflection does not increase or whose table is not ``{ disp force }`` of numbers, a
+direction the activity table leaves out, an active formulation without its block, a block the
+layout does not know, a value given twice in a block.
 """
 from __future__ import annotations
 
@@ -48,7 +48,7 @@ LENGTH_MM = {"mm": 1.0, "millimeter": 1.0, "millimetre": 1.0, "cm": 10.0, "centi
 ANGLE_RAD = {"rad": 1.0, "radian": 1.0, "radians": 1.0, "deg": math.pi / 180.0, "degree": math.pi / 180.0,
              "degrees": math.pi / 180.0}
 FORCE_N = {"newton": 1.0, "n": 1.0, "kilonewton": 1000.0, "kn": 1000.0, "pound_force": 4.4482216152605,
-           "lbf": 4.4482216152605, "kg_force": 9.80665, "kgf": 9.80665}
+           "lbf": 4.4482216152605, "kg_force": 9.80665, "kgf": 9.80665, "kilogram_force": 9.80665}
 TIME_S = {"second": 1.0, "sec": 1.0, "s": 1.0, "millisecond": 1e-3, "ms": 1e-3, "minute": 60.0, "hour": 3600.0}
 KNOWN_BLOCKS = {"HEADER", "UNITS", "GLOBAL", "DIRECTIONS", "FRICTION"} | {
     f"{formulation}_{direction}" for formulation in FORMULATIONS for direction in DIRECTIONS}
@@ -148,6 +148,16 @@ def read_gbs(path: str | Path) -> ImportedBushing:
             if table is None or len(table.rows) < 2:
                 raise IdentificationError(f"{path}, line {block.line}: [{block.name}] needs a (SPLINE_DATA) table "
                                           "{ disp force } of at least 2 rows")
+            columns = [name.lower() for name in table.columns]
+            if sorted(columns) != ["disp", "force"]:
+                raise IdentificationError(f"{path}, line {block.line}: [{block.name}]'s table has the columns "
+                                          f"{{ {' '.join(table.columns)} }}; a spline's are {{ disp force }}")
+            for line, cells in table.rows:
+                if not all(isinstance(cell, float) and math.isfinite(cell) for cell in cells):
+                    raise IdentificationError(f"{path}, line {line}: [{block.name}] {cells!r} is not a row of two "
+                                              "finite numbers (disp, force)")
+            order = (columns.index("disp"), columns.index("force"))
+            table.rows = [(line, (cells[order[0]], cells[order[1]])) for line, cells in table.rows]
             if len(table.rows) > MAX_KNOTS:
                 raise IdentificationError(f"{path}, line {block.line}: [{block.name}] has {len(table.rows)} points; "
                                           f"a backbone takes 2 to {MAX_KNOTS}")

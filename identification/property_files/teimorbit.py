@@ -44,13 +44,26 @@ def _value(text: str, path: Path, number: int):
         raise IdentificationError(f"{path}, line {number}: {text!r} is neither a number nor a quoted string") from None
 
 
+def _without_comment(line: str) -> str:
+    """The line without a trailing ``$`` comment (a ``$`` inside quotes is text)."""
+    quote = ""
+    for i, character in enumerate(line):
+        if quote:
+            quote = "" if character == quote else quote
+        elif character in "'\"":
+            quote = character
+        elif character == "$":
+            return line[:i]
+    return line
+
+
 def read_teimorbit(path: str | Path) -> dict[str, Block]:
     """The blocks of a TeimOrbit file by name (module docstring). IdentificationError names the
     file and line of what it cannot read (a line outside every block, a block twice, a table row
     with a column too many or too few or not a number)."""
     path = Path(path)
     try:
-        lines = path.read_text(encoding="utf-8", errors="strict").splitlines()
+        lines = path.read_text(encoding="utf-8-sig", errors="strict").splitlines()   # -sig: a BOM
     except FileNotFoundError:
         raise IdentificationError(f"property file {path} does not exist") from None
     except UnicodeDecodeError as exc:
@@ -58,7 +71,7 @@ def read_teimorbit(path: str | Path) -> dict[str, Block]:
     blocks: dict[str, Block] = {}
     block, sub, table = None, "", None
     for number, raw in enumerate(lines, start=1):
-        line = raw.strip()
+        line = _without_comment(raw).strip()
         if not line or line.startswith("$"):
             continue
         if (match := _BLOCK.match(line)) is not None:
@@ -81,7 +94,11 @@ def read_teimorbit(path: str | Path) -> dict[str, Block]:
             block.tables[sub] = table
             continue
         if (match := _VALUE.match(line)) is not None and table is None:
-            block.values[match["name"].upper()] = (number, _value(match["value"], path, number))
+            name = match["name"].upper()
+            if name in block.values:
+                raise IdentificationError(f"{path}, line {number}: [{block.name}] gives {name} twice (also line "
+                                          f"{block.values[name][0]})")
+            block.values[name] = (number, _value(match["value"], path, number))
             continue
         if table is not None:
             cells = line.split()

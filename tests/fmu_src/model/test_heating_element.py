@@ -85,6 +85,12 @@ def test_heating_needs_a_law_and_positive_constants():
         model.check({**params(), "thermal_resistance": -1.0})
 
 
+def test_a_model_whose_step_has_constants_of_its_own_is_refused_not_miscompiled():
+    from fmu_src.model.definition import ModelContractError
+    with pytest.raises(ModelContractError, match="fractional model's step has constants of its own per step size"):
+        get_model("fractional+wlf+heating")
+
+
 def test_a_model_without_states_of_its_own_heats_too():
     """Kelvin-Voigt's force is its spring's and its dashpot's: the heat c v^2 alone."""
     model = get_model("kelvin_voigt+wlf+heating")

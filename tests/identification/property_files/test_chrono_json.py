@@ -35,15 +35,21 @@ def test_the_hmmwv_bushings_in_the_projects_units(name):
     assert imported.provenance["bushing"] == name and imported.provenance["format"] == "chrono-json"
 
 
-def test_the_free_axis_takes_the_dof_values_and_without_one_they_are_left_out_with_a_warning():
-    with pytest.warns(PropertyFileWarning, match="belong to the joint's free degree of freedom, which the file does "
-                                                 "not name: left out"):
+def test_the_joints_free_rotations_take_the_dof_values_and_without_a_joint_they_are_left_out_with_a_warning():
+    with pytest.warns(PropertyFileWarning, match="belong to the free rotations of the joint it replaces, which the "
+                                                 "file does not name: left out"):
         read_chrono_bushing(HMMWV, "Lower Control Arm")
     with warnings.catch_warnings():
         warnings.simplefilter("error", PropertyFileWarning)
-        free = read_chrono_bushing(HMMWV, "Lower Control Arm", "rz")
-    assert free.axes["rz"][1] == {"k": 0.0, "c": 0.0, "preload": 0.0} and free.axes["rx"][1]["k"] == 1e8
-    assert free.provenance["free_axis"] == "rz"
+        revolute = read_chrono_bushing(HMMWV, "Lower Control Arm", "revolute")
+        spherical = read_chrono_bushing(HMMWV, "Lower Control Arm", "spherical")
+    # Chrono's ChVehicleJoint: the DOF values on the joint's free rotations, never on a translation
+    assert revolute.axes["rz"][1] == {"k": 0.0, "c": 0.0, "preload": 0.0} and revolute.axes["rx"][1]["k"] == 1e8
+    assert all(spherical.axes[a][1]["k"] == 0.0 for a in ("rx", "ry", "rz"))
+    assert all(spherical.axes[a][1]["k"] == 7e4 for a in ("x", "y", "z"))
+    assert revolute.provenance["free_axes"] == ["rz"]
+    with pytest.raises(IdentificationError, match="joint 'prismatic': one of revolute, universal, spherical"):
+        read_chrono_bushing(HMMWV, "Lower Control Arm", "prismatic")
 
 
 def test_import_to_a_six_axis_fmu_gives_k_x_plus_c_v(tmp_path):
@@ -102,16 +108,32 @@ def test_refusals_name_the_file_the_key_and_what_is_allowed(tmp_path):
     extra["Upper Control Arm"]["Bushing Data"]["Preload"] = 10.0
     (tmp_path / "extra.json").write_text(json.dumps(extra))
     with pytest.warns(PropertyFileWarning, match="'Preload' not read"):
-        read_chrono_bushing(tmp_path / "extra.json", "Upper Control Arm", "rz")
+        read_chrono_bushing(tmp_path / "extra.json", "Upper Control Arm", "revolute")
     (tmp_path / "bad.json").write_text('{"Bushing Data": {\n  "Stiffness Linear": 7e7,,\n}}')
     with pytest.raises(IdentificationError, match="bad.json, line 2, column 27: not JSON"):
         read_chrono_bushing(tmp_path / "bad.json")
     del data
 
 
+def test_comments_a_byte_order_mark_and_two_bushings_of_one_name(tmp_path):
+    text = HMMWV.read_text()
+    commented = "\ufeff// Chrono allows comments\n" + text.replace('"Stiffness Linear": 7e7,',
+                                                                    '"Stiffness Linear": 7e7, /* N/m */', 1)
+    (tmp_path / "commented.json").write_text(commented, encoding="utf-8")
+    assert quiet_read(tmp_path / "commented.json", "Upper Control Arm").axes["x"][1]["k"] == 7e4
+    twice = json.loads(text)
+    twice["Spindle"]["Upper Control Arm"] = {"Bushing Data": twice["Upper Control Arm"]["Bushing Data"]}
+    (tmp_path / "twice.json").write_text(json.dumps(twice))
+    with pytest.raises(IdentificationError, match="two bushings are named 'Upper Control Arm'"):
+        read_chrono_bushing(tmp_path / "twice.json", "Upper Control Arm")
+    (tmp_path / "latin.json").write_bytes(b'{"Bushing Data": {"Stiffness Linear": 7e7} "\xe9"}')
+    with pytest.raises(IdentificationError, match="not UTF-8 text"):
+        read_chrono_bushing(tmp_path / "latin.json")
+
+
 def test_the_command_line_imports_and_refuses_what_it_does_not_read(tmp_path, capsys):
     from identification.cli.arguments import main
-    assert main(["import", str(HMMWV), "--bushing", "Lower Control Arm", "--dof", "rz",
+    assert main(["import", str(HMMWV), "--bushing", "Lower Control Arm", "--joint", "revolute",
                  "--out", str(tmp_path / "lca.json")]) == 0
     written = json.loads((tmp_path / "lca.json").read_text())
     assert written["model"] == "SixAxisBushing" and written["axes"]["rz"]["parameters"]["k"] == 0.0

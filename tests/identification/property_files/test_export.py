@@ -72,6 +72,16 @@ def test_the_paper_table5_fit_exported_on_fz_is_its_static_force_at_rest(tmp_pat
     assert six.exists()
 
 
+def test_an_axis_without_damping_exports_none_and_reads_back(tmp_path):
+    """A spring alone: its loss stiffness is rounding (about -1e-13), written as 0, not refused."""
+    from fmu_src.parameter_files import save_parameters
+    spring = save_parameters(tmp_path / "spring.json", dict(k=500.0, c=0.0, preload=0.0), "kelvin_voigt")
+    back = imported(export_gbs(spring, tmp_path / "spring.gbs", direction="FX"))
+    assert back.axes["x"][1]["c"] == 0.0
+    with pytest.raises(IdentificationError, match="is a six-axis file: every direction is written"):
+        gbs_text(SIX, direction="FX")
+
+
 def test_bad_operating_points_are_refused_with_their_unit():
     with pytest.raises(IdentificationError, match=r"frequency_hz = 0.0 \[Hz\] must be a finite number > 0"):
         OperatingPoint(frequency_hz=0.0)

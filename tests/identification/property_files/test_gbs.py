@@ -96,6 +96,31 @@ def test_bad_files_are_refused_with_the_line_and_what_is_allowed(tmp_path, chang
         quiet_read(path)
 
 
+@pytest.mark.parametrize("change, message", [
+    (("C = 1.2", "C = 1.2\nC = 1.3"), r"\[CONSTANT_DAMPING_FX\] gives C twice"),
+    (("{ disp force }\n -4.0  -2600.0", "{ disp force k }\n -4.0  -2600.0 1"), r"3 values for the 2 columns|columns"),
+    ((" -4.0  -2600.0", " -4.0  'soft'"), r"is not a row of two finite numbers"),
+])
+def test_misleading_tables_and_repeated_values_are_refused(tmp_path, change, message):
+    path = tmp_path / "bad.gbs"
+    path.write_text(MOUNT.read_text().replace(change[0], change[1], 1))
+    with pytest.raises(IdentificationError, match=message):
+        quiet_read(path)
+
+
+def test_columns_by_name_trailing_comments_and_a_byte_order_mark(tmp_path):
+    text = MOUNT.read_text()
+    start = text.index("[SPLINE_STIFFNESS_FX]")
+    end = text.index("[CONSTANT_DAMPING_FX]")
+    swapped = "[SPLINE_STIFFNESS_FX]\n(SPLINE_DATA)\n{ force disp }\n" + "".join(f"{f} {x}\n" for x, f in FX)
+    path = tmp_path / "swapped.gbs"
+    path.write_text("\ufeff" + (text[:start] + swapped + text[end:]).replace("C = 1.2", "C = 1.2   $ N.s/mm", 1),
+                    encoding="utf-8")
+    axes = quiet_read(path).axes
+    assert [(axes["x"][1][f"backbone_x{i}"], axes["x"][1][f"backbone_F{i}"]) for i in range(1, 10)] == FX
+    assert axes["x"][1]["c"] == 1.2
+
+
 def test_the_command_line_imports_a_gbs(tmp_path):
     import json
     from identification.cli.arguments import main
