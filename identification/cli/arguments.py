@@ -247,9 +247,10 @@ def _add_import(subcommands) -> None:
     """The ``import`` command's arguments."""
     import_parser = subcommands.add_parser(
         "import", help="read another tool's bushing property file into a six-axis parameter file (Chrono's vehicle "
-                       "JSON, Altair's .gbs)")
+                       "JSON, Altair's .gbs, Adams' .bus)")
     import_parser.add_argument("file", type=Path, help="the property file: a Chrono vehicle JSON file with "
-                                                       "\"Bushing Data\" (.json) or an Altair bushing file (.gbs)")
+                                                       "\"Bushing Data\" (.json), an Altair bushing file (.gbs) or "
+                                                       "an Adams nonlinear bushing file (.bus)")
     import_parser.add_argument("--bushing", metavar="NAME", help="the bushing, by its part's name, where the file "
                                                                  "holds several (\"Lower Control Arm\")")
     import_parser.add_argument("--joint", choices=("revolute", "universal", "spherical"),

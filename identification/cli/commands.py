@@ -368,16 +368,19 @@ def design_command(args) -> int:
 def import_command(args) -> int:
     from fmu_src.parameter_files import save_six_axis
     from identification.property_files.chrono_json import read_chrono_bushing
+    from identification.property_files.bus import read_bus
     from identification.property_files.gbs import read_gbs
     check_output(args.out, "--out", suffixes=(".json",))
     suffix = args.file.suffix.lower()
-    if suffix not in (".json", ".gbs"):
-        raise UsageError(f"{args.file}: the property files this version reads are Chrono's vehicle JSON (.json) and "
-                         "Altair's bushing files (.gbs); Adams' .bus is not read yet")
-    if suffix == ".gbs" and (args.bushing or args.joint):
-        raise UsageError(f"{args.file}: --bushing and --joint are for Chrono's files; a .gbs holds one bushing with "
-                         "all six directions")
-    imported = read_gbs(args.file) if suffix == ".gbs" else read_chrono_bushing(args.file, args.bushing, args.joint)
+    readers = {".gbs": read_gbs, ".bus": read_bus}
+    if suffix not in (".json", *readers):
+        raise UsageError(f"{args.file}: the property files this version reads are Chrono's vehicle JSON (.json), "
+                         "Altair's bushing files (.gbs) and Adams' nonlinear bushing files (.bus)")
+    if suffix in readers and (args.bushing or args.joint):
+        raise UsageError(f"{args.file}: --bushing and --joint are for Chrono's files; a {suffix} holds one bushing "
+                         "with all six directions")
+    imported = (readers[suffix](args.file) if suffix in readers
+                else read_chrono_bushing(args.file, args.bushing, args.joint))
     path = save_six_axis(args.out, imported.axes, imported.provenance)
     name = imported.provenance.get("bushing", args.file.name)
     print(f"{name}: " + ", ".join(f"{axis} {model}" for axis, (model, _) in imported.axes.items())

@@ -4,6 +4,7 @@
 - ``teimorbit``: the TeimOrbit text format (blocks, values, tables) Altair's and Adams' files use;
 - ``gbs``: Altair's bushing property files (``.gbs``): splines as backbones, constant stiffness
   and damping;
+- ``bus``: Adams' nonlinear bushing property files (``.bus``): curves as backbones, damping;
 - ``export``: a parameter file written as a ``.gbs``: each direction's static curve and an
   equivalent linear damping at an operating point.
 

@@ -37,7 +37,7 @@ from pathlib import Path
 from fmu_src.model.registry import LINEAR_BASELINE
 from identification.errors import IdentificationError
 from identification.property_files.chrono_json import ImportedBushing, PropertyFileWarning
-from identification.property_files.teimorbit import read_teimorbit
+from identification.property_files.teimorbit import read_layout
 
 FORMAT = "gbs"
 DIRECTIONS = {"FX": "x", "FY": "y", "FZ": "z", "TX": "rx", "TY": "ry", "TZ": "rz"}
@@ -113,17 +113,37 @@ def _constant(block, path: Path, key: str) -> float:
     return value
 
 
+def curve_axis(path: Path, block, rows, travel: float, load: float, damping: float) -> tuple[str, dict]:
+    """(model, parameters) of a direction whose static force is the curve ``rows`` [(line,
+    (deflection, force))] in the file's units (times ``travel`` and ``load`` to the project's):
+    Kelvin-Voigt with a backbone through its points and the dashpot ``damping``; refused with the
+    line where the deflections do not increase or the points are more than a backbone takes."""
+    if len(rows) > MAX_KNOTS:
+        raise IdentificationError(f"{path}, line {block.line}: [{block.name}] has {len(rows)} points; a backbone "
+                                  f"takes 2 to {MAX_KNOTS}")
+    for (line, (x0, _)), (_, (x1, _)) in zip(rows, rows[1:]):
+        if not x1 > x0:
+            raise IdentificationError(f"{path}, line {line + 1}: [{block.name}] deflection {x1:g} after {x0:g}: the "
+                                      "deflections must increase")
+    parameters = {"c": damping, "preload": 0.0}
+    for i, (_, (x, f)) in enumerate(rows):
+        parameters[f"backbone_x{i + 1}"] = x * travel
+        parameters[f"backbone_F{i + 1}"] = f * load
+    return f"{LINEAR_BASELINE.name}+backbone{len(rows)}", parameters
+
+
+def units_of(blocks, path: Path) -> tuple[float, float, float, float]:
+    """(length to mm, angle to rad, force to N, time to s) of the ``[UNITS]`` block."""
+    return (_unit(blocks, path, "LENGTH", LENGTH_MM), _unit(blocks, path, "ANGLE", ANGLE_RAD, "radians"),
+            _unit(blocks, path, "FORCE", FORCE_N), _unit(blocks, path, "TIME", TIME_S, "second"))
+
+
 def read_gbs(path: str | Path) -> ImportedBushing:
     """The bushing of Altair's ``.gbs`` file ``path`` as a six-axis set (module docstring)."""
     path = Path(path)
-    blocks = read_teimorbit(path)
-    unknown = sorted(set(blocks) - KNOWN_BLOCKS)
-    if unknown:
-        raise IdentificationError(f"{path}: block(s) {', '.join(f'[{b}] (line {blocks[b].line})' for b in unknown)} "
-                                  "not in the .gbs layout; its blocks are HEADER, UNITS, GLOBAL, DIRECTIONS, "
-                                  "FRICTION and <formulation>_<direction>")
-    length, angle = _unit(blocks, path, "LENGTH", LENGTH_MM), _unit(blocks, path, "ANGLE", ANGLE_RAD, "radians")
-    force, time = _unit(blocks, path, "FORCE", FORCE_N), _unit(blocks, path, "TIME", TIME_S, "second")
+    blocks = read_layout(path, KNOWN_BLOCKS, ".gbs", "HEADER, UNITS, GLOBAL, DIRECTIONS, FRICTION and "
+                                                      "<formulation>_<direction>")
+    length, angle, force, time = units_of(blocks, path)
     active = _activity(blocks, path)
     unread, axes = [], {}
     if "FRICTION" in blocks and blocks["FRICTION"].values:
@@ -157,20 +177,8 @@ def read_gbs(path: str | Path) -> ImportedBushing:
                     raise IdentificationError(f"{path}, line {line}: [{block.name}] {cells!r} is not a row of two "
                                               "finite numbers (disp, force)")
             order = (columns.index("disp"), columns.index("force"))
-            table.rows = [(line, (cells[order[0]], cells[order[1]])) for line, cells in table.rows]
-            if len(table.rows) > MAX_KNOTS:
-                raise IdentificationError(f"{path}, line {block.line}: [{block.name}] has {len(table.rows)} points; "
-                                          f"a backbone takes 2 to {MAX_KNOTS}")
-            for (line, (x0, _)), (_, (x1, _)) in zip(table.rows, table.rows[1:]):
-                if not x1 > x0:
-                    raise IdentificationError(f"{path}, line {line + 1}: [{block.name}] deflection {x1:g} after "
-                                              f"{x0:g}: the deflections must increase")
-            knots = len(table.rows)
-            parameters = {"c": damping, "preload": 0.0}
-            for i, (_, (x, f)) in enumerate(table.rows):
-                parameters[f"backbone_x{i + 1}"] = x * travel
-                parameters[f"backbone_F{i + 1}"] = f * load
-            axes[axis] = (f"{LINEAR_BASELINE.name}+backbone{knots}", parameters)
+            rows = [(line, (cells[order[0]], cells[order[1]])) for line, cells in table.rows]
+            axes[axis] = curve_axis(path, block, rows, travel, load, damping)
         else:
             stiffness = 0.0
             if "CONSTANT_STIFFNESS" in formulations:

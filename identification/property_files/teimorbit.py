@@ -109,3 +109,14 @@ def read_teimorbit(path: str | Path) -> dict[str, Block]:
             continue
         raise IdentificationError(f"{path}, line {number}: {line!r} is not a value, a table or a block")
     return blocks
+
+
+def read_layout(path: str | Path, known: set[str], layout: str, blocks_in_words: str) -> dict[str, Block]:
+    """:func:`read_teimorbit` of a file whose blocks must be among ``known`` (the ``layout``'s, a
+    ``.gbs``'s or a ``.bus``'s, ``blocks_in_words`` what they are): another is refused with its line."""
+    blocks = read_teimorbit(path)
+    unknown = sorted(set(blocks) - known)
+    if unknown:
+        raise IdentificationError(f"{path}: block(s) {', '.join(f'[{b}] (line {blocks[b].line})' for b in unknown)} "
+                                  f"not in the {layout} layout; its blocks are {blocks_in_words}")
+    return blocks

@@ -138,7 +138,7 @@ def test_the_command_line_imports_and_refuses_what_it_does_not_read(tmp_path, ca
     written = json.loads((tmp_path / "lca.json").read_text())
     assert written["model"] == "SixAxisBushing" and written["axes"]["rz"]["parameters"]["k"] == 0.0
     assert written["fit"]["imported_from"].endswith("HMMWV_DoubleWishboneFront_bushings.json")
-    bus = tmp_path / "mount.bus"
-    bus.write_text("[MDI_HEADER]\n")
-    assert main(["import", str(bus), "--out", str(tmp_path / "x.json")]) == 2
-    assert "Adams' .bus is not read yet" in capsys.readouterr().err
+    other = tmp_path / "mount.gdf"
+    other.write_text("[MDI_HEADER]\n")
+    assert main(["import", str(other), "--out", str(tmp_path / "x.json")]) == 2
+    assert "Adams' nonlinear bushing files (.bus)" in capsys.readouterr().err
