@@ -217,13 +217,18 @@ SERIES_ITERATIONS = 60
 """Device steps a series element's step may take to find the device's velocity (``options.series``)."""
 
 
+def renamed(text: str, names: set[str], prefix: str) -> str:
+    """Kernel source ``text`` with its functions ``names`` (and the reads of them) renamed
+    ``<prefix><name>``: the inner model a wrapper delegates to."""
+    renamer = _Rename(names, prefix=prefix)
+    return "\n\n\n".join(ast.unparse(renamer.visit(node)) for node in parse(text).body)
+
+
 def _device_source(base: BushingModel, inner) -> tuple[str, set[str]]:
     """The device's kernels (the base with the options before the series element) as source, named
     ``device_<kernel>``, and the shared names they import."""
     text, shared = wrapper_source(base, inner)
-    tree = parse(text)
-    renamer = _Rename(set(DEVICE_KERNELS), prefix="device_")
-    return "\n\n\n".join(ast.unparse(renamer.visit(node)) for node in tree.body), shared
+    return renamed(text, set(DEVICE_KERNELS), "device_"), shared
 
 
 def _series_start_source(n: int, zero: str) -> str:
@@ -408,9 +413,8 @@ def law_wrapper_source(base: BushingModel, options) -> tuple[str, set[str]]:
         return body, tuple_text(scaled)
     temperature = f"p[{index[law.specs(count)[0].name]}]"
     if heating:
-        return heated_source(base, inner, text, shared, law_body, index, heating[0])
-    renamer = _Rename({"prepare"}, prefix="unconditioned_")
-    text = "\n\n\n".join(ast.unparse(renamer.visit(node)) for node in parse(text).body)
+        return heated_source(base, inner, text, shared, law_body, temperature, index, heating[0])
+    text = renamed(text, {"prepare"}, "unconditioned_")
     body, scaled = law_body(temperature, lambda i: f"p[{i}]")
     prepare = f"def prepare(p):\n{body}    return unconditioned_prepare({scaled})\n"
     return text + "\n\n\n" + prepare, shared
@@ -420,33 +424,31 @@ HEATED_KERNELS = DEVICE_KERNELS
 """The kernels of a heated model's inner model, renamed ``unheated_<name>`` under the thermal wrapper."""
 
 
-def heated_source(base: BushingModel, inner, text: str, shared: set[str], law_body, index: dict,
+def heated_source(base: BushingModel, inner, text: str, shared: set[str], law_body, ambient: str, index: dict,
                   heating) -> tuple[str, set[str]]:
     """The kernels of a model with a temperature law and a thermal state (``options.heating``):
     the inner model (without the law and the heating, its kernels renamed ``unheated_*``) at the
     rubber's temperature, the state's last entry; ``heated_constants(m, T)`` its constants there
-    (the law at T); the thermal state stepped by the trapezoid of F v and the cooling law."""
+    (the law at T); the thermal state stepped by the trapezoid of F v and the cooling law.
+    ``ambient``: the text of the law's temperature parameter (then the surroundings')."""
     element, count = heating
-    renamer = _Rename(set(HEATED_KERNELS), prefix="unheated_")
-    inner_text = "\n\n\n".join(ast.unparse(renamer.visit(node)) for node in parse(text).body)
+    inner_text = renamed(text, set(HEATED_KERNELS), "unheated_")
     n = len(base.states) + sum(len(e.states(c)) for e, c in inner.elements)
     size = len(index)
     capacity, resistance = (index[spec.name] for spec in element.specs(count))
-    ambient = next(name for name, i in index.items() if name == "temperature")
     own = tuple_text(f"state[{i}]" for i in range(n))
 
     def out(name: str, last: str) -> str:
         return tuple_text([f"{name}[{i}]" for i in range(n)] + [last])
-    body, scaled = law_body(f"p[{index[ambient]}]", lambda i: f"p[{i}]")
+    body, scaled = law_body(ambient, lambda i: f"p[{i}]")
     at_T, scaled_T = law_body("temperature_K", lambda i: f"m[1][{i}]")
     if "def unheated_prepare_step" in inner_text:
         raise ModelContractError(f"the {base.name} model's step has constants of its own per step size "
                                  "(prepare_step): self-heating, which prepares the model again at every step's "
                                  "temperature, is not generated for it yet")
-    stepping = "c"
     source = [
         f"def prepare(p):\n{body}    return (unheated_prepare({scaled}), {tuple_text(f'p[{i}]' for i in range(size))}, "
-        f"(p[{capacity}], p[{resistance}], p[{index[ambient]}]))\n",
+        f"(p[{capacity}], p[{resistance}], {ambient}))\n",
         f"def heated_constants(m, temperature_K):\n{at_T}    return unheated_prepare({scaled_T})\n",
         "def initial_state(m, x0):\n" + ("    s = unheated_initial_state(m[0], x0)\n" if n else "")
         + f"    return {out('s', 'm[2][2]')}\n",
@@ -455,7 +457,7 @@ def heated_source(base: BushingModel, inner, text: str, shared: set[str], law_bo
         f"def integrate(m, state, x, v, h, max_substeps):\n"
         f"    temperature_K = state[{n}]\n    c = heated_constants(m, temperature_K)\n"
         f"    f0 = unheated_force(c, {own}, x, v)\n"
-        f"    s, used, status = unheated_integrate({stepping}, {own}, x, v, h, max_substeps)\n"
+        f"    s, used, status = unheated_integrate(c, {own}, x, v, h, max_substeps)\n"
         f"    f1 = unheated_force(c, s, x + v * h, v)\n"
         f"    # the trapezoid of F v [N.mm/s = mW] over the step, in W\n"
         f"    power = 0.0005 * (f0 + f1) * v\n"
